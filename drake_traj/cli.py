@@ -1,0 +1,72 @@
+"""``drake-traj``: run scenarios from the command line.
+
+    drake-traj run [SCENARIO.yaml] [--out DIR] [--meshcat]
+
+writes DIR/result.npz, DIR/metrics.json, DIR/*.png and DIR/meshcat.html.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from pydrake.geometry import Meshcat
+
+from drake_traj.diagram import simulate
+from drake_traj.meshcat import draw_task, export_html
+from drake_traj.scenario import default_scenario_path, load_scenario, make_planner
+
+
+def run(scenario_path, out_dir, *, live_meshcat: bool = False) -> int:
+    """Simulate one scenario and write its outputs; returns the process exit code."""
+    scenario = load_scenario(scenario_path)
+    out_dir = Path(out_dir) if out_dir else Path("out") / scenario.name
+    meshcat = Meshcat()
+    if live_meshcat:
+        print(f"Meshcat: {meshcat.web_url()}", flush=True)
+    result = simulate(
+        make_planner(scenario),
+        name=scenario.name,
+        gains=scenario.controller,
+        time_step=scenario.time_step,
+        log_period=scenario.log_period,
+        settle_time=scenario.settle_time,
+        max_duration=scenario.max_duration,
+        meshcat=meshcat,
+        realtime_rate=1.0 if live_meshcat else 0.0,
+    )
+    result.save(out_dir)
+    result.save_figures(out_dir)
+    draw_task(meshcat, result)
+    export_html(meshcat, out_dir / "meshcat.html")
+    metrics = result.metrics()
+    print(json.dumps({key: metrics[key] for key in (
+        "name", "succeeded", "failure", "duration_s", "max_velocity_over_limit",
+        "max_acceleration_over_limit", "tracking_error_joint_max_rad", "tracking_error_tcp_max_m",
+        "real_time_factor")}, indent=2))
+    print(f"wrote {out_dir}/result.npz, metrics.json, *.png, meshcat.html")
+    if live_meshcat:
+        input("Meshcat is serving the recording; press Enter to quit. ")
+    return 0 if result.succeeded else 1
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="drake-traj", description=__doc__.splitlines()[0])
+    commands = parser.add_subparsers(dest="command", required=True)
+    run_parser = commands.add_parser("run", help="simulate a scenario and write its results")
+    run_parser.add_argument("scenario", nargs="?", default=None,
+                            help=f"scenario YAML (default: {default_scenario_path().name})")
+    run_parser.add_argument("--out", default=None, help="output directory (default: out/<scenario name>)")
+    run_parser.add_argument("--meshcat", action="store_true", help="serve Meshcat live during the run")
+    args = parser.parse_args(argv)
+    try:
+        return run(args.scenario or default_scenario_path(), args.out, live_meshcat=args.meshcat)
+    except ValueError as error:
+        print(f"drake-traj: error: {error}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

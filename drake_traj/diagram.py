@@ -1,0 +1,255 @@
+"""The closed loop: planner -> PD controller with gravity compensation -> discrete UR10e plant.
+
+The PD loop uses the plant's own PD-controlled actuators (``JointActuator.set_controller_gains``):
+the discrete solver treats the PD terms implicitly, so stiff gains stay stable at the 1 ms step
+even on the light wrist links, and the total torque saturates at each joint's effort limit like a
+real drive. The feed-forward, added on the actuation input, is gravity compensation g(q) or, with
+``feedforward_acceleration``, the full inverse dynamics M(q) qdd_ref + C(q, qd) qd - tau_g(q).
+
+Loggers sample every ``log_period`` (periodic events only, so every logger has the same uniform
+time grid starting at t = 0).
+"""
+
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.geometry import (
+    CollisionFilterDeclaration,
+    Meshcat,
+    MeshcatVisualizer,
+    MeshcatVisualizerParams,
+)
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import (
+    AddMultibodyPlant,
+    MultibodyPlant,
+    MultibodyPlantConfig,
+)
+from pydrake.multibody.tree import PdControllerGains
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.controllers import InverseDynamics
+from pydrake.systems.framework import DiagramBuilder, EventStatus, LeafSystem, TriggerType
+from pydrake.systems.primitives import LogVectorOutput
+
+from drake_traj import robot
+from drake_traj.planners.base import PlannerSystem
+from drake_traj.result import SimulationResult
+
+# Default PD gains per joint [N m/rad], [N m s/rad]: see README "Controller" for how they were chosen.
+DEFAULT_KP = (4000.0, 4000.0, 2000.0, 500.0, 500.0, 300.0)
+DEFAULT_KD = (200.0, 200.0, 100.0, 20.0, 20.0, 10.0)
+
+
+@dataclass
+class ControllerGains:
+    """PD gains of the simulated joint controller and the feed-forward choice."""
+
+    kp: list[float] = field(default_factory=lambda: list(DEFAULT_KP))
+    kd: list[float] = field(default_factory=lambda: list(DEFAULT_KD))
+    feedforward_acceleration: bool = True
+
+    def validate(self) -> None:
+        """Raise ValueError naming the gain that is of the wrong length, non-finite or negative."""
+        for name in ("kp", "kd"):
+            gains = np.asarray(getattr(self, name), dtype=float)
+            if gains.shape != (robot.NUM_JOINTS,):
+                raise ValueError(f"controller.{name} must have {robot.NUM_JOINTS} entries, got shape {gains.shape}")
+            if not np.all(np.isfinite(gains)) or np.any(gains < 0):
+                raise ValueError(f"controller.{name} must be finite and non-negative, got {gains.tolist()}")
+        if not np.all(np.asarray(self.kp) > 0):
+            raise ValueError(f"controller.kp must be positive, got {self.kp}")
+
+
+def add_ur10e(plant: MultibodyPlant):
+    """Parse models/ur10e.urdf into ``plant``, weld its base to the world; returns the instance."""
+    (instance,) = Parser(plant).AddModels(str(robot.model_path()))
+    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(robot.BASE_FRAME, instance))
+    return instance
+
+
+class TcpPose(LeafSystem):
+    """Measured TCP pose k(q) = [x, y, z, phi_X, phi_Y, phi_Z] from the plant state [q; qd]."""
+
+    def __init__(self):
+        super().__init__()
+        n = robot.NUM_JOINTS
+        self._state = self.DeclareVectorInputPort("state", 2 * n)
+        self.DeclareVectorOutputPort(
+            "pose", 6, lambda context, out: out.SetFromVector(robot.task_pose(self._state.Eval(context)[:n]))
+        )
+
+
+@dataclass
+class ClosedLoop:
+    """The built diagram and handles to its parts."""
+
+    diagram: object
+    plant: MultibodyPlant
+    planner: PlannerSystem
+    loggers: dict
+    visualizer: MeshcatVisualizer | None
+
+
+def build_closed_loop(
+    planner: PlannerSystem,
+    *,
+    gains: ControllerGains | None = None,
+    time_step: float = 1e-3,
+    log_period: float = 1e-3,
+    meshcat: Meshcat | None = None,
+) -> ClosedLoop:
+    """Wire ``planner`` to a PD-controlled discrete UR10e plant with loggers (and Meshcat).
+
+    Args:
+        planner: any system under the planner contract.
+        gains: PD gains and feed-forward choice (defaults: :class:`ControllerGains`).
+        time_step: plant discrete step [s].
+        log_period: uniform logging period [s].
+        meshcat: when given, the robot is drawn there (``MeshcatVisualizer``).
+    """
+    gains = gains or ControllerGains()
+    gains.validate()
+    for name, value in (("time_step", time_step), ("log_period", log_period)):
+        if not np.isfinite(value) or value <= 0:
+            raise ValueError(f"{name} must be a positive number of seconds, got {value}")
+
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlant(
+        MultibodyPlantConfig(time_step=time_step, discrete_contact_approximation="sap"), builder
+    )
+    instance = add_ur10e(plant)
+    for joint_index, actuator_index in enumerate(plant.GetJointActuatorIndices(instance)):
+        plant.get_joint_actuator(actuator_index).set_controller_gains(
+            PdControllerGains(p=gains.kp[joint_index], d=gains.kd[joint_index])
+        )
+    plant.Finalize()
+    # The arm's own links never touch in the tasks we plan; keep the solver free of self-contact.
+    bodies = [plant.get_body(index) for index in plant.GetBodyIndices(instance)]
+    scene_graph.collision_filter_manager().Apply(
+        CollisionFilterDeclaration().ExcludeWithin(plant.CollectRegisteredGeometries(bodies))
+    )
+
+    builder.AddSystem(planner)
+    builder.Connect(planner.GetOutputPort("desired_state"), plant.get_desired_state_input_port(instance))
+    mode = (
+        InverseDynamics.InverseDynamicsMode.kInverseDynamics
+        if gains.feedforward_acceleration
+        else InverseDynamics.InverseDynamicsMode.kGravityCompensation
+    )
+    feedforward = builder.AddSystem(InverseDynamics(plant, mode))
+    builder.Connect(plant.get_state_output_port(instance), feedforward.get_input_port_estimated_state())
+    if gains.feedforward_acceleration:
+        builder.Connect(
+            planner.GetOutputPort("desired_acceleration"), feedforward.get_input_port_desired_acceleration()
+        )
+    builder.Connect(feedforward.get_output_port_generalized_force(), plant.get_actuation_input_port(instance))
+
+    tcp = builder.AddSystem(TcpPose())
+    builder.Connect(plant.get_state_output_port(instance), tcp.get_input_port())
+
+    def log(port):
+        return LogVectorOutput(port, builder, {TriggerType.kPeriodic}, log_period)
+
+    loggers = {
+        "reference": log(planner.GetOutputPort("desired_state")),
+        "acceleration": log(planner.GetOutputPort("desired_acceleration")),
+        "scaling": log(planner.GetOutputPort("scaling")),
+        "measured": log(plant.get_state_output_port(instance)),
+        "torque": log(plant.get_net_actuation_output_port(instance)),
+        "tcp": log(tcp.get_output_port()),
+    }
+    visualizer = None
+    if meshcat is not None:
+        visualizer = MeshcatVisualizer.AddToBuilder(
+            builder, scene_graph, meshcat, MeshcatVisualizerParams(publish_period=1 / 30)
+        )
+    return ClosedLoop(builder.Build(), plant, planner, loggers, visualizer)
+
+
+def simulate(
+    planner: PlannerSystem,
+    *,
+    name: str = "run",
+    gains: ControllerGains | None = None,
+    time_step: float = 1e-3,
+    log_period: float = 1e-3,
+    settle_time: float = 0.5,
+    max_duration: float = 120.0,
+    meshcat: Meshcat | None = None,
+    realtime_rate: float = 0.0,
+) -> SimulationResult:
+    """Run ``planner`` in the closed loop until it finishes, plus ``settle_time`` [s].
+
+    The run stops at ``max_duration`` [s] if the planner has not finished. Whatever stops the run
+    early (an exception from a planner, a timeout) is caught: the result holds everything logged
+    up to that point and ``failure`` gives the reason. With ``meshcat``, the run is recorded there
+    (see :func:`drake_traj.meshcat.export_html`).
+
+    The planner must provide ``velocity_limit`` and ``acceleration_limit`` attributes [rad/s,
+    rad/s^2], the limits it promises; the result's metrics are taken against them.
+    """
+    for label, value in (("settle_time", settle_time), ("max_duration", max_duration)):
+        if not np.isfinite(value) or value < 0:
+            raise ValueError(f"{label} must be a non-negative number of seconds, got {value}")
+    loop = build_closed_loop(planner, gains=gains, time_step=time_step, log_period=log_period, meshcat=meshcat)
+    simulator = Simulator(loop.diagram)
+    simulator.set_target_realtime_rate(realtime_rate)
+    integrator = simulator.get_mutable_integrator()
+    integrator.set_maximum_step_size(time_step)
+    integrator.set_target_accuracy(1e-8)
+    context = simulator.get_mutable_context()
+    plant_context = loop.plant.GetMyMutableContextFromRoot(context)
+    loop.plant.SetPositions(plant_context, planner.initial_positions())
+    planner_context = planner.GetMyContextFromRoot(context)
+
+    finish_time = [float("nan")]
+
+    def monitor(root_context):
+        now = root_context.get_time()
+        if np.isnan(finish_time[0]) and planner.finished(planner_context):
+            finish_time[0] = now
+        if now >= finish_time[0] + settle_time:  # False while finish_time is nan
+            return EventStatus.ReachedTermination(planner, "planner finished")
+        return EventStatus.DidNothing()
+
+    simulator.set_monitor(monitor)
+    if loop.visualizer is not None:
+        loop.visualizer.StartRecording(False)
+    failure = None
+    start = time.perf_counter()
+    try:
+        simulator.AdvanceTo(max_duration)
+        if np.isnan(finish_time[0]):
+            failure = f"planner did not finish within max_duration = {max_duration} s"
+    except Exception as error:  # keep the log up to the failure; the reason goes in the result
+        failure = f"{type(error).__name__} at t = {context.get_time():.4f} s: {error}"
+    wall_time = time.perf_counter() - start
+    if loop.visualizer is not None:
+        loop.visualizer.StopRecording()
+        loop.visualizer.PublishRecording()
+
+    logs = {key: logger.FindLog(context) for key, logger in loop.loggers.items()}
+    count = min(log.num_samples() for log in logs.values())
+    data = {key: log.data()[:, :count].T for key, log in logs.items()}
+    n = robot.NUM_JOINTS
+    return SimulationResult(
+        name=name,
+        t=logs["reference"].sample_times()[:count].copy(),
+        q_ref=data["reference"][:, :n],
+        qd_ref=data["reference"][:, n:],
+        qdd_ref=data["acceleration"],
+        q_meas=data["measured"][:, :n],
+        qd_meas=data["measured"][:, n:],
+        tau=data["torque"],
+        scaling=data["scaling"][:, 0],
+        tcp=data["tcp"],
+        velocity_limit=np.broadcast_to(planner.velocity_limit, (n,)).astype(float),
+        acceleration_limit=np.broadcast_to(planner.acceleration_limit, (n,)).astype(float),
+        effort_limit=robot.EFFORT_LIMIT.copy(),
+        waypoints=planner.task_waypoints(),
+        duration=finish_time[0],
+        failure=failure,
+        wall_time=wall_time,
+    )

@@ -1,0 +1,189 @@
+"""A logged closed-loop run: arrays, metrics, save/load and figures.
+
+All arrays are time-major (one row per logged sample) on a uniform grid ``t`` [s]:
+``q_ref``, ``qd_ref``, ``qdd_ref`` (planner reference, rad, rad/s, rad/s^2), ``q_meas``, ``qd_meas``
+(plant state), ``tau`` (net joint torque applied by the drives, N m), ``scaling`` (c), ``tcp``
+(measured flange pose k(q) = [x, y, z, phi_X, phi_Y, phi_Z], m and rad, base frame).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from drake_traj import robot
+
+ARRAY_NAMES = ("t", "q_ref", "qd_ref", "qdd_ref", "q_meas", "qd_meas", "tau", "scaling", "tcp")
+_LIMIT_NAMES = ("velocity_limit", "acceleration_limit", "effort_limit", "waypoints")
+
+
+@dataclass
+class SimulationResult:
+    """One simulated run. ``failure`` is None on success, else the reason the run stopped early."""
+
+    name: str
+    t: np.ndarray
+    q_ref: np.ndarray
+    qd_ref: np.ndarray
+    qdd_ref: np.ndarray
+    q_meas: np.ndarray
+    qd_meas: np.ndarray
+    tau: np.ndarray
+    scaling: np.ndarray
+    tcp: np.ndarray
+    velocity_limit: np.ndarray
+    acceleration_limit: np.ndarray
+    effort_limit: np.ndarray = field(default_factory=lambda: robot.EFFORT_LIMIT.copy())
+    waypoints: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    duration: float = float("nan")
+    failure: str | None = None
+    wall_time: float = float("nan")
+
+    @property
+    def succeeded(self) -> bool:
+        return self.failure is None
+
+    def reference_tcp(self) -> np.ndarray:
+        """k(q_ref) at every sample, shape (N, 6)."""
+        return np.array([robot.task_pose(q) for q in self.q_ref])
+
+    def jerk(self) -> np.ndarray:
+        """Reference jerk [rad/s^3] by finite differences of qdd_ref, shape (N-1, 6)."""
+        return np.diff(self.qdd_ref, axis=0) / np.diff(self.t)[:, None]
+
+    def metrics(self) -> dict:
+        """Scalar and per-joint figures of merit, JSON-ready."""
+        tcp_error = np.linalg.norm(self.reference_tcp()[:, :3] - self.tcp[:, :3], axis=1)
+        simulated = float(self.t[-1]) if len(self.t) else 0.0
+        jerk = self.jerk()
+        return {
+            "name": self.name,
+            "succeeded": self.succeeded,
+            "failure": self.failure,
+            "duration_s": self.duration,
+            "samples": int(len(self.t)),
+            "log_period_s": float(np.median(np.diff(self.t))) if len(self.t) > 1 else None,
+            "qd_min": self.qd_ref.min(axis=0).tolist(),
+            "qd_max": self.qd_ref.max(axis=0).tolist(),
+            "qdd_min": self.qdd_ref.min(axis=0).tolist(),
+            "qdd_max": self.qdd_ref.max(axis=0).tolist(),
+            "max_velocity_over_limit": float(np.max(np.abs(self.qd_ref) / self.velocity_limit)),
+            "max_acceleration_over_limit": float(np.max(np.abs(self.qdd_ref) / self.acceleration_limit)),
+            "max_jerk": float(np.abs(jerk).max()) if len(jerk) else 0.0,
+            "tracking_error_joint_max_rad": float(np.abs(self.q_ref - self.q_meas).max()),
+            "tracking_error_tcp_max_m": float(tcp_error.max()),
+            "peak_torque_nm": np.abs(self.tau).max(axis=0).tolist(),
+            "peak_torque_over_limit": (np.abs(self.tau).max(axis=0) / self.effort_limit).tolist(),
+            "simulated_time_s": simulated,
+            "wall_time_s": self.wall_time,
+            "real_time_factor": simulated / self.wall_time if self.wall_time > 0 else None,
+        }
+
+    # --- persistence ---------------------------------------------------------------------------
+    def save(self, directory) -> Path:
+        """Write ``result.npz`` (arrays) and ``metrics.json`` into ``directory``; returns it."""
+        directory = Path(directory)
+        directory.mkdir(parents=True, exist_ok=True)
+        arrays = {name: getattr(self, name) for name in ARRAY_NAMES + _LIMIT_NAMES}
+        meta = {"name": self.name, "duration": self.duration, "failure": self.failure, "wall_time": self.wall_time}
+        np.savez_compressed(directory / "result.npz", meta=json.dumps(meta), **arrays)
+        (directory / "metrics.json").write_text(json.dumps(self.metrics(), indent=2))
+        return directory
+
+    @classmethod
+    def load(cls, directory) -> "SimulationResult":
+        """Read a result written by :meth:`save`."""
+        path = Path(directory) / "result.npz"
+        if not path.is_file():
+            raise ValueError(f"no result file at {path}")
+        with np.load(path) as data:
+            meta = json.loads(str(data["meta"]))
+            arrays = {f.name: data[f.name] for f in fields(cls) if f.name in data.files}
+        return cls(**meta, **arrays)
+
+    # --- figures -------------------------------------------------------------------------------
+    def joint_figure(self) -> Figure:
+        """q, qd, qdd per joint against time, with the velocity and acceleration limit lines."""
+        figure = Figure(figsize=(10, 9), layout="constrained")
+        axes = figure.subplots(3, 1, sharex=True)
+        for name, data, limit, ax, unit in (
+            ("q", self.q_ref, None, axes[0], "rad"),
+            ("qd", self.qd_ref, self.velocity_limit, axes[1], "rad/s"),
+            ("qdd", self.qdd_ref, self.acceleration_limit, axes[2], "rad/s$^2$"),
+        ):
+            for j in range(data.shape[1]):
+                ax.plot(self.t, data[:, j], label=f"joint {j + 1}")
+            if limit is not None:
+                for bound in (np.max(limit), -np.max(limit)):
+                    ax.axhline(bound, color="grey", linestyle="--", linewidth=1)
+            ax.set_ylabel(f"{name} [{unit}]")
+            ax.grid(True, alpha=0.3)
+        if np.isfinite(self.duration):
+            for ax in axes:
+                ax.axvline(self.duration, color="black", linewidth=0.8, alpha=0.5)
+        axes[0].legend(ncol=6, fontsize="small", loc="upper center")
+        axes[-1].set_xlabel("t [s]")
+        figure.suptitle(f"{self.name}: joint reference (dashed: limits)")
+        return figure
+
+    def tracking_figure(self) -> Figure:
+        """Joint tracking error q_ref - q_meas and torque over the effort limit."""
+        figure = Figure(figsize=(10, 6), layout="constrained")
+        error_ax, torque_ax = figure.subplots(2, 1, sharex=True)
+        for j in range(self.q_ref.shape[1]):
+            error_ax.plot(self.t, 1e3 * (self.q_ref[:, j] - self.q_meas[:, j]), label=f"joint {j + 1}")
+            torque_ax.plot(self.t, self.tau[:, j] / self.effort_limit[j])
+        error_ax.set_ylabel("q_ref - q_meas [mrad]")
+        torque_ax.set_ylabel("tau / effort limit")
+        torque_ax.set_xlabel("t [s]")
+        error_ax.legend(ncol=6, fontsize="small")
+        for ax in (error_ax, torque_ax):
+            ax.grid(True, alpha=0.3)
+        return figure
+
+    def scaling_figure(self) -> Figure:
+        """The scaling coefficient c(t)."""
+        figure = Figure(figsize=(8, 3), layout="constrained")
+        ax = figure.subplots()
+        ax.plot(self.t, self.scaling)
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel("c")
+        ax.set_ylim(-0.05, 1.05)
+        ax.grid(True, alpha=0.3)
+        return figure
+
+    def tcp_path_figure(self) -> Figure:
+        """The measured and reference TCP paths in 3-D (base frame) with the waypoints."""
+        figure = Figure(figsize=(7, 6), layout="constrained")
+        ax = figure.add_subplot(projection="3d")
+        reference = self.reference_tcp()
+        ax.plot(*reference[:, :3].T, label="reference", linewidth=2)
+        ax.plot(*self.tcp[:, :3].T, "--", label="measured", linewidth=1)
+        if len(self.waypoints):
+            ax.scatter(*self.waypoints.T, color="tab:orange", s=60, label="waypoints")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_zlabel("z [m]")
+        ax.legend()
+        ax.set_title(f"{self.name}: TCP path")
+        return figure
+
+    def save_figures(self, directory) -> list[Path]:
+        """Write joints.png, tracking.png, scaling.png and tcp_path.png; returns the paths."""
+        directory = Path(directory)
+        directory.mkdir(parents=True, exist_ok=True)
+        paths = []
+        for stem, make in (
+            ("joints", self.joint_figure),
+            ("tracking", self.tracking_figure),
+            ("scaling", self.scaling_figure),
+            ("tcp_path", self.tcp_path_figure),
+        ):
+            path = directory / f"{stem}.png"
+            make().savefig(path, dpi=110)
+            paths.append(path)
+        return paths

@@ -1,0 +1,107 @@
+"""Typed scenarios, loaded from YAML with pydrake's ``yaml_load_typed`` (files in ``diagrams/``).
+
+A scenario names the start configuration, the planner and its parameters, the PD controller and
+the simulation settings. Unknown keys, wrong lengths and non-finite or out-of-range numbers raise
+ValueError naming the file and the field.
+"""
+
+
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+from pydrake.common.yaml import yaml_load_typed
+
+from drake_traj import robot
+from drake_traj.diagram import ControllerGains
+
+# Seed 000's start configuration q(0) [rad]; its flange pose is p0 = [-0.174, -0.524, 0.273, pi, 0, 3pi/4].
+PAJAK_Q0 = [-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4]
+
+
+@dataclass
+class QuinticPtp:
+    """Synchronised quintic point-to-point moves through joint goals (seed 004), a stop at each.
+
+    goals [rad], one row of 6 per goal; velocity_limit [rad/s] and acceleration_limit [rad/s^2]
+    per joint (defaults: the UR controller's joint-move defaults used by seed 000).
+    """
+
+    goals: list[list[float]] = field(default_factory=list)
+    velocity_limit: list[float] = field(default_factory=lambda: [robot.DEFAULT_JOINT_MOVE_VELOCITY] * 6)
+    acceleration_limit: list[float] = field(default_factory=lambda: [robot.DEFAULT_JOINT_MOVE_ACCELERATION] * 6)
+
+
+@dataclass
+class Scenario:
+    """One experiment: start, planner, controller and simulation settings (times in seconds)."""
+
+    name: str = "unnamed"
+    q_initial: list[float] = field(default_factory=lambda: list(PAJAK_Q0))
+    planner: QuinticPtp = field(default_factory=QuinticPtp)
+    controller: ControllerGains = field(default_factory=ControllerGains)
+    time_step: float = 0.001
+    log_period: float = 0.001
+    settle_time: float = 0.5
+    max_duration: float = 120.0
+
+    def validate(self) -> None:
+        """Raise ValueError naming the first field that is malformed."""
+        q = np.asarray(self.q_initial, dtype=float)
+        if q.shape != (robot.NUM_JOINTS,):
+            raise ValueError(f"q_initial must have {robot.NUM_JOINTS} entries, got shape {q.shape}")
+        if not np.all(np.isfinite(q)):
+            raise ValueError(f"q_initial must be finite, got {self.q_initial}")
+        outside = np.flatnonzero(np.abs(q) > robot.POSITION_LIMIT)
+        if len(outside):
+            j = outside[0]
+            raise ValueError(
+                f"q_initial[{j}] = {q[j]} rad is outside the joint limit +-{robot.POSITION_LIMIT[j]:.6f} rad"
+            )
+        for label in ("time_step", "log_period", "max_duration", "settle_time"):
+            value = getattr(self, label)
+            smallest_allowed = 0.0 if label == "settle_time" else np.nextafter(0.0, 1.0)
+            if not np.isfinite(value) or value < smallest_allowed:
+                raise ValueError(f"{label} must be a finite, positive number of seconds, got {value}")
+        self.controller.validate()
+
+
+def default_scenario_path() -> Path:
+    """The scenario ``drake-traj run`` uses when none is given."""
+    return Path(str(resources.files("drake_traj.diagrams").joinpath("quintic_ptp.yaml")))
+
+
+def load_scenario(path) -> Scenario:
+    """Read and validate a scenario YAML file."""
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"scenario file not found: {path}")
+    try:
+        scenario = yaml_load_typed(schema=Scenario, data=path.read_text())
+    except RuntimeError as error:  # unknown keys, wrong types
+        raise ValueError(f"{path}: {error}") from error
+    try:
+        scenario.validate()
+    except ValueError as error:
+        raise ValueError(f"{path}: {error}") from error
+    return scenario
+
+
+def make_planner(scenario: Scenario):
+    """The planner system the scenario describes (errors name the ``planner`` field)."""
+    from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
+
+    config = scenario.planner
+    try:
+        plan = plan_synchronized_quintic(
+            scenario.q_initial,
+            config.goals,
+            config.velocity_limit,
+            config.acceleration_limit,
+            position_lower=-robot.POSITION_LIMIT,
+            position_upper=robot.POSITION_LIMIT,
+        )
+    except ValueError as error:
+        raise ValueError(f"scenario {scenario.name!r}, planner: {error}") from error
+    return QuinticPtpPlanner(plan, config.velocity_limit, config.acceleration_limit)
