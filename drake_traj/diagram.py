@@ -81,6 +81,30 @@ class TcpPose(LeafSystem):
         )
 
 
+class OneStepLookahead(LeafSystem):
+    """The reference one plant step ahead: [q + h qd + h^2/2 qdd; qd + h qdd].
+
+    The plant's implicit PD compares the desired state sampled at t_k with the state it computes
+    for t_k + h; without this lookahead the arm lags the reference by one step (about
+    |qd| h, i.e. 1 mrad at 1 rad/s and h = 1 ms).
+    """
+
+    def __init__(self, time_step: float):
+        super().__init__()
+        n = robot.NUM_JOINTS
+        self._h = time_step
+        self._state = self.DeclareVectorInputPort("desired_state", 2 * n)
+        self._acceleration = self.DeclareVectorInputPort("desired_acceleration", n)
+        self.DeclareVectorOutputPort("state", 2 * n, self._calc)
+
+    def _calc(self, context, output):
+        n = robot.NUM_JOINTS
+        state = self._state.Eval(context)
+        qdd = self._acceleration.Eval(context)
+        q, qd, h = state[:n], state[n:], self._h
+        output.SetFromVector(np.concatenate([q + h * qd + 0.5 * h * h * qdd, qd + h * qdd]))
+
+
 @dataclass
 class ClosedLoop:
     """The built diagram and handles to its parts."""
@@ -120,10 +144,9 @@ def build_closed_loop(
         MultibodyPlantConfig(time_step=time_step, discrete_contact_approximation="sap"), builder
     )
     instance = add_ur10e(plant)
-    for joint_index, actuator_index in enumerate(plant.GetJointActuatorIndices(instance)):
-        plant.get_joint_actuator(actuator_index).set_controller_gains(
-            PdControllerGains(p=gains.kp[joint_index], d=gains.kd[joint_index])
-        )
+    for joint_name, kp, kd in zip(robot.JOINT_NAMES, gains.kp, gains.kd):
+        actuator = plant.GetJointActuatorByName(f"{joint_name}_actuator", instance)
+        actuator.set_controller_gains(PdControllerGains(p=kp, d=kd))
     plant.Finalize()
     # The arm's own links never touch in the tasks we plan; keep the solver free of self-contact.
     bodies = [plant.get_body(index) for index in plant.GetBodyIndices(instance)]
@@ -132,7 +155,10 @@ def build_closed_loop(
     )
 
     builder.AddSystem(planner)
-    builder.Connect(planner.GetOutputPort("desired_state"), plant.get_desired_state_input_port(instance))
+    lookahead = builder.AddSystem(OneStepLookahead(time_step))
+    builder.Connect(planner.GetOutputPort("desired_state"), lookahead.GetInputPort("desired_state"))
+    builder.Connect(planner.GetOutputPort("desired_acceleration"), lookahead.GetInputPort("desired_acceleration"))
+    builder.Connect(lookahead.get_output_port(), plant.get_desired_state_input_port(instance))
     mode = (
         InverseDynamics.InverseDynamicsMode.kInverseDynamics
         if gains.feedforward_acceleration

@@ -1,0 +1,155 @@
+"""Headless closed-loop simulations: the quintic diagram end to end, logging, failure handling."""
+
+import json
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import ConstantVectorSource
+
+from drake_traj import robot
+from drake_traj.diagram import ControllerGains, simulate
+from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
+from drake_traj.result import ARRAY_NAMES, SimulationResult
+from drake_traj.scenario import load_scenario, make_planner
+
+from conftest import DIAGRAMS
+
+LIMIT_TOLERANCE = 1e-6  # relative; the reference is integrated by the Simulator (accuracy 1e-8)
+
+
+@pytest.fixture(scope="module")
+def quintic_result(quintic_run_dir):
+    return SimulationResult.load(quintic_run_dir)
+
+
+@pytest.fixture(scope="module")
+def quintic_planner():
+    return make_planner(load_scenario(DIAGRAMS / "quintic_ptp.yaml"))
+
+
+def short_move(**kwargs):
+    """A single 1-goal quintic move from seed 000's start (about 1.7 s)."""
+    q0 = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
+    plan = plan_synchronized_quintic(q0, q0 + [0.6, -0.3, 0.4, -0.5, 0.3, 0.8], 1.05, 1.40)
+    return QuinticPtpPlanner(plan, 1.05, 1.40, **kwargs)
+
+
+def test_result_files_are_time_major_with_the_contract_names(quintic_run_dir, quintic_result):
+    with np.load(quintic_run_dir / "result.npz") as data:
+        assert set(ARRAY_NAMES) <= set(data.files)
+        rows = len(data["t"])
+        for name, width in (("q_ref", 6), ("qd_ref", 6), ("qdd_ref", 6), ("q_meas", 6), ("qd_meas", 6),
+                            ("tau", 6), ("tcp", 6)):
+            assert data[name].shape == (rows, width), name
+        assert data["scaling"].shape == (rows,)
+    metrics = json.loads((quintic_run_dir / "metrics.json").read_text())
+    assert metrics["succeeded"] and metrics["samples"] == rows
+    for stem in ("joints", "tracking", "scaling", "tcp_path"):
+        assert (quintic_run_dir / f"{stem}.png").stat().st_size > 10_000
+
+
+def test_log_grid_is_uniform_at_one_millisecond(quintic_result):
+    np.testing.assert_allclose(np.diff(quintic_result.t), 1e-3, atol=1e-12)
+    assert quintic_result.t[0] == 0.0
+
+
+def test_reference_follows_the_closed_form_plan(quintic_result, quintic_planner):
+    # Independent of the Simulator: the plan's closed-form q(t), qd(t), qdd(t) on the log grid.
+    q, qd, qdd = quintic_planner.plan.sample(quintic_result.t)
+    np.testing.assert_allclose(quintic_result.q_ref, q, atol=1e-6)
+    np.testing.assert_allclose(quintic_result.qd_ref, qd, atol=1e-6)
+    np.testing.assert_allclose(quintic_result.qdd_ref, qdd, atol=1e-9)
+    assert quintic_result.duration == pytest.approx(quintic_planner.plan.duration, abs=1e-3)
+
+
+def test_limits_hold_at_every_logged_sample(quintic_result):
+    velocity_ratio = np.abs(quintic_result.qd_ref) / quintic_result.velocity_limit
+    acceleration_ratio = np.abs(quintic_result.qdd_ref) / quintic_result.acceleration_limit
+    assert velocity_ratio.max() <= 1 + LIMIT_TOLERANCE
+    assert acceleration_ratio.max() <= 1 + LIMIT_TOLERANCE
+    # The synchronised plan is time-optimal for its limiting joint: the limit is reached.
+    assert acceleration_ratio.max() == pytest.approx(1.0, abs=1e-4)
+    assert np.all(np.abs(quintic_result.tau) < quintic_result.effort_limit)
+
+
+def test_pd_loop_tracks_the_reference(quintic_result, quintic_planner):
+    metrics = quintic_result.metrics()
+    # Measured on this scenario: 3.5e-5 rad and 3.2e-5 m with inverse-dynamics feed-forward.
+    assert metrics["tracking_error_joint_max_rad"] < 5e-5
+    assert metrics["tracking_error_tcp_max_m"] < 5e-5
+    np.testing.assert_allclose(quintic_result.q_meas[-1], quintic_planner.plan.q_goal, atol=1e-5)
+    np.testing.assert_allclose(quintic_result.qd_meas[-1], 0.0, atol=1e-5)
+
+
+def test_logged_tcp_is_k_of_the_measured_configuration(quintic_result):
+    for row in range(0, len(quintic_result.t), 997):
+        np.testing.assert_allclose(quintic_result.tcp[row], robot.task_pose(quintic_result.q_meas[row]), atol=1e-12)
+
+
+def test_gravity_compensation_alone_tracks_worse_than_inverse_dynamics_feedforward():
+    with_feedforward = simulate(short_move(), settle_time=0.1).metrics()
+    gravity_only = simulate(short_move(), gains=ControllerGains(feedforward_acceleration=False), settle_time=0.1).metrics()
+    assert gravity_only["tracking_error_joint_max_rad"] > 10 * with_feedforward["tracking_error_joint_max_rad"]
+    assert gravity_only["tracking_error_joint_max_rad"] < 5e-3  # measured 1.05e-3: still a usable PD loop
+
+
+class PlannerFailingAt(QuinticPtpPlanner):
+    """A quintic planner whose acceleration raises after ``fail_time`` (a stand-in for any fault)."""
+
+    def __init__(self, fail_time, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.fail_time = fail_time
+
+    def acceleration(self, context):
+        if context.get_time() > self.fail_time:
+            raise ValueError("singular configuration (test fault)")
+        return super().acceleration(context)
+
+
+def test_a_run_that_fails_part_way_keeps_its_log_and_the_reason(tmp_path):
+    plan = short_move().plan
+    result = simulate(PlannerFailingAt(0.4, plan, 1.05, 1.40))
+    assert not result.succeeded
+    assert "singular configuration (test fault)" in result.failure and "t = 0.4" in result.failure
+    assert 395 <= len(result.t) <= 402 and np.all(np.isfinite(result.q_ref))
+    loaded = SimulationResult.load(result.save(tmp_path))
+    assert loaded.failure == result.failure
+    np.testing.assert_array_equal(loaded.q_ref, result.q_ref)
+
+
+def test_a_planner_that_never_finishes_is_reported():
+    result = simulate(short_move(), max_duration=0.5)
+    assert not result.succeeded and "did not finish" in result.failure
+    assert np.isnan(result.duration)
+
+
+def test_speed_override_slows_the_clock_and_keeps_velocity_continuous():
+    builder = DiagramBuilder()
+    planner = builder.AddSystem(short_move(update_period=0.01))
+    override = builder.AddSystem(ConstantVectorSource([0.5]))
+    builder.Connect(override.get_output_port(), planner.GetInputPort("speed_override"))
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    simulator.get_mutable_integrator().set_target_accuracy(1e-9)
+    simulator.AdvanceTo(1.0)
+    context = planner.GetMyContextFromRoot(simulator.get_context())
+    # c relaxes from 1 to 0.5 by eq. 18: c(t) = 0.5 exp(-t) + 0.5 (the first read happens at t = 0).
+    c = planner.GetOutputPort("scaling").Eval(context)[0]
+    assert c == pytest.approx(0.5 * np.exp(-1.0) + 0.5, rel=1e-9)
+    tau = 0.5 * 1.0 + 0.5 * (1 - np.exp(-1.0))
+    q, qd, _ = planner.plan.sample(tau)
+    state = planner.GetOutputPort("desired_state").Eval(context)
+    np.testing.assert_allclose(state[:6], q, atol=1e-7)
+    np.testing.assert_allclose(state[6:], qd * c, atol=1e-7)
+
+
+def test_speed_override_outside_zero_one_is_rejected():
+    builder = DiagramBuilder()
+    planner = builder.AddSystem(short_move())
+    override = builder.AddSystem(ConstantVectorSource([1.5]))
+    builder.Connect(override.get_output_port(), planner.GetInputPort("speed_override"))
+    simulator = Simulator(builder.Build())
+    with pytest.raises(ValueError, match="speed_override"):
+        simulator.AdvanceTo(0.1)
