@@ -518,3 +518,13 @@ def test_random_set_covers_both_binding_limits():
         j = int(np.argmax(joint_minimum_times(d, k_v, k_a)))
         bound.append(15 * abs(d[j]) / (8 * k_v[j]) >= math.sqrt(10 * abs(d[j]) / (SQRT3 * k_a[j])))
     assert 5 <= sum(bound) <= 35
+
+
+def test_scalar_rates_match_the_vectorised_sample():
+    plan = plan_synchronized_quintic(np.zeros(6), [[1.0, -0.5, 0.2, 0.0, 2.0, -1.0], [0.5, 0.5, 0.5, 0.5, 0.5, 0.5]], 1.05, 1.4)
+    times = np.concatenate([[-1.0, 0.0], np.linspace(0.0, plan.duration, 997), [plan.duration, plan.duration + 1.0]])
+    _, qd, qdd = plan.sample(times)
+    for row, t in enumerate(times):
+        rate, acceleration = plan.rates_at(float(t))
+        np.testing.assert_allclose(rate, qd[row], rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(acceleration, qdd[row], rtol=1e-12, atol=1e-12)

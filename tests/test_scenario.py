@@ -1,0 +1,87 @@
+"""Scenario files: loading, the CLI, the example, and clear errors for bad input."""
+
+import runpy
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from drake_traj import cli
+from drake_traj.scenario import Scenario, default_scenario_path, load_scenario, make_planner
+
+from conftest import DIAGRAMS
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+QUINTIC = (DIAGRAMS / "quintic_ptp.yaml").read_text()
+
+
+def write(tmp_path, text, name="scenario.yaml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_every_shipped_scenario_loads_and_builds_its_planner():
+    paths = sorted(DIAGRAMS.glob("*.yaml"))
+    assert paths, "no scenarios in diagrams/"
+    for path in paths:
+        scenario = load_scenario(path)
+        assert scenario.name == path.stem
+        make_planner(scenario)
+
+
+def test_default_scenario_is_shipped_with_the_package():
+    assert default_scenario_path().is_file()
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (("name: quintic_ptp", "name: quintic_ptp\nspeed: 3"), r"\['speed'\]"),
+        (("  goals:", "  goalz:"), r"goalz"),
+        (("q_initial: [-1.5707963267948966, ", "q_initial: ["), r"q_initial must have 6 entries"),
+        (("q_initial: [-1.5707963267948966", "q_initial: [.nan"), r"q_initial must be finite"),
+        (("q_initial: [-1.5707963267948966", "q_initial: [7.0"), r"q_initial\[0\] = 7.0 rad is outside"),
+        (("velocity_limit: [1.05, ", "velocity_limit: [0.0, "), r"velocity_limit\[0\].*> 0"),
+        (("acceleration_limit: [1.40, ", "acceleration_limit: [-1.0, "), r"acceleration_limit\[0\].*> 0"),
+        (("    - [-0.9, -1.9", "    - [-6.9, -1.9"), r"goals\[0\] joint 0 = -6.9 rad"),
+        (("    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]", "    - [-0.9, -1.9, -1.9, -0.9, 1.2]"), r"goals"),
+        (("    - [-0.9, -1.9", "    - [.inf, -1.9"), r"goals.*finite"),
+        (("  kp: [4000, ", "  kp: [-4000, "), r"controller.kp"),
+        (("  kd: [200, 200, 100, 20, 20, 10]", "  kd: [200, 200]"), r"controller.kd must have 6"),
+        (("time_step: 0.001", "time_step: 0.0"), r"time_step"),
+    ],
+)
+def test_bad_scenarios_name_the_field(tmp_path, change, message):
+    old, new = change
+    assert old in QUINTIC
+    path = write(tmp_path, QUINTIC.replace(old, new, 1))
+    with pytest.raises(ValueError, match=message):
+        make_planner(load_scenario(path))
+
+
+def test_missing_scenario_file_is_named(tmp_path):
+    with pytest.raises(ValueError, match="scenario file not found: .*nowhere.yaml"):
+        load_scenario(tmp_path / "nowhere.yaml")
+
+
+def test_cli_reports_bad_input_without_a_traceback(tmp_path, capsys):
+    path = write(tmp_path, QUINTIC.replace("name: quintic_ptp", "name: quintic_ptp\nspeed: 3"))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
+    assert "speed" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_scenario_defaults_are_the_papers_start_and_ur_limits():
+    scenario = Scenario()
+    np.testing.assert_allclose(scenario.q_initial, [-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
+    assert scenario.planner.velocity_limit == [1.05] * 6
+    assert scenario.planner.acceleration_limit == [1.40] * 6
+
+
+def test_example_runs_and_writes_its_outputs(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(sys, "argv", ["quintic_ptp.py", str(tmp_path)])
+    runpy.run_path(str(EXAMPLES / "quintic_ptp.py"), run_name="__main__")
+    assert "T = " in capsys.readouterr().out
+    assert (tmp_path / "result.npz").is_file() and (tmp_path / "joints.png").is_file()
