@@ -26,8 +26,13 @@ def draw_task(meshcat: Meshcat, result: SimulationResult, *, waypoint_radius: fl
 
 
 def export_html(meshcat: Meshcat, path) -> Path:
-    """Write the scene and its recording as one self-contained HTML file (no server needed)."""
+    """Write the scene and its recording as one self-contained HTML file (no server needed).
+
+    The camera is placed in front of and above the arm (base frame, z up) so the whole
+    workspace in front of it is in view.
+    """
     path = Path(path)
+    meshcat.SetCameraPose(camera_in_world=[1.6, -1.6, 1.2], target_in_world=[0.0, 0.0, 0.4])
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(meshcat.StaticHtml())
     return path
