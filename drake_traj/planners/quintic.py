@@ -80,8 +80,8 @@ def _require_positive(array: np.ndarray, name: str) -> None:
         )
 
 
-def _limit_vector(value, name: str, num_joints: int) -> np.ndarray:
-    """A per-joint limit: scalar (same for every joint) or shape (num_joints,); finite and > 0."""
+def _bound_vector(value, name: str, num_joints: int) -> np.ndarray:
+    """A per-joint value: scalar (same for every joint) or shape (num_joints,); finite."""
     array = _as_float_array(value, name)
     if array.ndim == 0:
         array = np.full(num_joints, float(array))
@@ -90,20 +90,13 @@ def _limit_vector(value, name: str, num_joints: int) -> np.ndarray:
             f"{name} must be a scalar or have shape ({num_joints},), got shape {array.shape}"
         )
     _require_finite(array, name)
-    _require_positive(array, name)
     return array
 
 
-def _bound_vector(value, name: str, num_joints: int) -> np.ndarray:
-    """A per-joint position bound: scalar or shape (num_joints,); finite."""
-    array = _as_float_array(value, name)
-    if array.ndim == 0:
-        array = np.full(num_joints, float(array))
-    elif array.shape != (num_joints,):
-        raise ValueError(
-            f"{name} must be a scalar or have shape ({num_joints},), got shape {array.shape}"
-        )
-    _require_finite(array, name)
+def _limit_vector(value, name: str, num_joints: int) -> np.ndarray:
+    """A per-joint limit: as :func:`_bound_vector`, and > 0."""
+    array = _bound_vector(value, name, num_joints)
+    _require_positive(array, name)
     return array
 
 
