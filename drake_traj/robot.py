@@ -14,6 +14,8 @@ from __future__ import annotations
 from importlib import resources
 from pathlib import Path
 
+import math
+
 import numpy as np
 
 NUM_JOINTS = 6
@@ -40,6 +42,8 @@ DEFAULT_JOINT_MOVE_ACCELERATION = 1.40  # [rad/s^2] (80 deg/s^2)
 
 LINK_MASSES = np.array([7.369, 13.051, 3.989, 2.1, 1.98, 0.615])  # [kg], links 1..6
 BASE_MASS = 4.0  # [kg], approximate; the base is welded to the world.
+_D1, _D4, _D5, _D6 = (float(DH_D[k]) for k in (0, 3, 4, 5))
+_A2, _A3 = float(DH_A[1]), float(DH_A[2])
 FLANGE_FRAME = "tool0"
 BASE_FRAME = "base"
 
@@ -149,15 +153,6 @@ def euler_rate_matrix(phi) -> np.ndarray:
     return np.array([[cy * cz, -sz, 0.0], [cy * sz, cz, 0.0], [-sy, 0.0, 1.0]])
 
 
-def _euler_rate_matrix_derivative(phi, phi_dot) -> np.ndarray:
-    """dB/dt for B of :func:`euler_rate_matrix`, given Euler rates phi_dot [rad/s]."""
-    _, phi_y, phi_z = phi
-    cy, sy, cz, sz = np.cos(phi_y), np.sin(phi_y), np.cos(phi_z), np.sin(phi_z)
-    d_dy = np.array([[-sy * cz, 0.0, 0.0], [-sy * sz, 0.0, 0.0], [-cy, 0.0, 0.0]])
-    d_dz = np.array([[-cy * sz, -cz, 0.0], [cy * cz, -sz, 0.0], [0.0, 0.0, 0.0]])
-    return d_dy * phi_dot[1] + d_dz * phi_dot[2]
-
-
 def geometric_jacobian(q) -> np.ndarray:
     """J_g(q) (6x6): [v; omega] of the flange in the base frame, v = d/dt of the flange origin."""
     return _geometric_jacobian(dh_frames(q))
@@ -170,20 +165,6 @@ def _geometric_jacobian(frames: np.ndarray) -> np.ndarray:
     return np.vstack([np.cross(axes, flange - origins).T, axes.T])
 
 
-def _geometric_jacobian_bias(frames: np.ndarray, qd: np.ndarray) -> np.ndarray:
-    """dJ_g/dt qd: the flange's [linear; angular] acceleration when qdd = 0 (base frame)."""
-    axes = frames[:-1, :3, 2]
-    origins = frames[:, :3, 3]
-    # omega_j: angular velocity of the frame carrying axis j, v_j: velocity of that frame's origin.
-    omegas = np.vstack([np.zeros(3), np.cumsum(axes * qd[:, None], axis=0)])
-    velocities = np.array(
-        [np.sum(np.cross(axes[:j], origins[j] - origins[:j]) * qd[:j, None], axis=0) for j in range(7)]
-    )
-    axis_rates = np.cross(omegas[:-1], axes)  # dz_j/dt = omega_j x z_j
-    linear = np.cross(axis_rates, origins[-1] - origins[:-1]) + np.cross(axes, velocities[-1] - velocities[:-1])
-    return np.concatenate([linear.T @ qd, axis_rates.T @ qd])
-
-
 def analytic_jacobian(q, *, min_cos_pitch: float = 1e-6) -> np.ndarray:
     """J(q) = diag(I, B^-1(phi)) J_g(q) (seed 000): d k(q)/dt = J(q) qd.
 
@@ -193,23 +174,178 @@ def analytic_jacobian(q, *, min_cos_pitch: float = 1e-6) -> np.ndarray:
 
 
 def analytic_jacobian_and_bias(q, qd, *, min_cos_pitch: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
-    """(J(q), dJ/dt(q, qd) qd) of the analytic Jacobian, in one pass over the chain.
+    """(J(q), dJ/dt(q, qd) qd) of the analytic Jacobian (seed 000), from :func:`ur10e_kinematics`.
 
-    The bias term is the second derivative of k(q(t)) when qdd = 0:
-    [a_bias; B^-1 (alpha_bias - dB/dt phi_dot)] with phi_dot = B^-1 omega.
+    The bias term is the second derivative of k(q(t)) when qdd = 0.
+    Raises SingularConfigurationError where cos(phi_Y) < ``min_cos_pitch`` (Euler gimbal lock).
     """
+    q = _as_joint_vector(q)
     qd = _as_joint_vector(qd, "qd")
-    frames = dh_frames(q)
-    phi = zyx_euler_from_rotation(frames[-1, :3, :3])
-    if abs(np.cos(phi[1])) < min_cos_pitch:
+    pose, jacobian, bias, cos_pitch, _ = ur10e_kinematics(q, qd)
+    if cos_pitch < min_cos_pitch:
         raise SingularConfigurationError(
             f"Z-Y-X Euler angles are singular at q={np.round(q, 6).tolist()}: "
-            f"phi_Y = {phi[1]:.6f} rad is at +-pi/2 (gimbal lock), B(phi) has no inverse"
+            f"phi_Y = {pose[4]:.6f} rad is at +-pi/2 (gimbal lock), B(phi) has no inverse"
         )
-    jacobian_g = _geometric_jacobian(frames)
-    b = euler_rate_matrix(phi)
-    jacobian = np.vstack([jacobian_g[:3], np.linalg.solve(b, jacobian_g[3:])])
-    bias_g = _geometric_jacobian_bias(frames, qd)
-    phi_dot = jacobian[3:] @ qd
-    angular_bias = np.linalg.solve(b, bias_g[3:] - _euler_rate_matrix_derivative(phi, phi_dot) @ phi_dot)
-    return jacobian, np.concatenate([bias_g[:3], angular_bias])
+    return jacobian, bias
+
+
+# --------------------------------------------------------------------------------------------
+# Closed-form k(q), analytic J(q) and J̇q̇: the hot path of the task-space planners.
+# --------------------------------------------------------------------------------------------
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _chain(q, qd, m):
+    """k(q), analytic J and J̇q̇ as nested tuples of components (floats, or arrays of tasks).
+
+    ``m`` is ``math`` for floats or ``numpy`` for arrays. Standard DH frames of robot.py written
+    out: joint axes z_j at origins o_j, flange o_6; J_g columns z_j x (o_6 - o_j) and z_j; the
+    bias by the usual velocity/acceleration recursion with q̈ = 0; then J = diag(I, B⁻¹) J_g and
+    the Euler part of the bias B⁻¹ (α - Ḃ φ̇) (seed 000, with B's columns in k(q)'s order).
+    """
+    q1, q2, q3, q4, q5, q6 = q
+    c1, s1 = m.cos(q1), m.sin(q1)
+    c2, s2 = m.cos(q2), m.sin(q2)
+    c5, s5 = m.cos(q5), m.sin(q5)
+    c6, s6 = m.cos(q6), m.sin(q6)
+    q23 = q2 + q3
+    q234 = q23 + q4
+    c23, s23 = m.cos(q23), m.sin(q23)
+    c234, s234 = m.cos(q234), m.sin(q234)
+    z0 = (0.0, 0.0, 1.0)
+    z1 = (s1, -c1, 0.0)
+    x4 = (c1 * c234, s1 * c234, s234)
+    z4 = (c1 * s234, s1 * s234, -c234)
+    z5 = (c5 * s1 - s5 * x4[0], -c5 * c1 - s5 * x4[1], -s5 * s234)
+    x5 = (c5 * x4[0] + s5 * s1, c5 * x4[1] - s5 * c1, c5 * s234)
+    x6 = tuple(c6 * x5[k] - s6 * z4[k] for k in range(3))
+    y6 = tuple(-s6 * x5[k] - c6 * z4[k] for k in range(3))
+    # r_j = o_{j+1} - o_j
+    rs = (
+        (0.0, 0.0, _D1),
+        (_A2 * c1 * c2, _A2 * s1 * c2, _A2 * s2),
+        (_A3 * c1 * c23, _A3 * s1 * c23, _A3 * s23),
+        (_D4 * z1[0], _D4 * z1[1], 0.0),
+        (_D5 * z4[0], _D5 * z4[1], _D5 * z4[2]),
+        (_D6 * z5[0], _D6 * z5[1], _D6 * z5[2]),
+    )
+    axes = (z0, z1, z1, z1, z4, z5)
+    # p_j = o_6 - o_j
+    ps = [None] * 6
+    acc = (0.0, 0.0, 0.0)
+    for j in range(5, -1, -1):
+        r = rs[j]
+        acc = (acc[0] + r[0], acc[1] + r[1], acc[2] + r[2])
+        ps[j] = acc
+    jv = [_cross(axes[j], ps[j]) for j in range(6)]
+    # bias recursion (q̈ = 0): α_{j+1} = α_j + ω_j x z_j q̇_j, ω_{j+1} = ω_j + z_j q̇_j,
+    # a_{j+1} = a_j + α_{j+1} x r_j + ω_{j+1} x (ω_{j+1} x r_j)
+    w = (0.0, 0.0, 0.0)
+    al = (0.0, 0.0, 0.0)
+    lin = (0.0, 0.0, 0.0)
+    for j in range(6):
+        z, r, v = axes[j], rs[j], qd[j]
+        zq = (z[0] * v, z[1] * v, z[2] * v)
+        if j:
+            wz = _cross(w, zq)
+            al = (al[0] + wz[0], al[1] + wz[1], al[2] + wz[2])
+        w = (w[0] + zq[0], w[1] + zq[1], w[2] + zq[2])
+        t1 = _cross(al, r)
+        t2 = _cross(w, _cross(w, r))
+        lin = (lin[0] + t1[0] + t2[0], lin[1] + t1[1] + t2[1], lin[2] + t1[2] + t2[2])
+    # Z-Y-X Euler angles (k(q) rows 4-6)
+    r11, r21, r31, r32, r33 = x6[0], x6[1], x6[2], y6[2], z5[2]
+    phx = m.atan2(r32, r33)
+    cy = m.hypot(r32, r33)  # = cos φ_Y >= 0
+    phy = m.atan2(-r31, cy)
+    phz = m.atan2(r21, r11)
+    sy, cz, sz = -r31, m.cos(phz), m.sin(phz)
+    if m is math:
+        icy = 1.0 / cy if cy > 0.0 else 1e300
+    else:
+        icy = 1.0 / np.maximum(cy, 1e-300)
+
+    def binv(v):  # B(φ)⁻¹ v, B of robot.euler_rate_matrix
+        fx = (cz * v[0] + sz * v[1]) * icy
+        return (fx, -sz * v[0] + cz * v[1], v[2] + sy * fx)
+
+    jw = [binv(axes[j]) for j in range(6)]
+    fx, fy, fz = binv(w)  # Euler rates φ̇
+    bdot = (
+        -sy * cz * fx * fy + fz * (-cy * sz * fx - cz * fy),
+        -sy * sz * fx * fy + fz * (cy * cz * fx - sz * fy),
+        -cy * fx * fy,
+    )
+    ang = binv((al[0] - bdot[0], al[1] - bdot[1], al[2] - bdot[2]))
+    pose = (ps[0][0], ps[0][1], ps[0][2] + 0.0, phx, phy, phz)
+    jac = tuple(tuple(jv[j][k] for j in range(6)) for k in range(3)) + tuple(
+        tuple(jw[j][k] for j in range(6)) for k in range(3)
+    )
+    bias = lin + ang
+    measure = _singularity_factors(s5, m.sin(q3), c2, c23, s234, m)
+    return pose, jac, bias, cy, measure
+
+
+def _singularity_factors(s5, s3, c2, c23, s234, m):
+    # det J_g = a2 a3 s3 s5 (a2 c2 + a3 c23 + d5 s234): elbow, wrist and shoulder factors.
+    shoulder = (_A2 * c2 + _A3 * c23 + _D5 * s234) / (abs(_A2) + abs(_A3))
+    if m is math:
+        return min(abs(s3), abs(s5), abs(shoulder))
+    return np.minimum(np.minimum(np.abs(s3), np.abs(s5)), np.abs(shoulder))
+
+
+def ur10e_kinematics(q, qd):
+    """(k(q), J(q), J̇(q, q̇) q̇, cos φ_Y, singularity measure) of the UR10e flange.
+
+    The standard-DH chain of :func:`dh_frames` written out in closed form (tests check it against
+    MultibodyPlant and finite differences of :func:`task_pose`): about 20 µs for one state, and
+    vectorised over leading dimensions (q, q̇ of shape (..., 6)).
+
+    Returns:
+        pose (..., 6), J (..., 6, 6), bias (..., 6), cos_pitch (...), measure (...), where
+        ``measure`` is :func:`singularity_measure`. No exception at gimbal lock: callers check
+        ``cos_pitch``.
+    """
+    q = np.asarray(q, dtype=float)
+    qd = np.asarray(qd, dtype=float)
+    if q.shape == (6,) and qd.shape == (6,):
+        pose, jac, bias, cy, measure = _chain(q.tolist(), qd.tolist(), math)
+        return np.array(pose), np.array(jac), np.array(bias), cy, measure
+    shape = np.broadcast_shapes(q.shape, qd.shape)
+    if shape[-1] != 6:
+        raise ValueError(f"q and qd must have shape (..., 6), got {q.shape} and {qd.shape}")
+    q = np.broadcast_to(q, shape).reshape(-1, 6)
+    qd = np.broadcast_to(qd, shape).reshape(-1, 6)
+    pose, jac, bias, cy, measure = _chain(tuple(q.T), tuple(qd.T), np)
+    count = q.shape[0]
+    pose_a = np.empty((count, 6))
+    bias_a = np.empty((count, 6))
+    jac_a = np.empty((count, 6, 6))
+    for k in range(6):
+        pose_a[:, k] = pose[k]
+        bias_a[:, k] = bias[k]
+        for j in range(6):
+            jac_a[:, k, j] = jac[k][j]
+    lead = shape[:-1]
+    return (
+        pose_a.reshape(lead + (6,)),
+        jac_a.reshape(lead + (6, 6)),
+        bias_a.reshape(lead + (6,)),
+        np.reshape(cy, lead),
+        np.reshape(measure, lead),
+    )
+
+
+def singularity_measure(q):
+    """min(|sin q3|, |sin q5|, |a2 c2 + a3 c23 + d5 s234| / (|a2| + |a3|)), in [0, 1].
+
+    det J_g = a2 a3 s3 s5 (a2 c2 + a3 c23 + d5 s234) for the UR10e: the three factors are the
+    elbow, wrist and shoulder singularities; the measure is zero exactly at a singular J.
+    """
+    q = np.asarray(q, dtype=float)
+    c2, c23, s234 = np.cos(q[..., 1]), np.cos(q[..., 1] + q[..., 2]), np.sin(q[..., 1:4].sum(-1))
+    return _singularity_factors(np.sin(q[..., 4]), np.sin(q[..., 2]), c2, c23, s234, np)
