@@ -15,36 +15,47 @@ update. :func:`integrate` is a small fixed-step RK4 loop for tests and benchmark
 
 Corrections and readings (``/work/shared/ERRATA.md``, seed 000):
 
-- the orientation error is wrapped to (-π, π] (``robot.task_pose_error``);
-- cases (2) and (4) of the scaling choice use q̈_min (the paper prints q̈_max);
+- the orientation error is wrapped to (-π, π];
+- cases (2) and (4) of the scaling choice use q̈_min (the paper prints q̈_max), and ĉ is chosen
+  from the bounds of all joints (the "one ĉ suitable for all accelerations"), so fixing one joint
+  never pushes another out of its box;
 - ρ is not given in the paper; ``rho = 0.03`` with d normalised by the range q̇_max - q̇_min
-  (2.1 rad/s) reproduces sim 2's minimum joint velocity;
-- σ of eq. 19 is a monotone continuous progress variable: the projection of the TCP on the
-  segment p_i -> p_{i+1}, measured from where the TCP entered the ball and reaching 1 one
-  neighbourhood radius ϵ further on (the literal 1 - δ/ϵ is not monotone and stalls).
+  (2.1 rad/s) reproduces sim 2's minimum joint velocity (-0.98 vs -0.97 rad/s);
+- σ of eq. 19 is only described in words (0 when the TCP enters the ball, 1 when it leaves).
+  Here σ = (TCP path length since entering the ball) / (1.25 ϵ): monotone, continuous, 0 on
+  entry, and it reaches 1 about when the TCP leaves (the path through the balls of the paper's
+  task is 1.2-1.35 ϵ). It grows whenever the TCP moves, so the target always leads; the literal
+  1 - δ/ϵ is not monotone and a projection on p_i -> p_{i+1} does not grow while the TCP still
+  heads for p_i: both stall inside the first ball.
+- the kinematics (k(q), the analytic J and J̇q̇) are the same as ``drake_traj.robot`` (checked
+  by the tests to 1e-9) written in closed form, ~20x faster (acceleration() is called 3-4
+  times per simulated millisecond).
 
 Improvements over the literal method (each a flag of :class:`PajakParameters`, default on; all
 off gives the paper's method as printed, with the ERRATA corrections):
 
 1. ``smooth_penalty`` / ``continuous_switching``: q̈ continuous after t = 0. The penalty minus
-   its tangent at the threshold has zero slope there (q̈ no longer jumps by ρ/(R ϑ²) when it
-   switches on); the blended target starts at p_i exactly when the TCP enters the ball (σ = 0)
-   and the waypoint switches exactly when σ reaches 1, so the target never jumps.
-2. ``bounded_scaling``: c stays in [0, 1]. When no c in [0, 1] keeps every limit, q̈ is clipped
-   to the acceleration box (narrowed near the velocity limits so the joints brake) and the
-   event is counted (discrete state ``SATURATED``) instead of letting c leave [0, 1], where it
-   would switch the velocity penalty off or reverse the feedback and diverge.
-3. ``damped_inverse``: damped least squares near a singular J (the damping grows as the UR's
-   singularity measure falls below a threshold), so q̈ stays bounded; no progress for
-   ``stall_time`` seconds, a gimbal-locked Euler pose or a non-finite value raise
-   :class:`PlanningError` naming time, configuration and cause.
+   its tangent at the threshold has zero slope there (the literal q̈ jumps by ρ/(R ϑ²) = 1.43
+   rad/s² when it switches on); the waypoint switches exactly when σ reaches 1, where the
+   blended target already is p_{i+1} (literal: when the TCP leaves the ball, whatever σ is).
+2. ``bounded_scaling``: c stays in [0, 1] and the limits hold on every evaluation. The box
+   used for c also keeps q̇ viable (q̈_i <= K (q̇_max - q̇_i), active only within ϑ/4 of the
+   limit), and when no c in [0, 1] keeps the limits (a = -J⁻¹J̇q̇ alone breaks them) q̈ blends
+   continuously from the clipped law to proportional braking; the event is counted
+   (``SATURATED``). The literal c leaves [0, 1] there, which switches the penalty off or
+   reverses the feedback, and the motion diverges.
+3. ``damped_inverse``: damped least squares (JᵀJ + λ²I)⁻¹Jᵀ, λ² growing as the UR10e's
+   singularity measure (factors of det J) falls below 0.1, so the motion stays bounded near
+   singular configurations. No progress for ``stall_time`` seconds, a gimbal-locked Euler pose
+   or a non-finite value raise :class:`PlanningError` naming time, configuration and cause.
 4. ``preserve_damping``: with c < 1 the literal law has damping c Λ_V against stiffness c Λ_P,
-   which breaks condition (11) below c = 4 Λ_P / Λ_V² ≈ 0.907 and the TCP overshoots the goal.
-   Time-scaling semantics fix it: damping c Λ_V and stiffness c² Λ_P keep the damping ratio of
-   the unscaled law. To keep q̈ linear in c (so cases 1-4 stay an exact interval computation) the
-   stiffness is written c · c_r Λ_P with c_r the eq. 18 value from the anchor: c = c_r whenever
-   the limits are inactive, and while they are active the anchor is re-recorded every update,
-   so c_r - c = O(update period).
+   which breaks condition (11) below c* = 4 Λ_P / Λ_V² = 0.907, and the TCP overshoots the
+   final goal (0.8 mm in sim 3, 10 cm on a direct move with the paper's limits). The damping is
+   raised to c Λ_V max(1, sqrt(c*/c_r)) (c_r: the eq. 18 value, = c up to one update period
+   while the limits are active), which is critical damping for c < c*. It is applied while
+   converging to a fixed target (p_w; each waypoint in stop mode), ramped in with σ during the
+   last blend so q̈ stays continuous; q̈ stays linear in c, so cases 1-4 remain exact. The price
+   is time: sim 3 takes 5.86 s instead of 5.35 s.
 
 Equation numbers in comments are the paper's.
 """
@@ -52,29 +63,32 @@ Equation numbers in comments are the paper's.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
 from drake_traj import robot
+from drake_traj.planners.base import PlannerSystem
 from drake_traj.planners.scaling import relaxed_scaling
 
 __all__ = [
+    "DISCRETE_NAMES",
     "DISCRETE_SIZE",
     "PajakLaw",
     "PajakParameters",
+    "PajakPlanner",
+    "PAPER_METHOD",
     "PlanningError",
     "acceleration_terms",
     "blend_progress",
     "blended_target",
     "choose_scaling",
+    "damping_factor",
     "integrate",
     "integrate_many",
     "paper_parameters",
     "paper_initial_configuration",
     "scaling_interval",
-    "singularity_measure",
-    "ur10e_kinematics",
     "velocity_penalty",
 ]
 
@@ -87,20 +101,35 @@ C0 = 2  # eq. 18 anchor: c at T0
 WAYPOINT = 3  # index i of the active waypoint p_i (float holding an integer)
 BLENDING = 4  # 1 while the TCP passes the neighbourhood of p_i (eq. 19, second case)
 SIGMA = 5  # σ of eq. 19 stored at the last update (σ is monotone: max with the current value)
-S_ENTRY = 6  # projection of the TCP on p_i -> p_{i+1} where it entered the ball [m]
-BEST = 7  # smallest "remaining path" measure so far (progress monitor) [m]
-T_BEST = 8  # time at which BEST was last improved [s]
-SATURATED = 9  # number of updates at which no c in [0, 1] satisfied the limits (improvement 2)
-DISCRETE_SIZE = 10
-DISCRETE_NAMES = ("c", "t0", "c0", "waypoint", "blending", "sigma", "s_entry", "best", "t_best", "saturated")
+TRAVEL = 6  # TCP path length since it entered the ball, up to the last update [m]
+X_REF = slice(7, 10)  # TCP position at the last update [m]
+BEST = 10  # smallest "remaining path" measure so far (progress monitor) [m]
+T_BEST = 11  # time at which BEST was last improved [s]
+SATURATED = 12  # number of updates at which no c in [0, 1] satisfied the limits (improvement 2)
+DISCRETE_SIZE = 13
+DISCRETE_NAMES = (
+    "c", "t0", "c0", "waypoint", "blending", "sigma", "travel", "x_ref_x", "x_ref_y", "x_ref_z", "best",
+    "t_best", "saturated",
+)
+
+# The improvement flags of PajakParameters switched off: the paper's method as printed, with the
+# ERRATA corrections (used for the Table 2 reproduction and to show what each improvement fixes).
+PAPER_METHOD = dict(
+    smooth_penalty=False,
+    continuous_switching=False,
+    bounded_scaling=False,
+    damped_inverse=False,
+    preserve_damping=False,
+)
 
 # UR10e geometry (standard DH, robot.py).
-_D1, _D4, _D5, _D6 = (float(robot.DH_D[k]) for k in (0, 3, 4, 5))
-_A2, _A3 = float(robot.DH_A[1]), float(robot.DH_A[2])
+_D1 = float(robot.DH_D[0])
 SHOULDER = np.array([0.0, 0.0, _D1])  # shoulder point (joint-2 axis on the base axis) [m]
 REACH = 1.3  # [m], UR10e reach from the shoulder (ur10e_facts.md)
 _ORIENTATION_LENGTH = 0.1  # [m/rad], weight of orientation in the progress measure
 _MIN_COS_PITCH = 1e-6  # Euler gimbal lock (as robot.analytic_jacobian_and_bias)
+_BRAKE_TIME = 0.05  # [s], time constant of the fallback braking at low speed (improvement 2)
+_BRAKE_GAP = 0.1  # emptiness of the c interval at which the fallback is pure braking
 
 
 class PlanningError(ValueError):
@@ -142,22 +171,25 @@ class PajakParameters:
         velocity_limit: q̇_max = -q̇_min (scalar or 6) [rad/s], eq. 4.
         acceleration_limit: q̈_max = -q̈_min (scalar or 6) [rad/s²], eq. 5.
         vartheta: ϑ, penalty threshold on the normalised distance d (eq. 14), in (0, 0.5).
-        rho: ρ, penalty strength (eq. 14) [rad/s], not given in the paper (ERRATA: 0.03).
+        rho: ρ, penalty strength (eq. 14) [rad²/s³], not given in the paper (ERRATA: 0.03).
         accuracy: ε, the task is finished when the TCP is this close to p_w [m].
         neighbourhood: ϵ, radius of the blending ball around each waypoint [m] (eq. 19).
         limit_velocity: add the penalty perturbation Δq̈ (eq. 15-16); sims 2 and 3.
         limit_acceleration: scale the trajectory (eq. 17-18), c(0) = 0; sim 3.
         blend_waypoints: pass waypoints without stopping (eq. 19); False stops at each.
         smooth_penalty: improvement 1, penalty with zero slope at the threshold.
-        continuous_switching: improvement 1, σ = 0 on entry and the switch exactly at σ = 1.
-        bounded_scaling: improvement 2, c in [0, 1]; otherwise clip q̈ and count it.
-        damped_inverse: improvement 3, damped least squares near singular J.
-        preserve_damping: improvement 4, stiffness scaled by c·c_r (≈ c²): condition (11) for any c.
+        continuous_switching: improvement 1, the waypoint switches when σ reaches 1 (literal:
+            when the TCP leaves the ball).
+        bounded_scaling: improvement 2, c in [0, 1], limits kept by braking when no c works.
+        damped_inverse: improvement 3, damped least squares near a singular J.
+        preserve_damping: improvement 4, condition (11) kept for c < 1 near the final goal.
         scaling_rate: rate of eq. 18 [1/s] (1 in the paper).
-        singularity_threshold: DLS starts below this value of :func:`singularity_measure`.
-        max_damping: DLS damping λ at the singularity.
-        stop_speed: in stop mode, TCP speed [m/s] below which a waypoint counts as reached.
-        stall_time: no progress for this long [s] raises PlanningError.
+        singularity_threshold: damped least squares below this :func:`drake_traj.robot.singularity_measure`.
+        max_damping: damping λ of the damped least squares at a singular J.
+        stop_speed: stop mode: TCP speed [m/s] below which a waypoint counts as reached.
+        stall_time: no progress (remaining path shorter by 0.1 mm) for this long [s] raises
+            PlanningError.
+        blend_length: σ = path length through the ball / (blend_length · ϵ) (eq. 19 reading).
     """
 
     waypoints: np.ndarray
@@ -178,10 +210,11 @@ class PajakParameters:
     damped_inverse: bool = True
     preserve_damping: bool = True
     scaling_rate: float = 1.0
-    singularity_threshold: float = 0.02
-    max_damping: float = 0.05
+    singularity_threshold: float = 0.1
+    max_damping: float = 0.2
     stop_speed: float = 0.01
-    stall_time: float = 2.0
+    stall_time: float = 3.0
+    blend_length: float = 1.25
 
     def validate(self) -> "PajakParameters":
         """Check every field; return a copy with arrays normalised ((w, 6) waypoints, (6,) gains
@@ -216,7 +249,7 @@ class PajakParameters:
             values[name] = _positive_vector(getattr(self, name), name, n)
         for name in (
             "rho", "accuracy", "neighbourhood", "scaling_rate", "singularity_threshold", "max_damping",
-            "stop_speed", "stall_time",
+            "stop_speed", "stall_time", "blend_length",
         ):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
@@ -285,170 +318,9 @@ def paper_parameters(simulation: int = 3, **overrides) -> PajakParameters:
         [0.275, -0.525, 0.730],  # p_f
     ]
     waypoints = np.array([p + orientation for p in positions])
-    settings = dict(limit_velocity=simulation >= 2, limit_acceleration=simulation == 3)
+    settings = dict(waypoints=waypoints, limit_velocity=simulation >= 2, limit_acceleration=simulation == 3)
     settings.update(overrides)
-    return PajakParameters(waypoints=waypoints, **settings)
-
-
-# --------------------------------------------------------------------------------------------
-# Kinematics: closed-form UR10e k(q), analytic J(q) and J̇q̇ (same as robot.py, ~20x faster).
-# --------------------------------------------------------------------------------------------
-
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _chain(q, qd, m):
-    """k(q), analytic J and J̇q̇ as nested tuples of components (floats, or arrays of tasks).
-
-    ``m`` is ``math`` for floats or ``numpy`` for arrays. Standard DH frames of robot.py written
-    out: joint axes z_j at origins o_j, flange o_6; J_g columns z_j x (o_6 - o_j) and z_j; the
-    bias by the usual velocity/acceleration recursion with q̈ = 0; then J = diag(I, B⁻¹) J_g and
-    the Euler part of the bias B⁻¹ (α - Ḃ φ̇) (seed 000, with B's columns in k(q)'s order).
-    """
-    q1, q2, q3, q4, q5, q6 = q
-    c1, s1 = m.cos(q1), m.sin(q1)
-    c2, s2 = m.cos(q2), m.sin(q2)
-    c5, s5 = m.cos(q5), m.sin(q5)
-    c6, s6 = m.cos(q6), m.sin(q6)
-    q23 = q2 + q3
-    q234 = q23 + q4
-    c23, s23 = m.cos(q23), m.sin(q23)
-    c234, s234 = m.cos(q234), m.sin(q234)
-    z0 = (0.0, 0.0, 1.0)
-    z1 = (s1, -c1, 0.0)
-    x4 = (c1 * c234, s1 * c234, s234)
-    z4 = (c1 * s234, s1 * s234, -c234)
-    z5 = (c5 * s1 - s5 * x4[0], -c5 * c1 - s5 * x4[1], -s5 * s234)
-    x5 = (c5 * x4[0] + s5 * s1, c5 * x4[1] - s5 * c1, c5 * s234)
-    x6 = tuple(c6 * x5[k] - s6 * z4[k] for k in range(3))
-    y6 = tuple(-s6 * x5[k] - c6 * z4[k] for k in range(3))
-    # r_j = o_{j+1} - o_j
-    rs = (
-        (0.0, 0.0, _D1),
-        (_A2 * c1 * c2, _A2 * s1 * c2, _A2 * s2),
-        (_A3 * c1 * c23, _A3 * s1 * c23, _A3 * s23),
-        (_D4 * z1[0], _D4 * z1[1], 0.0),
-        (_D5 * z4[0], _D5 * z4[1], _D5 * z4[2]),
-        (_D6 * z5[0], _D6 * z5[1], _D6 * z5[2]),
-    )
-    axes = (z0, z1, z1, z1, z4, z5)
-    # p_j = o_6 - o_j
-    ps = [None] * 6
-    acc = (0.0, 0.0, 0.0)
-    for j in range(5, -1, -1):
-        r = rs[j]
-        acc = (acc[0] + r[0], acc[1] + r[1], acc[2] + r[2])
-        ps[j] = acc
-    jv = [_cross(axes[j], ps[j]) for j in range(6)]
-    # bias recursion (q̈ = 0): α_{j+1} = α_j + ω_j x z_j q̇_j, ω_{j+1} = ω_j + z_j q̇_j,
-    # a_{j+1} = a_j + α_{j+1} x r_j + ω_{j+1} x (ω_{j+1} x r_j)
-    w = (0.0, 0.0, 0.0)
-    al = (0.0, 0.0, 0.0)
-    lin = (0.0, 0.0, 0.0)
-    for j in range(6):
-        z, r, v = axes[j], rs[j], qd[j]
-        zq = (z[0] * v, z[1] * v, z[2] * v)
-        if j:
-            wz = _cross(w, zq)
-            al = (al[0] + wz[0], al[1] + wz[1], al[2] + wz[2])
-        w = (w[0] + zq[0], w[1] + zq[1], w[2] + zq[2])
-        t1 = _cross(al, r)
-        t2 = _cross(w, _cross(w, r))
-        lin = (lin[0] + t1[0] + t2[0], lin[1] + t1[1] + t2[1], lin[2] + t1[2] + t2[2])
-    # Z-Y-X Euler angles (k(q) rows 4-6)
-    r11, r21, r31, r32, r33 = x6[0], x6[1], x6[2], y6[2], z5[2]
-    phx = m.atan2(r32, r33)
-    cy = m.hypot(r32, r33)  # = cos φ_Y >= 0
-    phy = m.atan2(-r31, cy)
-    phz = m.atan2(r21, r11)
-    sy, cz, sz = -r31, m.cos(phz), m.sin(phz)
-    if m is math:
-        icy = 1.0 / cy if cy > 0.0 else 1e300
-    else:
-        icy = 1.0 / np.maximum(cy, 1e-300)
-
-    def binv(v):  # B(φ)⁻¹ v, B of robot.euler_rate_matrix
-        fx = (cz * v[0] + sz * v[1]) * icy
-        return (fx, -sz * v[0] + cz * v[1], v[2] + sy * fx)
-
-    jw = [binv(axes[j]) for j in range(6)]
-    fx, fy, fz = binv(w)  # Euler rates φ̇
-    bdot = (
-        -sy * cz * fx * fy + fz * (-cy * sz * fx - cz * fy),
-        -sy * sz * fx * fy + fz * (cy * cz * fx - sz * fy),
-        -cy * fx * fy,
-    )
-    ang = binv((al[0] - bdot[0], al[1] - bdot[1], al[2] - bdot[2]))
-    pose = (ps[0][0], ps[0][1], ps[0][2] + 0.0, phx, phy, phz)
-    jac = tuple(tuple(jv[j][k] for j in range(6)) for k in range(3)) + tuple(
-        tuple(jw[j][k] for j in range(6)) for k in range(3)
-    )
-    bias = lin + ang
-    measure = _singularity_factors(s5, m.sin(q3), c2, c23, s234, m)
-    return pose, jac, bias, cy, measure
-
-
-def _singularity_factors(s5, s3, c2, c23, s234, m):
-    # det J_g = a2 a3 s3 s5 (a2 c2 + a3 c23 + d5 s234): elbow, wrist and shoulder factors.
-    shoulder = (_A2 * c2 + _A3 * c23 + _D5 * s234) / (abs(_A2) + abs(_A3))
-    if m is math:
-        return min(abs(s3), abs(s5), abs(shoulder))
-    return np.minimum(np.minimum(np.abs(s3), np.abs(s5)), np.abs(shoulder))
-
-
-def ur10e_kinematics(q, qd):
-    """(k(q), J(q), J̇(q, q̇) q̇, cos φ_Y, singularity measure) of the UR10e flange.
-
-    Same quantities as ``robot.task_pose`` and ``robot.analytic_jacobian_and_bias`` (the tests
-    check agreement to 1e-9), in closed form: about 30 µs for one state instead of ~600 µs, and
-    vectorised over leading dimensions (q, q̇ of shape (..., 6)).
-
-    Returns:
-        pose (..., 6), J (..., 6, 6), bias (..., 6), cos_pitch (...), measure (...), where
-        ``measure`` is :func:`singularity_measure`. No exception at gimbal lock: callers check
-        ``cos_pitch``.
-    """
-    q = np.asarray(q, dtype=float)
-    qd = np.asarray(qd, dtype=float)
-    if q.shape == (6,) and qd.shape == (6,):
-        pose, jac, bias, cy, measure = _chain(q.tolist(), qd.tolist(), math)
-        return np.array(pose), np.array(jac), np.array(bias), cy, measure
-    shape = np.broadcast_shapes(q.shape, qd.shape)
-    if shape[-1] != 6:
-        raise ValueError(f"q and qd must have shape (..., 6), got {q.shape} and {qd.shape}")
-    q = np.broadcast_to(q, shape).reshape(-1, 6)
-    qd = np.broadcast_to(qd, shape).reshape(-1, 6)
-    pose, jac, bias, cy, measure = _chain(tuple(q.T), tuple(qd.T), np)
-    count = q.shape[0]
-    pose_a = np.empty((count, 6))
-    bias_a = np.empty((count, 6))
-    jac_a = np.empty((count, 6, 6))
-    for k in range(6):
-        pose_a[:, k] = pose[k]
-        bias_a[:, k] = bias[k]
-        for j in range(6):
-            jac_a[:, k, j] = jac[k][j]
-    lead = shape[:-1]
-    return (
-        pose_a.reshape(lead + (6,)),
-        jac_a.reshape(lead + (6, 6)),
-        bias_a.reshape(lead + (6,)),
-        np.reshape(cy, lead),
-        np.reshape(measure, lead),
-    )
-
-
-def singularity_measure(q):
-    """min(|sin q3|, |sin q5|, |a2 c2 + a3 c23 + d5 s234| / (|a2| + |a3|)), in [0, 1].
-
-    det J_g = a2 a3 s3 s5 (a2 c2 + a3 c23 + d5 s234) for the UR10e: the three factors are the
-    elbow, wrist and shoulder singularities; the measure is zero exactly at a singular J.
-    """
-    q = np.asarray(q, dtype=float)
-    c2, c23, s234 = np.cos(q[..., 1]), np.cos(q[..., 1] + q[..., 2]), np.sin(q[..., 1:4].sum(-1))
-    return _singularity_factors(np.sin(q[..., 4]), np.sin(q[..., 2]), c2, c23, s234, np)
+    return PajakParameters(**settings)
 
 
 # --------------------------------------------------------------------------------------------
@@ -481,31 +353,41 @@ def velocity_penalty(qd, qd_min, qd_max, rho: float, vartheta: float, *, smooth:
     return np.where(upper, -magnitude, magnitude)
 
 
-def _solve(jac, rhs, measure, params_threshold, max_damping, damped: bool):
-    """J⁻¹ rhs (eq. 13), or the damped least-squares (JᵀJ + λ²I)⁻¹ Jᵀ rhs (improvement 3)."""
-    if not damped:
+def damping_factor(measure, threshold, max_damping):
+    """λ² of the damped least-squares inverse (improvement 3): 0 for measure >= threshold,
+    rising to max_damping² at a singular J: λ² = λ_max² (1 - (measure/threshold)²)."""
+    ratio = np.minimum(np.asarray(measure, dtype=float) / threshold, 1.0)
+    return (max_damping * max_damping) * (1.0 - ratio * ratio)
+
+
+def _solve(jac, rhs, lam2=None):
+    """J⁻¹ rhs (eq. 13), or (JᵀJ + λ²I)⁻¹ Jᵀ rhs (damped least squares) when lam2 is given."""
+    if lam2 is None:
         return np.linalg.solve(jac, rhs)
-    ratio = np.minimum(np.asarray(measure, dtype=float) / params_threshold, 1.0)
-    lam2 = (max_damping * max_damping) * (1.0 - ratio * ratio)
     jt = np.swapaxes(jac, -1, -2)
-    normal = jt @ jac
-    normal = normal + lam2[..., None, None] * np.eye(6) if np.ndim(lam2) else normal + lam2 * np.eye(6)
+    normal = jt @ jac + np.asarray(lam2)[..., None, None] * _EYE6
     return np.linalg.solve(normal, jt @ rhs)
 
 
-def acceleration_terms(jac, bias, error, qd, position_gain, velocity_gain, penalty=0.0, *,
-                       measure=1.0, singularity_threshold=0.02, max_damping=0.05, damped=True):
+_EYE6 = np.eye(6)
+
+
+def acceleration_terms(jac, bias, error, qd, position_gain, velocity_gain, penalty=0.0, lam2=None):
     """(a, b_V, b_P) of eq. 17 with b = b_V + b_P:
 
     a = -J⁻¹ J̇q̇, b_V = -J⁻¹ Λ_V J q̇ + Δq̈, b_P = -J⁻¹ Λ_P e (e of eq. 6 or eq. 19).
     q̈ = a + c (b_V + b_P) is eq. 17; with c = 1 it is eq. 16 (eq. 13 without Δq̈).
+    With ``lam2`` (λ², see :func:`damping_factor`) J⁻¹ is the damped least-squares inverse.
     Shapes: jac (..., 6, 6), the vectors (..., 6); gains broadcast against (..., 6).
     """
-    rhs = np.stack(
-        [bias, velocity_gain * np.einsum("...ij,...j->...i", jac, qd), position_gain * error], axis=-1
-    )
-    sol = _solve(jac, rhs, measure, singularity_threshold, max_damping, damped)
-    return -sol[..., 0], -sol[..., 1] + penalty, -sol[..., 2]
+    jac = np.asarray(jac, dtype=float)
+    shape = jac.shape[:-1] + (3,)
+    rhs = np.empty(shape)
+    rhs[..., 0] = bias
+    rhs[..., 1] = velocity_gain * (jac @ np.asarray(qd, dtype=float)[..., None])[..., 0]
+    rhs[..., 2] = position_gain * error
+    sol = _solve(jac, rhs, lam2)
+    return -sol[..., 0], penalty - sol[..., 1], -sol[..., 2]
 
 
 def scaling_interval(a, b, qdd_min, qdd_max):
@@ -515,18 +397,19 @@ def scaling_interval(a, b, qdd_min, qdd_max):
     b_i > 0: (q̈_min - a_i)/b_i <= c <= (q̈_max - a_i)/b_i; b_i < 0: the same with the roles
     of q̈_min and q̈_max swapped; b_i = 0: no bound if a_i is inside the box, else empty.
     Upper bounds (cases 1, 2) combine by min (case a), lower bounds (3, 4) by max (case b).
+    The interval is empty where c_lo > c_hi.
     """
-    with np.errstate(divide="ignore", invalid="ignore"):
-        to_max = (qdd_max - a) / b
-        to_min = (qdd_min - a) / b
-    positive = b > 0
-    zero = b == 0
-    inside = (a >= qdd_min) & (a <= qdd_max)
-    low = np.where(positive, to_min, to_max)
-    high = np.where(positive, to_max, to_min)
-    low = np.where(zero, np.where(inside, -np.inf, np.inf), low)
-    high = np.where(zero, np.where(inside, np.inf, -np.inf), high)
-    return low.max(axis=-1), high.min(axis=-1)
+    b = np.asarray(b, dtype=float)
+    if b.all():
+        inv = 1.0 / b
+        to_max = (qdd_max - a) * inv
+        to_min = (qdd_min - a) * inv
+    else:  # b_i = 0: ±inf bounds (a_i inside) or an empty interval (a_i outside)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            to_max = (qdd_max - a) / b
+            to_min = (qdd_min - a) / b
+    # fmin/fmax ignore the NaN of 0/0 (a_i exactly on a bound with b_i = 0: no bound)
+    return np.fmin(to_max, to_min).max(axis=-1), np.fmax(to_max, to_min).min(axis=-1)
 
 
 def choose_scaling(c_relaxed, c_lo, c_hi, *, bounded: bool = True):
@@ -547,25 +430,28 @@ def choose_scaling(c_relaxed, c_lo, c_hi, *, bounded: bool = True):
     feasible = c_lo <= c_hi
     c = np.minimum(np.maximum(c_relaxed, c_lo), c_hi)
     if bounded:
-        c = np.clip(c, 0.0, 1.0)
+        c = np.minimum(np.maximum(c, 0.0), 1.0)
     return c, feasible
 
 
-def blend_progress(position, p_i, p_next, s_entry, neighbourhood, *, continuous: bool = True):
-    """σ of eq. 19 (before the monotone max), from the TCP projection on p_i -> p_{i+1}.
+def blend_progress(position, reference, travel, length):
+    """σ of eq. 19 before the monotone max: the TCP path length through the ball / ``length``.
 
-    s = (x - p_i)·u, u the unit direction of the segment. Continuous (default): σ = (s - s_entry)
-    / (ϵ - s_entry), 0 where the TCP entered the ball, 1 one radius past p_i along the segment
-    (the denominator is kept >= ϵ/2). Literal reading: σ = s/ϵ. Clipped to [0, 1].
+    σ = (ℓ + |x - x_ref|) / length, clipped to [0, 1], where ℓ is the path length accumulated
+    at the updates since the TCP entered the ball and x_ref the TCP position at the last update.
+    It is 0 on entry, continuous in x and grows whenever the TCP moves, so the target always
+    leads (a projection on p_i -> p_{i+1} does not grow while the TCP is still heading for p_i,
+    and 1 - δ/ϵ is not monotone: both stall, ERRATA). ``length`` = ``blend_length`` · ϵ.
     """
-    segment = p_next - p_i
-    length = np.linalg.norm(segment, axis=-1)
-    s = np.einsum("...i,...i->...", position - p_i, segment) / np.maximum(length, 1e-12)
-    if continuous:
-        sigma = (s - s_entry) / np.maximum(neighbourhood - s_entry, 0.5 * neighbourhood)
-    else:
-        sigma = s / neighbourhood
-    return np.clip(sigma, 0.0, 1.0), s
+    step = np.sqrt(np.sum((position - reference) ** 2, axis=-1))
+    return np.clip((travel + step) / length, 0.0, 1.0), step
+
+
+def _pose_error(pose, goal):
+    """robot.task_pose_error over leading dimensions: pose - goal, orientation wrapped."""
+    error = pose - goal
+    error[..., 3:] = robot.wrap_angle(error[..., 3:])
+    return error
 
 
 def blended_target(p_i, p_next, sigma):
@@ -648,14 +534,23 @@ class PajakLaw:
         self.qdd_max = stack("acceleration_limit")
         for name in (
             "vartheta", "rho", "accuracy", "neighbourhood", "scaling_rate", "singularity_threshold",
-            "max_damping", "stop_speed", "stall_time",
+            "max_damping", "stop_speed", "stall_time", "blend_length",
         ):
             values = stack(name)
             setattr(self, name, values)
-        # velocity-aware acceleration box of the fallback: its bound falls from q̈_max at the
-        # penalty threshold to 0 at the velocity limit (improvement 2)
-        self.brake_gain = self.qdd_max / (self.vartheta[:, None] * 2.0 * self.qd_max)
+        # velocity-viability bound of the acceleration box (improvement 2): it falls from q̈_max
+        # at d = ϑ/4 to 0 at the velocity limit
+        self.viability_gain = self.qdd_max / (0.25 * self.vartheta[:, None] * 2.0 * self.qd_max)
+        self.viability_onset = self.qd_max * (1.0 - 0.5 * self.vartheta[:, None])
+        self.blend_distance = self.blend_length * self.neighbourhood
+        # c below which condition (11) fails for the scaled gains c Λ_V, c Λ_P: 4 Λ_P / Λ_V² = 0.907
+        self.critical_scaling = np.max(4.0 * self.kp / self.kv**2, axis=1)
         self._rows = np.arange(count)
+        self._zeros = np.zeros(count)
+        self._ones = np.ones(count)
+        self._false = np.zeros(count, dtype=bool)
+        # |q̇| above which the penalty of eq. 14 is active: d < ϑ  <=>  |q̇| > q̇_max (1 - 2ϑ)
+        self.penalty_onset = self.qd_max * (1.0 - 2.0 * self.vartheta[:, None])
 
     # --- shapes --------------------------------------------------------------------------------
     def _batch(self, value, width):
@@ -684,61 +579,89 @@ class PajakLaw:
         return self._out(d)
 
     # --- evaluation ----------------------------------------------------------------------------
-    def _evaluate(self, t, q, qd, d) -> _Evaluation:
+    def _kinematics(self, q, qd):
         if self.count == 1:
-            pose, jac, bias, cy, measure = ur10e_kinematics(q[0], qd[0])
-            pose, jac, bias = pose[None], jac[None], bias[None]
-            cy, measure = np.array([cy]), np.array([measure])
-        else:
-            pose, jac, bias, cy, measure = ur10e_kinematics(q, qd)
+            pose, jac, bias, cy, measure = robot.ur10e_kinematics(q[0], qd[0])
+            return pose[None], jac[None], bias[None], np.array([cy]), np.array([measure])
+        return robot.ur10e_kinematics(q, qd)
+
+    def _evaluate(self, t, q, qd, d) -> _Evaluation:
+        pose, jac, bias, cy, measure = self._kinematics(q, qd)
         rows = self._rows
-        i = d[:, WAYPOINT].astype(int)
+        i = d[:, WAYPOINT].astype(np.intp)
         p_i = self.waypoints[rows, i]
-        sigma = np.zeros(self.count)
-        target = p_i
         blending = d[:, BLENDING] > 0.5
         if self.blend_waypoints and blending.any():
             p_next = self.waypoints[rows, np.minimum(i + 1, self.num_waypoints - 1)]
-            raw, _ = blend_progress(
-                pose[:, :3], p_i[:, :3], p_next[:, :3], d[:, S_ENTRY], self.neighbourhood,
-                continuous=self.continuous_switching,
-            )
+            raw, _ = blend_progress(pose[:, :3], d[:, X_REF], d[:, TRAVEL], self.blend_distance)
             sigma = np.where(blending, np.maximum(raw, d[:, SIGMA]), 0.0)  # monotone σ
             target = np.where(blending[:, None], blended_target(p_i, p_next, sigma), p_i)  # eq. 19
-        error = robot.task_pose_error(pose, target)  # eq. 6 / eq. 19, orientation wrapped
-        if self.limit_velocity:
+        else:
+            sigma = self._zeros
+            target = p_i  # eq. 6
+        error = pose - target
+        error[:, 3:] = robot.wrap_angle(error[:, 3:])  # orientation wrapped (ERRATA)
+        if self.limit_velocity and (np.abs(qd) > self.penalty_onset).any():
             penalty = velocity_penalty(
                 qd, -self.qd_max, self.qd_max, self.rho[:, None], self.vartheta[:, None],
                 smooth=self.smooth_penalty,
             )  # eq. 14-15
         else:
             penalty = 0.0
-        a, b_v, b_p = acceleration_terms(
-            jac, bias, error, qd, self.kp, self.kv, penalty, measure=measure,
-            singularity_threshold=self.singularity_threshold, max_damping=self.max_damping,
-            damped=self.damped_inverse,
-        )  # eq. 17 (eq. 16 when c = 1)
-        saturated = np.zeros(self.count, dtype=bool)
-        if self.limit_acceleration:
-            c_r, _ = relaxed_scaling(t, d[:, T0], d[:, C0], 1.0, self.scaling_rate)  # eq. 18
-            # improvement 4: stiffness c·c_r Λ_P (≈ c²), damping c Λ_V; literal: c Λ_P
-            b = b_v + (np.clip(c_r, 0.0, 1.0)[:, None] if self.preserve_damping else 1.0) * b_p
-            c_lo, c_hi = scaling_interval(a, b, -self.qdd_max, self.qdd_max)  # cases 1-4
-            c, feasible = choose_scaling(c_r, c_lo, c_hi, bounded=self.bounded_scaling)  # cases a-c
-            qdd = a + c[:, None] * b  # eq. 17
-            if self.bounded_scaling:
-                saturated = ~feasible
-                if saturated.any():
-                    upper = self.qdd_max
-                    lower = -self.qdd_max
-                    if self.limit_velocity:
-                        upper = np.minimum(upper, self.brake_gain * (self.qd_max - qd))
-                        lower = np.maximum(lower, self.brake_gain * (-self.qd_max - qd))
-                    qdd = np.where(saturated[:, None], np.clip(qdd, lower, upper), qdd)
-        else:
-            c_r = np.ones(self.count)
-            c = c_r
+        lam2 = None
+        if self.damped_inverse and (measure < self.singularity_threshold).any():
+            lam2 = damping_factor(measure, self.singularity_threshold, self.max_damping)
+        a, b_v, b_p = acceleration_terms(jac, bias, error, qd, self.kp, self.kv, penalty, lam2)  # eq. 17
+        saturated = self._false
+        if not self.limit_acceleration:
+            c_r = c = self._ones
             qdd = a + b_v + b_p  # eq. 16 (eq. 13 without the penalty)
+            return _Evaluation(qdd, c, c_r, saturated, pose, target, sigma, measure, cy)
+        c_r = relaxed_scaling(t, d[:, T0], d[:, C0], 1.0, self.scaling_rate)[0]  # eq. 18
+        if self.preserve_damping:
+            # improvement 4: damping c·h Λ_V with h = max(1, sqrt(c*/c_r)), c* = 4 Λ_P / Λ_V²,
+            # restores condition (11) (critical damping) for c < c*. Applied while converging to
+            # a fixed target (p_w; every waypoint in stop mode), ramped in with σ during the last
+            # blend so that q̈ stays continuous.
+            if not self.blend_waypoints:
+                weight = self._ones
+            elif (i >= self.num_waypoints - 2).any():
+                weight = np.where(i >= self.num_waypoints - 1, 1.0, np.where(i == self.num_waypoints - 2, sigma, 0.0))
+            else:
+                weight = None
+            if weight is not None and (c_r < self.critical_scaling).any():
+                boost = np.sqrt(self.critical_scaling / np.minimum(np.maximum(c_r, 1e-3), 1.0))
+                boost = 1.0 + weight * np.maximum(boost - 1.0, 0.0)
+                b = boost[:, None] * (b_v - penalty) + penalty + b_p
+            else:
+                b = b_v + b_p
+        else:
+            b = b_v + b_p
+        lower, upper = -self.qdd_max, self.qdd_max
+        if self.bounded_scaling and self.limit_velocity and (np.abs(qd) > self.viability_onset).any():
+            # improvement 2: the box also keeps q̇ viable: q̈_i <= K (q̇_max - q̇_i) (and the
+            # mirror bound), so q̇ can only approach its limit exponentially even when c is held
+            # small by another joint and the penalty (scaled by c) cannot act. K puts the bound's
+            # onset at d = ϑ/4, inside the penalty zone.
+            upper = np.minimum(np.maximum(self.viability_gain * (self.qd_max - qd), lower), upper)
+            lower = np.minimum(np.maximum(self.viability_gain * (-self.qd_max - qd), lower), -lower)
+        c_lo, c_hi = scaling_interval(a, b, lower, upper)  # cases 1-4
+        c, feasible = choose_scaling(c_r, c_lo, c_hi, bounded=self.bounded_scaling)  # cases a-c
+        qdd = a + c[:, None] * b  # eq. 17
+        if self.bounded_scaling and not feasible.all():
+            # improvement 2: no c in [0, 1] keeps the limits (then a = -J⁻¹J̇q̇ alone breaks
+            # them: the joints move too fast for the curvature of the path). Blend, by how
+            # empty the interval is, from q̈ clipped to the box to braking all joints
+            # proportionally at the largest admissible rate; both stay in the box (braking only
+            # lowers |q̇|), and the blend is continuous.
+            saturated = ~feasible
+            clipped = np.minimum(np.maximum(qdd, lower), upper)
+            with np.errstate(divide="ignore"):
+                rate = np.min(self.qdd_max / np.abs(qd), axis=1)
+            brake = -qd * np.minimum(rate, 1.0 / _BRAKE_TIME)[:, None]
+            gap = np.maximum(c_lo, 0.0) - np.minimum(c_hi, 1.0)
+            weight = np.minimum(np.maximum(gap / _BRAKE_GAP, 0.0), 1.0)[:, None]
+            qdd = np.where(saturated[:, None], clipped + weight * (brake - clipped), qdd)
         return _Evaluation(qdd, c, c_r, saturated, pose, target, sigma, measure, cy)
 
     def acceleration(self, t: float, q, qd, discrete):
@@ -821,6 +744,9 @@ class PajakLaw:
         distance = np.linalg.norm(position - p_i[:, :3], axis=1)
         if self.blend_waypoints:
             blending = d[:, BLENDING] > 0.5
+            _, step = blend_progress(position, d[:, X_REF], d[:, TRAVEL], self.blend_distance)
+            d[:, TRAVEL] = np.where(blending, d[:, TRAVEL] + step, 0.0)
+            d[:, X_REF] = position
             d[:, SIGMA] = np.where(blending, ev.sigma, 0.0)
             if self.continuous_switching:
                 switch = blending & (ev.sigma >= 1.0)  # σ reached 1: the target is p_{i+1} already
@@ -835,12 +761,9 @@ class PajakLaw:
             p_i = self.waypoints[rows, i]
             distance = np.linalg.norm(position - p_i[:, :3], axis=1)
             enter = (d[:, BLENDING] < 0.5) & ~last & (distance < self.neighbourhood)
-            if enter.any():
-                p_next = self.waypoints[rows, np.minimum(i + 1, self.num_waypoints - 1)]
-                _, s = blend_progress(position, p_i[:, :3], p_next[:, :3], 0.0, self.neighbourhood)
-                d[:, BLENDING] = np.where(enter, 1.0, d[:, BLENDING])
-                d[:, S_ENTRY] = np.where(enter, s, d[:, S_ENTRY])
-                d[:, SIGMA] = np.where(enter, 0.0, d[:, SIGMA])
+            d[:, BLENDING] = np.where(enter, 1.0, d[:, BLENDING])
+            d[:, TRAVEL] = np.where(enter, 0.0, d[:, TRAVEL])
+            d[:, SIGMA] = np.where(enter, 0.0, d[:, SIGMA])
         else:
             # stop at each waypoint: reached within ε at low TCP speed, then the next task
             # starts from rest (with c from 0 again when the acceleration is limited)
@@ -861,7 +784,7 @@ class PajakLaw:
         orientation = np.linalg.norm(robot.wrap_angle(ev.pose[:, 3:] - p_i[:, 3:]), axis=1)
         remaining = distance + _ORIENTATION_LENGTH * orientation + self.remaining[rows, i]
         improved = remaining < d[:, BEST] - 1e-4
-        d[:, BEST] = np.where(improved, remaining, np.minimum(d[:, BEST], remaining))
+        d[:, BEST] = np.where(improved, remaining, d[:, BEST])
         d[:, T_BEST] = np.where(improved, t, d[:, T_BEST])
         stalled = ~finished & (t - d[:, T_BEST] > self.stall_time)
         status = np.where(finished, 1, status)
@@ -887,15 +810,15 @@ class PajakLaw:
 
     def _tcp_speed(self, q, qd):
         if self.count == 1:
-            _, jac, _, _, _ = ur10e_kinematics(q[0], qd[0])
+            _, jac, _, _, _ = robot.ur10e_kinematics(q[0], qd[0])
             return np.array([np.linalg.norm(jac[:3] @ qd[0])])
-        _, jac, _, _, _ = ur10e_kinematics(q, qd)
+        _, jac, _, _, _ = robot.ur10e_kinematics(q, qd)
         return np.linalg.norm(np.einsum("nij,nj->ni", jac[:, :3], qd), axis=1)
 
     def finished(self, q, qd, discrete):
         """True once the TCP is within ε of the final waypoint p_w and p_w is the active target."""
         q2, d2 = self._batch(q, 6), self._batch(discrete, DISCRETE_SIZE)
-        pose, *_ = ur10e_kinematics(q2, np.zeros_like(q2))
+        pose, *_ = robot.ur10e_kinematics(q2, np.zeros_like(q2))
         i = d2[:, WAYPOINT].astype(int)
         last = i >= self.num_waypoints - 1
         distance = np.linalg.norm(pose[:, :3] - self.waypoints[self._rows, i, :3], axis=1)
@@ -915,31 +838,47 @@ _CAUSES = {-1: "stall", -2: "singular", -3: "non-finite", -4: "timeout"}
 # --------------------------------------------------------------------------------------------
 
 
-def _rk4_step(law, t, q, qd, d, dt):
-    k1v, k1a = qd, law._evaluate(t, q, qd, d).qdd
+def _rk4_step(law, t, q, qd, d, dt, k1a, peak):
+    """One RK4 step of (q, q̇)' = (q̇, q̈) with the discrete state held; k1a = q̈(t, q, q̇).
+    ``peak`` (6,) accumulates max |q̈| over the stages."""
     h = 0.5 * dt
     k2v = qd + h * k1a
-    k2a = law._evaluate(t + h, q + h * k1v, k2v, d).qdd
+    k2a = law._evaluate(t + h, q + h * qd, k2v, d).qdd
     k3v = qd + h * k2a
     k3a = law._evaluate(t + h, q + h * k2v, k3v, d).qdd
     k4v = qd + dt * k3a
     k4a = law._evaluate(t + dt, q + dt * k3v, k4v, d).qdd
-    q_new = q + dt / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)
-    qd_new = qd + dt / 6.0 * (k1a + 2 * k2a + 2 * k3a + k4a)
+    np.maximum(peak, np.abs(k2a[0]), out=peak)
+    np.maximum(peak, np.abs(k3a[0]), out=peak)
+    np.maximum(peak, np.abs(k4a[0]), out=peak)
+    q_new = q + dt / 6.0 * (qd + 2.0 * k2v + 2.0 * k3v + k4v)
+    qd_new = qd + dt / 6.0 * (k1a + 2.0 * k2a + 2.0 * k3a + k4a)
     return q_new, qd_new
 
 
-def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0) -> dict:
+def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settle_time: float = 0.0,
+              raise_on_timeout: bool = True) -> dict:
     """Integrate one task with RK4 at a fixed step, updating the discrete state every step.
 
     At every step k: discrete update at t_k, then the sample (t_k, q_k, q̇_k, q̈_k, c_k, TCP,
-    waypoint), then an RK4 step with the discrete state held. Stops at the first sample where the
-    task is finished.
+    waypoint), then an RK4 step with the discrete state held (its first stage is the sample).
+    Stops at the first sample where the task is finished, or ``settle_time`` later (to look at
+    what happens after the finish, e.g. an overshoot).
+
+    Args:
+        law: a single-task :class:`PajakLaw`.
+        q0: initial joint positions [rad], (6,); the arm starts at rest.
+        dt: step [s].
+        t_max: give up after this long [s].
+        settle_time: keep integrating this long after the finish [s].
+        raise_on_timeout: False returns what was computed up to t_max (T = nan) instead of
+            raising (to look at the start of a motion).
 
     Returns:
         dict of arrays: t (K,), q, qd, qdd (K, 6), c (K,), tcp (K, 6) pose, waypoint (K,),
-        saturated (K,) bool, discrete (K, DISCRETE_SIZE), and "T" (final time) and "error"
-        (final TCP position error [m]).
+        saturated (K,) bool, discrete (K, DISCRETE_SIZE); and T (finish time [s]), finish_index,
+        error (TCP position error at the finish [m]) and stage_peak (6,): max |q̈| over every
+        evaluation, RK4 stages included.
 
     Raises:
         PlanningError: singularity, no progress, non-finite values or not finished by t_max;
@@ -951,22 +890,28 @@ def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0) -> di
         raise ValueError(f"dt must be a positive number of seconds, got {dt}")
     if not np.isfinite(t_max) or t_max <= 0:
         raise ValueError(f"t_max must be a positive number of seconds, got {t_max}")
+    if not np.isfinite(settle_time) or settle_time < 0:
+        raise ValueError(f"settle_time must be a non-negative number of seconds, got {settle_time}")
     q = law._batch(robot._as_joint_vector(q0, "q0"), 6).copy()
     qd = np.zeros_like(q)
     d = law._batch(law.initial_discrete(), DISCRETE_SIZE)
     steps = int(math.ceil(t_max / dt))
-    log = {name: [] for name in ("t", "q", "qd", "qdd", "c", "tcp", "waypoint", "saturated", "discrete")}
+    names = ("t", "q", "qd", "qdd", "c", "tcp", "waypoint", "saturated", "discrete")
+    log = {name: [] for name in names}
+    peak = np.zeros(6)
 
     def partial():
         out = {k: np.array(v) for k, v in log.items()}
+        out["stage_peak"] = peak.copy()
         return out
 
     t = 0.0
-    for k in range(steps + 1):
+    finish_time = finish_index = final_error = None
+    for k in range(steps + int(math.ceil(settle_time / dt)) + 1):
         t = k * dt
         try:
             d, status, message = law._update(t, q, qd, d)
-            if status[0] < 0:
+            if status[0] < 0 and finish_time is None:
                 raise PlanningError(message[0], time=t, configuration=q[0], cause=_CAUSES[int(status[0])])
             ev = law._evaluate(t, q, qd, d)
             law._check(t, q[0], ev, 0)
@@ -977,82 +922,108 @@ def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0) -> di
             raise PlanningError(
                 f"numerical failure: {exc}", time=t, configuration=q[0], cause="non-finite", partial=partial()
             ) from exc
-        log["t"].append(t)
-        log["q"].append(q[0].copy())
-        log["qd"].append(qd[0].copy())
-        log["qdd"].append(ev.qdd[0].copy())
-        log["c"].append(float(ev.c[0]))
-        log["tcp"].append(ev.pose[0].copy())
-        log["waypoint"].append(int(d[0, WAYPOINT]))
-        log["saturated"].append(bool(ev.saturated[0]))
-        log["discrete"].append(d[0].copy())
-        if status[0] == 1:
-            out = partial()
-            out["T"] = t
-            out["error"] = float(np.linalg.norm(ev.pose[0, :3] - law.waypoints[0, law.num_waypoints[0] - 1, :3]))
-            return out
+        np.maximum(peak, np.abs(ev.qdd[0]), out=peak)
+        for name, value in zip(
+            names,
+            (t, q[0].copy(), qd[0].copy(), ev.qdd[0].copy(), float(ev.c[0]), ev.pose[0].copy(),
+             int(d[0, WAYPOINT]), bool(ev.saturated[0]), d[0].copy()),
+        ):
+            log[name].append(value)
+        if status[0] == 1 and finish_time is None:
+            finish_time = t
+            finish_index = len(log["t"]) - 1
+            final_error = float(np.linalg.norm(ev.pose[0, :3] - law.waypoints[0, law.num_waypoints[0] - 1, :3]))
+        if finish_time is not None and t >= finish_time + settle_time - 1e-12:
+            break
+        if finish_time is None and k >= steps:
+            if raise_on_timeout:
+                raise PlanningError(
+                    f"the task did not finish within t_max = {t_max} s", time=t, configuration=q[0],
+                    cause="timeout", partial=partial(),
+                )
+            break
         try:
-            q, qd = _rk4_step(law, t, q, qd, d, dt)
+            q, qd = _rk4_step(law, t, q, qd, d, dt, ev.qdd, peak)
         except (np.linalg.LinAlgError, FloatingPointError) as exc:
             raise PlanningError(
                 f"numerical failure: {exc}", time=t, configuration=q[0], cause="non-finite", partial=partial()
             ) from exc
-    raise PlanningError(
-        f"the task did not finish within t_max = {t_max} s", time=t, configuration=q[0], cause="timeout",
-        partial=partial(),
-    )
+    out = partial()
+    out["T"] = np.nan if finish_time is None else finish_time
+    out["finish_index"] = finish_index
+    out["error"] = np.nan if final_error is None else final_error
+    return out
 
 
 def integrate_many(law: PajakLaw, q0, *, dt: float = 2e-3, t_max: float = 30.0) -> list[dict]:
     """Integrate a batch of tasks at once (RK4, vectorised over tasks), without raising.
 
-    Each task stops (its state frozen) when it finishes or fails. Nothing is stored per sample;
-    the summary per task has: status ("finished" or a failure cause), message, T, error (final
-    TCP distance to p_w [m]), max_velocity_ratio = max |q̇|/q̇_max and max_acceleration_ratio =
-    max |q̈|/q̈_max over every evaluated sample (RK4 stages included), saturated (updates with
-    the fallback), nan (any non-finite value seen).
+    Each task stops when it finishes or fails; the batch is compacted to the running tasks as
+    they end. Nothing is stored per sample; the summary per task has: status ("finished" or
+    the failure cause), message, T, error (final TCP distance to p_w [m]), q (final), and
+    max_velocity_ratio = max |q̇|/q̇_max and max_acceleration_ratio = max |q̈|/q̈_max over every
+    evaluated sample (RK4 stages included), c_range (min, max of c over the same samples),
+    saturated (updates with the improvement-2 fallback), nan (a non-finite value was seen).
     """
     if law.single:
         raise ValueError("law must be a batch PajakLaw (built from a sequence of parameters)")
+    if not np.isfinite(dt) or dt <= 0:
+        raise ValueError(f"dt must be a positive number of seconds, got {dt}")
     q = np.array(q0, dtype=float)
     if q.shape != (law.count, 6):
         raise ValueError(f"q0 must have shape ({law.count}, 6), got {q.shape}")
+    parameters = list(law.parameters)
+    active = np.arange(law.count)  # original index of each row of the current batch
     qd = np.zeros_like(q)
     d = law.initial_discrete()
-    running = np.ones(law.count, dtype=bool)
-    result = [dict(status="timeout", message="", T=np.nan, error=np.nan, max_velocity_ratio=0.0,
-                   max_acceleration_ratio=0.0, saturated=0, nan=False) for _ in range(law.count)]
+    result = [
+        dict(status="timeout", message=f"the task did not finish within t_max = {t_max} s", T=np.nan,
+             error=np.nan, q=None, max_velocity_ratio=0.0, max_acceleration_ratio=0.0, saturated=0, nan=False)
+        for _ in range(law.count)
+    ]
     vel_ratio = np.zeros(law.count)
     acc_ratio = np.zeros(law.count)
     nan = np.zeros(law.count, dtype=bool)
+    c_min = np.full(law.count, np.inf)
+    c_max = np.full(law.count, -np.inf)
     steps = int(math.ceil(t_max / dt))
-    t = 0.0
+    current = law
 
     def stage(t_s, q_s, qd_s):
-        qdd = law._evaluate(t_s, q_s, qd_s, d).qdd
+        ev = current._evaluate(t_s, q_s, qd_s, d)
+        qdd = ev.qdd
+        c_min[active] = np.fmin(c_min[active], ev.c)
+        c_max[active] = np.fmax(c_max[active], ev.c)
         ok = np.all(np.isfinite(qdd), axis=1)
-        nan[running & ~ok] = True
-        ratio = np.max(np.abs(qdd) / law.qdd_max, axis=1)
-        acc_ratio[running] = np.maximum(acc_ratio[running], np.where(ok, ratio, np.inf)[running])
+        nan[active[~ok]] = True
+        ratio = np.max(np.abs(qdd) / current.qdd_max, axis=1)
+        acc_ratio[active] = np.maximum(acc_ratio[active], np.where(ok, ratio, np.inf))
         return np.where(ok[:, None], qdd, 0.0)
 
+    t = 0.0
     with np.errstate(all="ignore"):
         for k in range(steps + 1):
             t = k * dt
-            d_new, status, message = law._update(t, q, qd, d)
-            d = np.where(running[:, None], d_new, d)
-            vel_ratio[running] = np.maximum(vel_ratio[running], np.max(np.abs(qd) / law.qd_max, axis=1)[running])
-            for j in np.flatnonzero(running & (status != 0)):
-                pose, *_ = ur10e_kinematics(q[j], qd[j])
-                r = result[j]
-                r["status"] = "finished" if status[j] == 1 else _CAUSES[int(status[j])]
-                r["message"] = message[j]
-                r["T"] = t
-                r["error"] = float(np.linalg.norm(pose[:3] - law.waypoints[j, law.num_waypoints[j] - 1, :3]))
-                r["q"] = q[j].copy()
-                running[j] = False
-            if not running.any():
-                break
+            d, status, message = current._update(t, q, qd, d)
+            vel_ratio[active] = np.maximum(vel_ratio[active], np.max(np.abs(qd) / current.qd_max, axis=1))
+            ended = np.flatnonzero(status != 0)
+            if ended.size:
+                pose, *_ = robot.ur10e_kinematics(q[ended], qd[ended])
+                for row, j in enumerate(ended):
+                    r = result[active[j]]
+                    r["status"] = "finished" if status[j] == 1 else _CAUSES[int(status[j])]
+                    r["message"] = message[j]
+                    r["T"] = t
+                    goal = current.waypoints[j, current.num_waypoints[j] - 1, :3]
+                    r["error"] = float(np.linalg.norm(pose[row, :3] - goal))
+                    r["q"] = q[j].copy()
+                    r["saturated"] = int(d[j, SATURATED])
+                keep = status == 0
+                if not keep.any():
+                    active = active[keep]
+                    break
+                active, q, qd, d = active[keep], q[keep], qd[keep], d[keep]
+                current = PajakLaw([parameters[j] for j in active])
             h = 0.5 * dt
             k1a = stage(t, q, qd)
             k2v = qd + h * k1a
@@ -1061,17 +1032,75 @@ def integrate_many(law: PajakLaw, q0, *, dt: float = 2e-3, t_max: float = 30.0) 
             k3a = stage(t + h, q + h * k2v, k3v)
             k4v = qd + dt * k3a
             k4a = stage(t + dt, q + dt * k3v, k4v)
-            q_new = q + dt / 6.0 * (qd + 2 * k2v + 2 * k3v + k4v)
-            qd_new = qd + dt / 6.0 * (k1a + 2 * k2a + 2 * k3a + k4a)
-            q = np.where(running[:, None], q_new, q)
-            qd = np.where(running[:, None], qd_new, qd)
+            q = q + dt / 6.0 * (qd + 2 * k2v + 2 * k3v + k4v)
+            qd = qd + dt / 6.0 * (k1a + 2 * k2a + 2 * k3a + k4a)
+    for row, j in enumerate(active):  # still running at t_max
+        result[j]["T"] = t
+        result[j]["q"] = q[row].copy()
+        result[j]["saturated"] = int(d[row, SATURATED])
     for j in range(law.count):
-        r = result[j]
-        if running[j]:
-            r["message"] = f"the task did not finish within t_max = {t_max} s"
-            r["T"] = t
-        r["max_velocity_ratio"] = float(vel_ratio[j])
-        r["max_acceleration_ratio"] = float(acc_ratio[j])
-        r["saturated"] = int(d[j, SATURATED])
-        r["nan"] = bool(nan[j])
+        result[j]["max_velocity_ratio"] = float(vel_ratio[j])
+        result[j]["max_acceleration_ratio"] = float(acc_ratio[j])
+        result[j]["nan"] = bool(nan[j])
+        result[j]["c_range"] = (float(c_min[j]), float(c_max[j]))
     return result
+
+
+# --------------------------------------------------------------------------------------------
+# The planner system (DESIGN.md contract): a thin shell around PajakLaw.
+# --------------------------------------------------------------------------------------------
+
+
+class PajakPlanner(PlannerSystem):
+    """Seed 000's planner as a LeafSystem: continuous [q; q̇], discrete ``scaling`` [c, t0, c0]
+    and ``task`` (the rest of :data:`DISCRETE_NAMES`), updated every ``update_period``.
+
+    The acceleration (and c) are evaluated by :meth:`PajakLaw.acceleration` at every derivative
+    call, so the acceleration limit holds at every integrator stage, not only at updates. A
+    :class:`PlanningError` from the law ends the simulation; ``simulate`` keeps the log.
+    The ``speed_override`` input is not used by this planner (its clock is real time).
+
+    Args:
+        parameters: the task and the law's settings.
+        q_initial: joint positions at t = 0 [rad].
+        update_period: period of the discrete update (anchor, waypoint switching) [s].
+    """
+
+    def __init__(self, parameters: PajakParameters, q_initial, *, update_period: float = 1e-3):
+        if not np.isfinite(update_period) or update_period <= 0:
+            raise ValueError(f"update_period must be a positive number of seconds, got {update_period}")
+        self.law = PajakLaw(parameters)
+        initial = self.law.initial_discrete()
+        super().__init__(q_initial, initial_scaling=float(initial[C]))
+        self.task_state_index = self.DeclareDiscreteState(initial[C0 + 1 :])
+        self.velocity_limit = self.law.qd_max[0]
+        self.acceleration_limit = self.law.qdd_max[0]
+        self.DeclarePeriodicDiscreteUpdateEvent(update_period, 0.0, self._update)
+
+    def _law_arguments(self, context):
+        state = self.reference_state(context)
+        discrete = np.concatenate(
+            [
+                context.get_discrete_state(self.scaling_state_index).get_value(),
+                context.get_discrete_state(self.task_state_index).get_value(),
+            ]
+        )
+        return context.get_time(), state[: self.num_joints], state[self.num_joints :], discrete
+
+    def acceleration(self, context) -> np.ndarray:
+        return self.law.acceleration(*self._law_arguments(context))[0]
+
+    def scaling(self, context) -> float:
+        return float(self.law.acceleration(*self._law_arguments(context))[1])
+
+    def finished(self, context) -> bool:
+        _, q, qd, discrete = self._law_arguments(context)
+        return bool(self.law.finished(q, qd, discrete))
+
+    def task_waypoints(self) -> np.ndarray:
+        return self.law.parameters.waypoints[:, :3].copy()
+
+    def _update(self, context, discrete_state):
+        updated = self.law.update(*self._law_arguments(context))
+        discrete_state.get_mutable_vector(self.scaling_state_index).SetFromVector(updated[: C0 + 1])
+        discrete_state.get_mutable_vector(self.task_state_index).SetFromVector(updated[C0 + 1 :])
