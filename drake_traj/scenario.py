@@ -7,6 +7,7 @@ ValueError naming the file and the field.
 
 
 from dataclasses import dataclass, field
+from typing import Union
 from importlib import resources
 from pathlib import Path
 
@@ -34,12 +35,42 @@ class QuinticPtp:
 
 
 @dataclass
+class PajakTask:
+    """Seed 000's acceleration-level task-space planner (Pająk 2024) through task-space waypoints.
+
+    waypoints: rows [x, y, z, phi_X, phi_Y, phi_Z] [m, rad] in the base frame, the last is p_f.
+    Gains Λ_P [1/s^2], Λ_V [1/s], limits [rad/s, rad/s^2], accuracy ε and neighbourhood ϵ [m] as
+    in the paper; the improvement flags are those of
+    :class:`drake_traj.planners.pajak.PajakParameters` (all off: the paper's method).
+    """
+
+    waypoints: list[list[float]] = field(default_factory=list)
+    position_gain: float = 20.0
+    velocity_gain: float = 9.392
+    velocity_limit: float = robot.DEFAULT_JOINT_MOVE_VELOCITY
+    acceleration_limit: float = robot.DEFAULT_JOINT_MOVE_ACCELERATION
+    vartheta: float = 0.1
+    rho: float = 0.03
+    accuracy: float = 0.001
+    neighbourhood: float = 0.05
+    limit_velocity: bool = True
+    limit_acceleration: bool = True
+    blend_waypoints: bool = True
+    smooth_penalty: bool = True
+    continuous_switching: bool = True
+    bounded_scaling: bool = True
+    damped_inverse: bool = True
+    preserve_damping: bool = True
+    update_period: float = 0.001
+
+
+@dataclass
 class Scenario:
     """One experiment: start, planner, controller and simulation settings (times in seconds)."""
 
     name: str = "unnamed"
     q_initial: list[float] = field(default_factory=lambda: list(PAJAK_Q0))
-    planner: QuinticPtp = field(default_factory=QuinticPtp)
+    planner: Union[QuinticPtp, PajakTask] = field(default_factory=QuinticPtp)
     controller: ControllerGains = field(default_factory=ControllerGains)
     time_step: float = 0.001
     log_period: float = 0.001
@@ -69,7 +100,7 @@ class Scenario:
 
 def default_scenario_path() -> Path:
     """The scenario ``drake-traj run`` uses when none is given."""
-    return Path(str(resources.files("drake_traj.diagrams").joinpath("quintic_ptp.yaml")))
+    return Path(str(resources.files("drake_traj.diagrams").joinpath("pajak_sim3.yaml")))
 
 
 def load_scenario(path) -> Scenario:
@@ -90,10 +121,14 @@ def load_scenario(path) -> Scenario:
 
 def make_planner(scenario: Scenario):
     """The planner system the scenario describes (errors name the ``planner`` field)."""
+    from drake_traj.planners.pajak import PajakParameters, PajakPlanner
     from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
 
     config = scenario.planner
     try:
+        if isinstance(config, PajakTask):
+            settings = {name: value for name, value in vars(config).items() if name != "update_period"}
+            return PajakPlanner(PajakParameters(**settings), scenario.q_initial, update_period=config.update_period)
         plan = plan_synchronized_quintic(
             scenario.q_initial,
             config.goals,
@@ -102,6 +137,6 @@ def make_planner(scenario: Scenario):
             position_lower=-robot.POSITION_LIMIT,
             position_upper=robot.POSITION_LIMIT,
         )
+        return QuinticPtpPlanner(plan, config.velocity_limit, config.acceleration_limit)
     except ValueError as error:
         raise ValueError(f"scenario {scenario.name!r}, planner: {error}") from error
-    return QuinticPtpPlanner(plan, config.velocity_limit, config.acceleration_limit)

@@ -15,3 +15,11 @@ def quintic_run_dir(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("quintic_run")
     assert cli.main(["run", str(DIAGRAMS / "quintic_ptp.yaml"), "--out", str(out)]) == 0
     return out
+
+
+@pytest.fixture(scope="session")
+def default_run_dir(tmp_path_factory) -> Path:
+    """Output directory of ``drake-traj run --out DIR``: the default scenario, Pająk sim 3."""
+    out = tmp_path_factory.mktemp("default_run")
+    assert cli.main(["run", "--out", str(out)]) == 0
+    return out
