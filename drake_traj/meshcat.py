@@ -32,7 +32,7 @@ def export_html(meshcat: Meshcat, path) -> Path:
     workspace in front of it is in view.
     """
     path = Path(path)
-    meshcat.SetCameraPose(camera_in_world=[1.6, -1.6, 1.2], target_in_world=[0.0, 0.0, 0.4])
+    meshcat.SetCameraPose(camera_in_world=[0.9, -1.6, 1.1], target_in_world=[-0.1, -0.4, 0.45])
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(meshcat.StaticHtml())
     return path
