@@ -102,10 +102,10 @@ class PlannerFailingAt(QuinticPtpPlanner):
         super().__init__(*args, **kwargs)
         self.fail_time = fail_time
 
-    def acceleration(self, context):
+    def evaluate(self, context):
         if context.get_time() > self.fail_time:
             raise ValueError("singular configuration (test fault)")
-        return super().acceleration(context)
+        return super().evaluate(context)
 
 
 def test_a_run_that_fails_part_way_keeps_its_log_and_the_reason(tmp_path):

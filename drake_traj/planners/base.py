@@ -9,14 +9,16 @@ Every planner is a LeafSystem with
 - output ports ``desired_state`` [q; qd], ``desired_acceleration`` qdd and ``scaling`` c;
 - an optional input port ``speed_override`` (a value in [0, 1]; unconnected means 1).
 
-Subclasses implement :meth:`PlannerSystem.acceleration` (qdd from the context) and
-:meth:`PlannerSystem.finished`, and declare their own update events.
+Subclasses implement :meth:`PlannerSystem.evaluate` (qdd and c from the context) and
+:meth:`PlannerSystem.finished`, and declare their own update events. The evaluation is cached
+per context, so the derivatives and the output ports at one context share a single call.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from pydrake.systems.framework import BasicVector, LeafSystem
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import BasicVector, LeafSystem, ValueProducer
 
 from drake_traj import robot
 
@@ -43,15 +45,16 @@ class PlannerSystem(LeafSystem):
         self.DeclareVectorOutputPort("desired_state", 2 * n, self._calc_desired_state)
         self.DeclareVectorOutputPort("desired_acceleration", n, self._calc_desired_acceleration)
         self.DeclareVectorOutputPort("scaling", 1, self._calc_scaling_output)
+        self._evaluation = self.DeclareCacheEntry(
+            "reference acceleration and scaling [qdd; c]",
+            ValueProducer(allocate=AbstractValue.Make(BasicVector(n + 1)).Clone, calc=self._calc_evaluation),
+            {self.all_sources_ticket()},
+        )
 
     # --- to implement -------------------------------------------------------------------------
-    def acceleration(self, context) -> np.ndarray:
-        """Reference joint acceleration qdd [rad/s^2] at the context's time and state."""
+    def evaluate(self, context) -> tuple[np.ndarray, float]:
+        """(qdd [rad/s^2], c) of the reference at the context's time and state."""
         raise NotImplementedError
-
-    def scaling(self, context) -> float:
-        """The scaling coefficient c at the context's time (default: the stored value)."""
-        return float(context.get_discrete_state(self.scaling_state_index).get_value()[0])
 
     def finished(self, context) -> bool:
         """True once the planner's task is complete (used to stop the simulation)."""
@@ -78,6 +81,18 @@ class PlannerSystem(LeafSystem):
     def reference_state(self, context) -> np.ndarray:
         """[q; qd] of the reference, shape (12,)."""
         return context.get_continuous_state_vector().CopyToVector()
+
+    def acceleration(self, context) -> np.ndarray:
+        """Reference joint acceleration qdd [rad/s^2] (cached :meth:`evaluate`)."""
+        return self._evaluation.Eval(context).get_value()[: self.num_joints]
+
+    def scaling(self, context) -> float:
+        """The scaling coefficient c at the context's time (cached :meth:`evaluate`)."""
+        return float(self._evaluation.Eval(context).get_value()[self.num_joints])
+
+    def _calc_evaluation(self, context, value):
+        acceleration, scaling = self.evaluate(context)
+        value.get_mutable_value().SetFromVector(np.append(acceleration, scaling))
 
     def DoCalcTimeDerivatives(self, context, derivatives):
         qd = self.reference_state(context)[self.num_joints :]

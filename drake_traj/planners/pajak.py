@@ -818,7 +818,7 @@ class PajakLaw:
     def finished(self, q, qd, discrete):
         """True once the TCP is within ε of the final waypoint p_w and p_w is the active target."""
         q2, d2 = self._batch(q, 6), self._batch(discrete, DISCRETE_SIZE)
-        pose, *_ = robot.ur10e_kinematics(q2, np.zeros_like(q2))
+        pose, *_ = self._kinematics(q2, np.zeros_like(q2))  # the fast scalar path for one task
         i = d2[:, WAYPOINT].astype(int)
         last = i >= self.num_waypoints - 1
         distance = np.linalg.norm(pose[:, :3] - self.waypoints[self._rows, i, :3], axis=1)
@@ -1087,11 +1087,9 @@ class PajakPlanner(PlannerSystem):
         )
         return context.get_time(), state[: self.num_joints], state[self.num_joints :], discrete
 
-    def acceleration(self, context) -> np.ndarray:
-        return self.law.acceleration(*self._law_arguments(context))[0]
-
-    def scaling(self, context) -> float:
-        return float(self.law.acceleration(*self._law_arguments(context))[1])
+    def evaluate(self, context) -> tuple[np.ndarray, float]:
+        qdd, c = self.law.acceleration(*self._law_arguments(context))
+        return qdd, float(c)
 
     def finished(self, context) -> bool:
         _, q, qd, discrete = self._law_arguments(context)

@@ -618,13 +618,10 @@ class QuinticPtpPlanner(PlannerSystem):
         c, c_rate = relaxed_scaling(t, t0, c0, goal)
         return tau0 + scaled_clock(t, t0, c0, goal), float(c), float(c_rate)
 
-    def acceleration(self, context) -> np.ndarray:
+    def evaluate(self, context) -> tuple[np.ndarray, float]:
         tau, c, c_rate = self._clock(context)
         qd_plan, qdd_plan = self.plan.rates_at(tau)
-        return qdd_plan * c**2 + qd_plan * c_rate
-
-    def scaling(self, context) -> float:
-        return self._clock(context)[1]
+        return qdd_plan * c**2 + qd_plan * c_rate, c
 
     def finished(self, context) -> bool:
         return self._clock(context)[0] >= self.plan.duration
