@@ -1,0 +1,726 @@
+"""Velocity look-ahead and cubic ACC/DEC along a Cartesian polyline (seed 002, Li, Zhang, Zhou).
+
+Seed 002 (Li, Zhang, Zhou 2019: "Trajectory planning of high precision collaborative robots") plans
+the tool path in Cartesian space first, then re-times the joints and fits a quintic B-spline. This
+module is the Cartesian stage only (section 2):
+
+1. break-point velocity limits (eq. 1-7): how fast the tool may pass each point of the polyline
+   given how sharply the direction changes there;
+2. the look-ahead (eq. 8-10, Fig. 2): lower the limits until every pair of neighbours can be joined
+   with the average ACC/DEC acceleration A over the segment between them;
+3. the cubic ACC/DEC profile (eq. 11-13, Tables 1-2): the speed law along one straight segment, one
+   of seven cases;
+4. the whole path: the segment profiles laid end to end, sampled densely in time.
+
+Equation numbers in comments are the paper's. The OCR text has errors; the project ERRATA (seed 002)
+is followed and wins where they differ:
+
+- eq. 3 and 6 are indexed one off: the direction change at P_i is from P_{i-1}P_i to P_iP_{i+1};
+- eq. 4 is v_i = min{v_m, sqrt(a_m dl_i / K_i)} with dl_i = min{l_step, l_i} (sqrt(a_m R) on an
+  arc sampled with chords no longer than l_step);
+- eq. 8-10 and 13 use the average ACC/DEC acceleration A = (2/3) a_m of eq. 12, not a_m: the cubic
+  ramp's peak acceleration is 1.5 times its average, so with A = (2/3) a_m the peak is exactly a_m;
+- eq. 13: L_e = (2 V_m^2 - V_s^2 - V_e^2) / (2A), V_a = sqrt((2 A L + V_s^2 + V_e^2) / 2);
+- the seven cases and their times are the ERRATA's list (see :class:`AccDecCase`).
+
+Everything here is plain numpy; tests call the functions directly. Units: metres, seconds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import IntEnum
+
+import numpy as np
+
+__all__ = [
+    "AccDecCase",
+    "AccDecProfile",
+    "BreakPointGeometry",
+    "CartesianPlan",
+    "CartesianSample",
+    "acc_dec_profile",
+    "average_acceleration",
+    "break_point_geometry",
+    "break_point_limits",
+    "classify_acc_dec",
+    "forward_backward_pass",
+    "look_ahead",
+    "plan_cartesian_path",
+]
+
+# Relative tolerance of the ACC/DEC classification: a segment whose length is within this fraction
+# of the minimum length |V_e^2 - V_s^2| / (2A) is the pure ACC (II) or DEC (III) case, and start or
+# end speeds this little above V_m count as V_m. Covers the round-off of the look-ahead (eq. 9-10),
+# which leaves L and L_min equal to a few ulps.
+_RTOL = 1e-9
+
+
+# --------------------------------------------------------------------------------------------
+# Input validation helpers (messages always name the argument and the reason).
+# --------------------------------------------------------------------------------------------
+
+
+def _positive_scalar(value, name: str, unit: str) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be a real number [{unit}]: {exc}") from exc
+    if not np.isfinite(number):
+        raise ValueError(f"{name} must be finite [{unit}], got {number}")
+    if number <= 0.0:
+        raise ValueError(f"{name} must be > 0 [{unit}], got {number}")
+    return number
+
+
+def _nonnegative_scalar(value, name: str, unit: str) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be a real number [{unit}]: {exc}") from exc
+    if not np.isfinite(number):
+        raise ValueError(f"{name} must be finite [{unit}], got {number}")
+    if number < 0.0:
+        raise ValueError(f"{name} must be >= 0 [{unit}], got {number}")
+    return number
+
+
+def _vector(value, name: str, unit: str) -> np.ndarray:
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be an array of real numbers [{unit}]: {exc}") from exc
+    if array.ndim != 1:
+        raise ValueError(f"{name} must have shape (n,), got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        i = int(np.argmax(~np.isfinite(array)))
+        raise ValueError(f"{name}[{i}] must be finite [{unit}], got {array[i]}")
+    return array
+
+
+def _polyline(points) -> np.ndarray:
+    """``points`` as an (N, 3) float array of N >= 2 distinct, non-repeating points."""
+    try:
+        array = np.array(points, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"points must be an (N, 3) array of real numbers [m]: {exc}") from exc
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise ValueError(f"points must have shape (N, 3) [m], got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        i, j = (int(k) for k in np.argwhere(~np.isfinite(array))[0])
+        raise ValueError(f"points[{i}, {j}] must be finite [m], got {array[i, j]}")
+    if len(np.unique(array, axis=0)) < 2:
+        raise ValueError(
+            f"points must contain at least two distinct points, got {len(array)} point(s) and "
+            f"{len(np.unique(array, axis=0))} distinct"
+        )
+    repeated = np.all(array[1:] == array[:-1], axis=1)
+    if np.any(repeated):
+        i = int(np.argmax(repeated)) + 1
+        raise ValueError(
+            f"points[{i}] repeats points[{i - 1}] = {array[i].tolist()}: consecutive points must "
+            "differ (a zero-length segment has no direction)"
+        )
+    return array
+
+
+# --------------------------------------------------------------------------------------------
+# Break-point velocity limits (eq. 1-7).
+# --------------------------------------------------------------------------------------------
+
+
+def average_acceleration(a_max: float) -> float:
+    """Average ACC/DEC acceleration A = (2/3) a_m [m/s^2] (eq. 12).
+
+    The cubic ramp (eq. 11) has its peak acceleration at mid-ramp, 1.5 times its average, so a
+    ramp planned with A = (2/3) a_m peaks at exactly a_m.
+    """
+    return 2.0 / 3.0 * _positive_scalar(a_max, "a_max", "m/s^2")
+
+
+@dataclass(frozen=True)
+class BreakPointGeometry:
+    """Geometry of a polyline P_0 ... P_n at its break points.
+
+    Attributes:
+        lengths: l_i = |P_i - P_{i-1}| for i = 1..n [m], shape (n,); ``lengths[i - 1]`` is l_i.
+        directions: unit vectors of P_{i-1}P_i for i = 1..n [-], shape (n, 3).
+        direction_change: K_i = |u_{i+1} - u_i| (eq. 6, indices corrected) [-], shape (n + 1,),
+            in [0, 2]; K_0 = K_n = 0 (no incoming or outgoing direction at the ends).
+        curvature: K_i / dl_i [1/m], the discrete curvature seen by eq. 4, shape (n + 1,); 1/R at
+            the interior points of an arc of radius R sampled with equal chords (dl_i = chord);
+            0 at both ends and on straight runs.
+        step: dl_i = min{l_step, l_i} [m] (eq. 1), shape (n + 1,); dl_0 = 0.
+    """
+
+    lengths: np.ndarray
+    directions: np.ndarray
+    direction_change: np.ndarray
+    curvature: np.ndarray
+    step: np.ndarray
+
+
+def break_point_geometry(points, step_length: float | None = None) -> BreakPointGeometry:
+    """Segment lengths, directions and direction changes K_i of a polyline (eq. 1, 3, 6).
+
+    The velocity change at P_i (eq. 2-3) is |v_i| times the change of the direction cosines
+    (cos theta_x, cos theta_y, cos theta_z) from P_{i-1}P_i to P_iP_{i+1}; those cosines are the
+    components of the unit direction u, so K_i (eq. 6) = |u_{i+1} - u_i| = 2 sin(phi_i / 2) with
+    phi_i the turning angle. (The paper indexes eq. 3 and 6 one off; ERRATA.)
+
+    Args:
+        points: P_0 ... P_n [m], shape (n + 1, 3), n >= 1; consecutive points must differ.
+        step_length: l_step [m] of eq. 1, > 0, or None for no step cap (dl_i = l_i).
+
+    Returns:
+        :class:`BreakPointGeometry`.
+
+    Raises:
+        ValueError: wrong shape, non-finite values, fewer than two distinct points, a repeated
+            consecutive point, or a non-positive step length.
+    """
+    p = _polyline(points)
+    l_step = np.inf if step_length is None else _positive_scalar(step_length, "step_length", "m")
+    chords = np.diff(p, axis=0)
+    lengths = np.linalg.norm(chords, axis=1)  # l_i, i = 1..n
+    directions = chords / lengths[:, None]  # (cos theta_ix, cos theta_iy, cos theta_iz) (eq. 3)
+    n = len(lengths)
+    k = np.zeros(n + 1)
+    # eq. 6 (indices corrected): K_i from P_{i-1}P_i (directions[i - 1]) to P_iP_{i+1}
+    # (directions[i]), i = 1..n-1.
+    k[1:n] = np.linalg.norm(directions[1:] - directions[:-1], axis=1)
+    step = np.zeros(n + 1)
+    step[1:] = np.minimum(l_step, lengths)  # eq. 1: dl_i = min{l_step, l_i}
+    curvature = np.zeros(n + 1)
+    curvature[1:] = k[1:] / step[1:]
+    return BreakPointGeometry(lengths, directions, k, curvature, step)
+
+
+def break_point_limits(points, v_max: float, a_max: float, step_length: float | None = None):
+    """Maximum permissible speed v_i at each point of a polyline (eq. 4-7, corrected).
+
+    Passing P_i at speed v turns the velocity by dv_i = v K_i (eq. 2-3) while covering dl_i, i.e.
+    in dt_i = dl_i / v; eq. 1 asks dv_i / dt_i <= a_m, so (eq. 4, ERRATA)
+
+        v_i = min{v_m, sqrt(a_m dl_i / K_i)},    dl_i = min{l_step, l_i},
+
+    with v_i = v_m where the path is straight (K_i = 0) and v_0 = v_n = 0 (start and stop at rest).
+    On an arc of radius R sampled with equal chords no longer than l_step, v_i = min{v_m,
+    sqrt(a_m R)}. The sgn of eq. 4-5 is always +1 here (dl_i > 0); these are speeds. Eq. 7 takes
+    the maximum permissible value.
+
+    As in the paper, a sharp corner (even a full reversal, K_i = 2) gets a non-zero speed: the
+    turn is modelled as spread over dl_i, not as an instantaneous change of direction.
+
+    Args:
+        points: P_0 ... P_n [m], shape (n + 1, 3); consecutive points must differ.
+        v_max: v_m, maximum tool speed [m/s], > 0.
+        a_max: a_m, maximum tool acceleration [m/s^2], > 0.
+        step_length: l_step [m], > 0, or None (dl_i = l_i).
+
+    Returns:
+        v_i [m/s], shape (n + 1,).
+
+    Raises:
+        ValueError: as :func:`break_point_geometry`, or non-positive / non-finite limits.
+    """
+    v_m = _positive_scalar(v_max, "v_max", "m/s")
+    a_m = _positive_scalar(a_max, "a_max", "m/s^2")
+    geometry = break_point_geometry(points, step_length)
+    k = geometry.direction_change
+    limits = np.full(k.shape, v_m)
+    turning = k > 0.0
+    # eq. 4 (corrected): sqrt(a_m dl_i / K_i), capped by v_m; eq. 7 takes this maximum.
+    limits[turning] = np.minimum(v_m, np.sqrt(a_m * geometry.step[turning] / k[turning]))
+    limits[0] = 0.0  # eq. 1: v_0 = 0
+    limits[-1] = 0.0  # and v_n = 0: the tool stops at the end of the path
+    return limits
+
+
+# --------------------------------------------------------------------------------------------
+# The look-ahead (eq. 8-10, Fig. 2).
+# --------------------------------------------------------------------------------------------
+
+
+def _look_ahead_inputs(limits, lengths, a_max):
+    v = _vector(limits, "limits", "m/s")
+    lengths = _vector(lengths, "lengths", "m")
+    if v.size < 2:
+        raise ValueError(f"limits must have at least two entries (one segment), got {v.size}")
+    if lengths.shape != (v.size - 1,):
+        raise ValueError(
+            f"lengths must have shape ({v.size - 1},) (one per segment between the {v.size} "
+            f"limits), got shape {lengths.shape}"
+        )
+    if np.any(v < 0.0):
+        i = int(np.argmax(v < 0.0))
+        raise ValueError(f"limits[{i}] must be >= 0 [m/s], got {v[i]}")
+    if np.any(lengths <= 0.0):
+        i = int(np.argmax(lengths <= 0.0))
+        raise ValueError(f"lengths[{i}] must be > 0 [m], got {lengths[i]}")
+    return v, lengths, average_acceleration(a_max)
+
+
+def look_ahead(limits, lengths, a_max: float) -> np.ndarray:
+    """The paper's multi-pass velocity look-ahead (Fig. 2, eq. 8-10 with A = (2/3) a_m).
+
+    Walks i = 1..n. If the speeds of P_{i-1} and P_i cannot be joined over l_i, i.e.
+    l_imin = |v_i^2 - v_{i-1}^2| / (2A) > l_i (eq. 8), the larger one is lowered: v_i =
+    sqrt(2 A l_i + v_{i-1}^2) if v_i > v_{i-1} (eq. 9), then on to i + 1; else v_{i-1} =
+    sqrt(2 A l_i + v_i^2) (eq. 10), then back to i - 1, since the lowered v_{i-1} may now be
+    out of reach of v_{i-2}. Speeds are only lowered, each to the largest value its neighbour
+    allows, so the result is the largest speed vector under ``limits`` that meets eq. 8 everywhere:
+    the same as :func:`forward_backward_pass` (tested), but with up to O(n^2) steps.
+
+    A speed is lowered only when the new value is strictly smaller, so round-off in eq. 8 can
+    never make the walk cycle.
+
+    Args:
+        limits: upper bounds on the speed at P_0 ... P_n [m/s], >= 0, shape (n + 1,) (from
+            :func:`break_point_limits`: v_0 = v_n = 0).
+        lengths: l_1 ... l_n [m], > 0, shape (n,).
+        a_max: a_m [m/s^2], > 0; the look-ahead uses A = (2/3) a_m (eq. 12, ERRATA).
+
+    Returns:
+        The adjusted speeds [m/s], shape (n + 1,): v_i <= limits_i and
+        |v_i^2 - v_{i-1}^2| <= 2 A l_i (to round-off).
+    """
+    v, lengths, acc = _look_ahead_inputs(limits, lengths, a_max)
+    n = lengths.size
+    i = 1
+    while i <= n:
+        reach = 2.0 * acc * lengths[i - 1]
+        l_min_times_2a = abs(v[i] ** 2 - v[i - 1] ** 2)  # eq. 8, times 2A
+        if l_min_times_2a <= reach:
+            i += 1
+        elif v[i] > v[i - 1]:
+            v[i] = min(v[i], np.sqrt(reach + v[i - 1] ** 2))  # eq. 9
+            i += 1
+        else:
+            lowered = np.sqrt(reach + v[i] ** 2)  # eq. 10
+            if lowered < v[i - 1]:
+                v[i - 1] = lowered
+                i = max(i - 1, 1)  # step back: recheck P_{i-2} -> P_{i-1}
+            else:
+                i += 1
+    return v
+
+
+def forward_backward_pass(limits, lengths, a_max: float) -> np.ndarray:
+    """One forward and one backward pass of eq. 9 and 10 (A = (2/3) a_m).
+
+    Forward: v_i = min(v_i, sqrt(v_{i-1}^2 + 2 A l_i)); backward: v_{i-1} = min(v_{i-1},
+    sqrt(v_i^2 + 2 A l_i)). The reference the multi-pass :func:`look_ahead` is tested against,
+    and the O(n) way to get the same speeds. Arguments and result as :func:`look_ahead`.
+    """
+    v, lengths, acc = _look_ahead_inputs(limits, lengths, a_max)
+    reach = 2.0 * acc * lengths
+    for i in range(1, v.size):  # eq. 9
+        v[i] = min(v[i], np.sqrt(v[i - 1] ** 2 + reach[i - 1]))
+    for i in range(v.size - 1, 0, -1):  # eq. 10
+        v[i - 1] = min(v[i - 1], np.sqrt(v[i] ** 2 + reach[i - 1]))
+    return v
+
+
+# --------------------------------------------------------------------------------------------
+# The cubic ACC/DEC profile of one segment (eq. 11-13, Tables 1-2).
+# --------------------------------------------------------------------------------------------
+
+
+class AccDecCase(IntEnum):
+    """The seven velocity profiles of Fig. 3 / Table 1 (numbering and times per ERRATA).
+
+    With A = (2/3) a_m, L_min = |V_e^2 - V_s^2| / (2A) and L_e, V_a from eq. 13:
+
+    - I: uniform, V_s = V_e = V_m; T = L / V_m.
+    - II: accelerate only, V_s < V_e, L = L_min; T = (V_e - V_s) / A.
+    - III: decelerate only, V_s > V_e, L = L_min; T = (V_s - V_e) / A.
+    - IV: uniform then decelerate, V_s = V_m > V_e, L > L_e; T = (2AL + (V_m - V_e)^2) / (2 A V_m).
+    - V: accelerate then uniform, V_s < V_e = V_m, L > L_e; T = (2AL + (V_m - V_s)^2) / (2 A V_m).
+    - VI: accelerate to V_a < V_m then decelerate, L_min < L < L_e; T = (2 V_a - V_s - V_e) / A.
+    - VII: accelerate, uniform, decelerate, V_s, V_e < V_m, L >= L_e;
+      T = (2AL + (V_m - V_s)^2 + (V_m - V_e)^2) / (2 A V_m).
+
+    Every ramp peaks at a_m, so all cases but I reach a_m; I has zero acceleration.
+    """
+
+    I = 1  # noqa: E741 (the paper's roman numeral)
+    II = 2
+    III = 3
+    IV = 4
+    V = 5
+    VI = 6
+    VII = 7
+
+
+def _segment_inputs(length, v_start, v_end, v_max, a_max):
+    length = _positive_scalar(length, "length", "m")
+    v_m = _positive_scalar(v_max, "v_max", "m/s")
+    acc = average_acceleration(a_max)
+    v_s = _nonnegative_scalar(v_start, "v_start", "m/s")
+    v_e = _nonnegative_scalar(v_end, "v_end", "m/s")
+    for name, value in (("v_start", v_s), ("v_end", v_e)):
+        if value > v_m * (1.0 + _RTOL):
+            raise ValueError(f"{name} = {value} m/s must be <= v_max = {v_m} m/s")
+    v_s, v_e = min(v_s, v_m), min(v_e, v_m)
+    l_min = abs(v_e**2 - v_s**2) / (2.0 * acc)  # eq. 8 with A
+    if length < l_min * (1.0 - _RTOL):
+        raise ValueError(
+            f"length = {length} m is too short to change speed from v_start = {v_s} m/s to "
+            f"v_end = {v_e} m/s with average acceleration A = (2/3) a_max = {acc} m/s^2: it needs "
+            f"|v_end^2 - v_start^2| / (2A) = {l_min} m (eq. 8); run the look-ahead first"
+        )
+    return length, v_s, v_e, v_m, acc, l_min
+
+
+def _classify(length, v_s, v_e, v_m, acc, l_min) -> AccDecCase:
+    if v_s == v_m and v_e == v_m:
+        return AccDecCase.I
+    if length <= l_min * (1.0 + _RTOL):  # L = L_min: the whole segment is one ramp
+        return AccDecCase.II if v_e > v_s else AccDecCase.III
+    if v_s == v_m:
+        return AccDecCase.IV
+    if v_e == v_m:
+        return AccDecCase.V
+    l_e = (2.0 * v_m**2 - v_s**2 - v_e**2) / (2.0 * acc)  # eq. 13 (with A)
+    return AccDecCase.VI if length < l_e else AccDecCase.VII
+
+
+def classify_acc_dec(length, v_start, v_end, v_max, a_max) -> AccDecCase:
+    """Which of the seven ACC/DEC profiles (Table 1) a segment follows.
+
+    Args:
+        length: L [m], > 0.
+        v_start, v_end: V_s, V_e [m/s], in [0, v_max] (up to 1e-9 relative above v_max is clipped).
+        v_max: V_m [m/s], > 0.
+        a_max: a_m [m/s^2], > 0 (A = (2/3) a_m).
+
+    Returns:
+        :class:`AccDecCase`. A length within 1e-9 relative of L_min counts as L = L_min (II or III).
+
+    Raises:
+        ValueError: non-positive length or limits, negative or too-high speeds, or L < L_min.
+    """
+    return _classify(*_segment_inputs(length, v_start, v_end, v_max, a_max))
+
+
+def _smoothstep(tau):
+    """The shape of eq. 11 on tau = (t - T_0) / (T_1 - T_0) in [0, 1]: 3 tau^2 - 2 tau^3."""
+    return tau * tau * (3.0 - 2.0 * tau)
+
+
+def _evaluate(t, length, v_s, v_c, v_e, t_acc, t_uni, t_dec):
+    """s(t), v(t), a(t) of ramp (v_s -> v_c, t_acc) + uniform (v_c, t_uni) + ramp (v_c -> v_e, t_dec).
+
+    All arguments broadcast. t is the time since the segment start; it is clipped to [0, T]. The
+    deceleration ramp is evaluated backwards from the segment end, so s(T) = L exactly.
+    """
+    duration = t_acc + t_uni + t_dec
+    t = np.clip(t, 0.0, duration)
+    in_acc = t < t_acc
+    in_dec = t > t_acc + t_uni
+    # Acceleration ramp, eq. 11 with T_0 = 0, T_1 = t_acc:
+    # v = v_s + (v_c - v_s) S(tau), s = integral of v, a = (v_c - v_s) / t_acc * 6 tau (1 - tau).
+    tau = np.where(in_acc, t / np.where(t_acc > 0.0, t_acc, 1.0), 1.0)
+    dv1 = v_c - v_s
+    s_acc = v_s * t + dv1 * np.where(in_acc, t_acc, 0.0) * tau**3 * (1.0 - 0.5 * tau)
+    v_acc = v_s + dv1 * _smoothstep(tau)
+    a_acc = 6.0 * dv1 / np.where(t_acc > 0.0, t_acc, 1.0) * tau * (1.0 - tau)
+    # Uniform phase.
+    d_acc = 0.5 * (v_s + v_c) * t_acc
+    s_uni = d_acc + v_c * (t - t_acc)
+    # Deceleration ramp, seen backwards from the end: over the remaining time r = T - t it is an
+    # eq. 11 ramp from v_e up to v_c (S(1 - x) = 1 - S(x)), and s = L - (distance still to go).
+    r = duration - t
+    sigma = np.where(in_dec, r / np.where(t_dec > 0.0, t_dec, 1.0), 0.0)
+    dv2 = v_c - v_e
+    s_dec = length - (v_e * r + dv2 * np.where(in_dec, t_dec, 0.0) * sigma**3 * (1.0 - 0.5 * sigma))
+    v_dec = v_e + dv2 * _smoothstep(sigma)
+    a_dec = -6.0 * dv2 / np.where(t_dec > 0.0, t_dec, 1.0) * sigma * (1.0 - sigma)
+
+    s = np.where(in_acc, s_acc, np.where(in_dec, s_dec, s_uni))
+    v = np.where(in_acc, v_acc, np.where(in_dec, v_dec, v_c))
+    a = np.where(in_acc, a_acc, np.where(in_dec, a_dec, 0.0))
+    s = np.where(t >= duration, length, np.clip(s, 0.0, length))
+    v = np.where(t >= duration, v_e, v)
+    return s, v, a + 0.0
+
+
+@dataclass(frozen=True)
+class AccDecProfile:
+    """One segment's cubic ACC/DEC speed law (eq. 11): ramp up, cruise, ramp down.
+
+    Ramps follow eq. 11, v = V_0 + (V_1 - V_0)(3 tau^2 - 2 tau^3), whose acceleration
+    6 (V_1 - V_0) tau (1 - tau) / T_r is a smooth bell: zero at both ends, peak 1.5 times the
+    average at mid-ramp. Every ramp has average A = (2/3) a_m, so its peak is a_m. Speed and
+    acceleration are continuous, also between phases.
+
+    Attributes:
+        case: the profile (:class:`AccDecCase`).
+        length: L [m].
+        v_start, v_end: V_s, V_e [m/s].
+        v_cruise: the speed between the ramps [m/s]: V_m (I, IV, V, VII), V_a (VI), V_e (II) or
+            V_s (III).
+        v_max: V_m [m/s].
+        a_max: a_m [m/s^2] (peak of every ramp).
+        t_acc, t_uniform, t_dec: durations of the acceleration, uniform and deceleration phases
+            [s], each >= 0.
+    """
+
+    case: AccDecCase
+    length: float
+    v_start: float
+    v_end: float
+    v_cruise: float
+    v_max: float
+    a_max: float
+    t_acc: float
+    t_uniform: float
+    t_dec: float
+
+    @property
+    def duration(self) -> float:
+        """T = t_acc + t_uniform + t_dec [s] (Table 2)."""
+        return self.t_acc + self.t_uniform + self.t_dec
+
+    @property
+    def peak_acceleration(self) -> float:
+        """Largest |a(t)| [m/s^2]: 1.5 times the ramp average (the mid-ramp value), 0 in case I."""
+        peaks = [0.0]
+        if self.t_acc > 0.0:
+            peaks.append(1.5 * (self.v_cruise - self.v_start) / self.t_acc)
+        if self.t_dec > 0.0:
+            peaks.append(1.5 * (self.v_cruise - self.v_end) / self.t_dec)
+        return max(peaks)
+
+    def sample(self, t):
+        """Distance s [m], speed v [m/s] and tangential acceleration a [m/s^2] at time ``t``.
+
+        Args:
+            t: time since the segment start [s], scalar or array; clipped to [0, duration].
+
+        Returns:
+            (s, v, a), each with the shape of ``t``. s(0) = 0, s(T) = L exactly.
+        """
+        t = np.asarray(t, dtype=float)
+        s, v, a = _evaluate(
+            t, self.length, self.v_start, self.v_cruise, self.v_end,
+            self.t_acc, self.t_uniform, self.t_dec,
+        )
+        return s[()], v[()], a[()]
+
+
+def acc_dec_profile(length, v_start, v_end, v_max, a_max) -> AccDecProfile:
+    """The cubic ACC/DEC profile that covers ``length`` from V_s to V_e in minimum time.
+
+    Classifies the segment (Table 1, :func:`classify_acc_dec`) and sets the phases so that every
+    ramp has the average acceleration A = (2/3) a_m (eq. 12) and so peaks at a_m, and the total
+    time is Table 2's (ERRATA). Cases II and III (L = L_min to 1e-9) use T = 2 L / (V_s + V_e),
+    which equals (V_e - V_s) / A there and makes the distance covered exactly L.
+
+    Args:
+        length: L [m], > 0.
+        v_start, v_end: V_s, V_e [m/s], in [0, v_max].
+        v_max: V_m [m/s], > 0.
+        a_max: a_m [m/s^2], > 0.
+
+    Returns:
+        :class:`AccDecProfile`.
+
+    Raises:
+        ValueError: as :func:`classify_acc_dec`.
+    """
+    length, v_s, v_e, v_m, acc, l_min = inputs = _segment_inputs(
+        length, v_start, v_end, v_max, a_max
+    )
+    case = _classify(*inputs)
+    t_acc = t_uni = t_dec = 0.0
+    if case == AccDecCase.I:
+        v_c = v_m
+        t_uni = length / v_m  # Table 2, I: L / V_m
+    elif case in (AccDecCase.II, AccDecCase.III):
+        # Table 2, II / III: |V_e - V_s| / A; written as 2 L / (V_s + V_e) (equal when L = L_min)
+        # so the ramp covers L exactly.
+        ramp = 2.0 * length / (v_s + v_e)
+        if case == AccDecCase.II:
+            v_c, t_acc = v_e, ramp
+        else:
+            v_c, t_dec = v_s, ramp
+    else:
+        if case == AccDecCase.VI:
+            v_c = np.sqrt((2.0 * acc * length + v_s**2 + v_e**2) / 2.0)  # eq. 13, V_a
+            v_c = float(min(max(v_c, v_s, v_e), v_m))
+        else:  # IV, V, VII reach V_m
+            v_c = v_m
+        t_acc = (v_c - v_s) / acc
+        t_dec = (v_c - v_e) / acc
+        d_ramps = (v_c**2 - v_s**2 + v_c**2 - v_e**2) / (2.0 * acc)
+        # Table 2, IV / V / VII: the cruise covers what the ramps leave; VI has none (L = d_ramps).
+        t_uni = max(length - d_ramps, 0.0) / v_c if case != AccDecCase.VI else 0.0
+    return AccDecProfile(
+        case=case, length=length, v_start=v_s, v_end=v_e, v_cruise=float(v_c), v_max=v_m,
+        a_max=float(a_max), t_acc=float(t_acc), t_uniform=float(t_uni), t_dec=float(t_dec),
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# The whole path.
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class CartesianSample:
+    """Tool state along the path at sample times (all arrays share the first dimension N).
+
+    Attributes:
+        t: times [s], shape (N,).
+        s: arc length travelled along the polyline [m], shape (N,).
+        position: tool position [m], shape (N, 3).
+        speed: path speed ds/dt [m/s], shape (N,).
+        acceleration: tangential acceleration d^2s/dt^2 [m/s^2], shape (N,).
+        segment: index k of the segment P_k P_{k+1} each sample lies on, shape (N,).
+    """
+
+    t: np.ndarray
+    s: np.ndarray
+    position: np.ndarray
+    speed: np.ndarray
+    acceleration: np.ndarray
+    segment: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class CartesianPlan:
+    """The Cartesian time law of seed 002 section 2: a polyline with one ACC/DEC law per segment.
+
+    Built by :func:`plan_cartesian_path`. Segment k runs from P_k to P_{k+1}, from time
+    ``t_starts[k]`` for ``profiles[k].duration``, from speed ``velocities[k]`` to
+    ``velocities[k + 1]``; speeds and tangential accelerations are continuous at the joints.
+    The tool moves straight between points, so at a break point the velocity direction turns
+    at once (the paper's model: eq. 1 bounds that turn by a_m over dl_i).
+
+    Attributes:
+        points: P_0 ... P_n [m], shape (n + 1, 3).
+        limits: break-point limits from eq. 4-7 [m/s], shape (n + 1,).
+        velocities: speeds after the look-ahead (Fig. 2) [m/s], shape (n + 1,).
+        profiles: one :class:`AccDecProfile` per segment, length n.
+        t_starts: start time of each segment [s], shape (n,).
+    """
+
+    points: np.ndarray
+    limits: np.ndarray
+    velocities: np.ndarray
+    profiles: tuple[AccDecProfile, ...]
+    t_starts: np.ndarray
+    _table: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        table = np.array(
+            [
+                (p.length, p.v_start, p.v_cruise, p.v_end, p.t_acc, p.t_uniform, p.t_dec)
+                for p in self.profiles
+            ]
+        )
+        object.__setattr__(self, "_table", table)
+        for name in ("points", "limits", "velocities", "t_starts"):
+            array = np.array(getattr(self, name), dtype=float)
+            array.setflags(write=False)
+            object.__setattr__(self, name, array)
+        object.__setattr__(self, "profiles", tuple(self.profiles))
+
+    @property
+    def lengths(self) -> np.ndarray:
+        """l_1 ... l_n [m], shape (n,)."""
+        return self._table[:, 0]
+
+    @property
+    def cumulative_length(self) -> np.ndarray:
+        """Arc length at P_0 ... P_n [m], shape (n + 1,)."""
+        return np.concatenate([[0.0], np.cumsum(self.lengths)])
+
+    @property
+    def segment_times(self) -> np.ndarray:
+        """Time at P_0 ... P_n [s], shape (n + 1,)."""
+        return np.append(self.t_starts, self.duration)
+
+    @property
+    def duration(self) -> float:
+        """Total motion time [s]."""
+        return float(self.t_starts[-1] + self.profiles[-1].duration)
+
+    @property
+    def cases(self) -> np.ndarray:
+        """The :class:`AccDecCase` number of each segment, shape (n,)."""
+        return np.array([int(p.case) for p in self.profiles])
+
+    def sample(self, t) -> CartesianSample:
+        """Tool position, path speed and tangential acceleration at times ``t``.
+
+        At a segment joint the segment that starts there is used (the values agree: the speed is
+        the shared break-point speed and the acceleration is zero). Times are clipped to
+        [0, duration]: at rest at P_0 before, at P_n after.
+
+        Args:
+            t: times [s], scalar or 1-D array, finite.
+
+        Returns:
+            :class:`CartesianSample` with N = t.size.
+        """
+        times = np.atleast_1d(np.asarray(t, dtype=float))
+        if times.ndim != 1:
+            raise ValueError(f"t must be a scalar or have shape (N,), got shape {times.shape}")
+        if not np.all(np.isfinite(times)):
+            raise ValueError("t must be finite [s]")
+        times = np.clip(times, 0.0, self.duration)
+        k = np.clip(np.searchsorted(self.t_starts, times, side="right") - 1, 0, len(self.profiles) - 1)
+        length, v_s, v_c, v_e, t_acc, t_uni, t_dec = self._table[k].T
+        local = times - self.t_starts[k]
+        # The plan's end time maps to the last profile's own end (no round-off in the subtraction).
+        local = np.where(times >= self.duration, t_acc + t_uni + t_dec, local)
+        s_local, speed, acceleration = _evaluate(
+            local, length, v_s, v_c, v_e, t_acc, t_uni, t_dec
+        )
+        directions = np.diff(self.points, axis=0) / self.lengths[:, None]
+        position = self.points[k] + s_local[:, None] * directions[k]
+        s = self.cumulative_length[k] + s_local
+        return CartesianSample(times, s, position, speed, acceleration, k)
+
+    def sample_uniform(self, period: float) -> CartesianSample:
+        """Dense samples every ``period`` seconds from 0, plus the final time [s]."""
+        dt = _positive_scalar(period, "period", "s")
+        times = np.arange(0.0, self.duration, dt)
+        return self.sample(np.append(times, self.duration))
+
+
+def plan_cartesian_path(
+    points, v_max: float, a_max: float, step_length: float | None = None
+) -> CartesianPlan:
+    """Seed 002's Cartesian stage: limits (eq. 4-7), look-ahead (Fig. 2), ACC/DEC (eq. 11-13).
+
+    The tool starts and stops at rest, moves straight from point to point, never exceeds v_max,
+    and its tangential acceleration peaks at a_max on every ramp (average A = (2/3) a_max).
+
+    Args:
+        points: P_0 ... P_n [m], shape (n + 1, 3), n >= 1; consecutive points must differ.
+        v_max: v_m [m/s], > 0.
+        a_max: a_m [m/s^2], > 0.
+        step_length: l_step of eq. 1 [m], > 0, or None (dl_i = l_i).
+
+    Returns:
+        :class:`CartesianPlan`.
+
+    Raises:
+        ValueError: fewer than two distinct points, repeated consecutive points, wrong shapes,
+            non-finite values or non-positive limits; the message names the argument and reason.
+    """
+    p = _polyline(points)
+    limits = break_point_limits(p, v_max, a_max, step_length)
+    lengths = np.linalg.norm(np.diff(p, axis=0), axis=1)
+    velocities = look_ahead(limits, lengths, a_max)
+    profiles = tuple(
+        acc_dec_profile(lengths[k], velocities[k], velocities[k + 1], v_max, a_max)
+        for k in range(lengths.size)
+    )
+    durations = np.array([profile.duration for profile in profiles])
+    t_starts = np.concatenate([[0.0], np.cumsum(durations)[:-1]])
+    return CartesianPlan(p, limits, velocities, profiles, t_starts)
