@@ -42,6 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drake_traj.validation import finite_array, positive_scalar
+
 __all__ = [
     "PHASES",
     "LoopGeometry",
@@ -68,32 +70,6 @@ PHASES = ("BM", "MT1", "arc", "T2M", "ME")
 # --------------------------------------------------------------------------------------------
 # Input validation helpers (messages always name the argument and the reason).
 # --------------------------------------------------------------------------------------------
-
-
-def _point(value, name: str) -> np.ndarray:
-    """A 3-vector [m] as a float array (copy), or ValueError naming ``name``."""
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a 3-vector of real numbers [m]: {exc}") from exc
-    if array.shape != (3,):
-        raise ValueError(f"{name} must have shape (3,) [m], got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be finite, got {array}")
-    return array
-
-
-def _positive_scalar(value, name: str, unit: str) -> float:
-    """A finite scalar > 0, or ValueError naming ``name``."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a real number [{unit}]: {exc}") from exc
-    if not np.isfinite(number):
-        raise ValueError(f"{name} must be finite [{unit}], got {number}")
-    if number <= 0.0:
-        raise ValueError(f"{name} must be > 0 [{unit}], got {number}")
-    return number
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:
@@ -175,8 +151,8 @@ def poly7_timing(delta_s, v_max) -> tuple[float, float]:
     Returns:
         (t_f [s], p [m/s^9]).
     """
-    delta_s = _positive_scalar(delta_s, "delta_s", "m")
-    v_max = _positive_scalar(v_max, "v_max", "m/s")
+    delta_s = positive_scalar(delta_s, "delta_s", "m")
+    v_max = positive_scalar(v_max, "v_max", "m/s")
     t_f = 10080.0 / 6144.0 * delta_s / v_max  # eq. 6, second row divided by the first
     p = 10080.0 * delta_s / t_f**9  # eq. 6, second row
     return t_f, p
@@ -300,9 +276,9 @@ def loop_geometry(B, M, E, delta=None, radius=None) -> LoopGeometry:
             collinear (no corner to loop through); neither or a non-positive/non-finite delta or
             radius; delta and radius given together that do not fit the corner.
     """
-    B = _point(B, "B")
-    M = _point(M, "M")
-    E = _point(E, "E")
+    B = finite_array(B, "B", "m", shape=(3,))
+    M = finite_array(M, "M", "m", shape=(3,))
+    E = finite_array(E, "E", "m", shape=(3,))
     a = M - B
     d = M - E
     norm_a = float(np.linalg.norm(a))
@@ -335,9 +311,9 @@ def loop_geometry(B, M, E, delta=None, radius=None) -> LoopGeometry:
             "delta or radius must be given (Delta [m] or R [m] of the loop), got neither"
         )
     if delta is not None:
-        delta = _positive_scalar(delta, "delta", "m")
+        delta = positive_scalar(delta, "delta", "m")
     if radius is not None:
-        radius = _positive_scalar(radius, "radius", "m")
+        radius = positive_scalar(radius, "radius", "m")
         delta_from_radius = radius / half_sin  # section 2.2: Delta from R and the half angle BME
         if delta is None:
             delta = delta_from_radius
@@ -472,7 +448,7 @@ def loop_time_law(geometry: LoopGeometry, v_max) -> LoopTimeLaw:
         raise ValueError(
             f"geometry must be a LoopGeometry (from loop_geometry), got {type(geometry).__name__}"
         )
-    v_max = _positive_scalar(v_max, "v_max", "m/s")
+    v_max = positive_scalar(v_max, "v_max", "m/s")
     g = geometry
     t_BM = 105.0 / 64.0 * g.ds_BM / v_max  # eq. 7
     t_MT1 = g.ds_MT1 / v_max  # eq. 8

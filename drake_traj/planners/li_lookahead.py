@@ -33,6 +33,8 @@ from enum import IntEnum
 
 import numpy as np
 
+from drake_traj.validation import finite_array, nonnegative_scalar, positive_scalar
+
 __all__ = [
     "AccDecCase",
     "AccDecProfile",
@@ -61,40 +63,10 @@ _RTOL = 1e-9
 # --------------------------------------------------------------------------------------------
 
 
-def _positive_scalar(value, name: str, unit: str) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a real number [{unit}]: {exc}") from exc
-    if not np.isfinite(number):
-        raise ValueError(f"{name} must be finite [{unit}], got {number}")
-    if number <= 0.0:
-        raise ValueError(f"{name} must be > 0 [{unit}], got {number}")
-    return number
-
-
-def _nonnegative_scalar(value, name: str, unit: str) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a real number [{unit}]: {exc}") from exc
-    if not np.isfinite(number):
-        raise ValueError(f"{name} must be finite [{unit}], got {number}")
-    if number < 0.0:
-        raise ValueError(f"{name} must be >= 0 [{unit}], got {number}")
-    return number
-
-
 def _vector(value, name: str, unit: str) -> np.ndarray:
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be an array of real numbers [{unit}]: {exc}") from exc
+    array = finite_array(value, name, unit)
     if array.ndim != 1:
         raise ValueError(f"{name} must have shape (n,), got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
-        i = int(np.argmax(~np.isfinite(array)))
-        raise ValueError(f"{name}[{i}] must be finite [{unit}], got {array[i]}")
     return array
 
 
@@ -135,7 +107,7 @@ def average_acceleration(a_max: float) -> float:
     The cubic ramp (eq. 11) has its peak acceleration at mid-ramp, 1.5 times its average, so a
     ramp planned with A = (2/3) a_m peaks at exactly a_m.
     """
-    return 2.0 / 3.0 * _positive_scalar(a_max, "a_max", "m/s^2")
+    return 2.0 / 3.0 * positive_scalar(a_max, "a_max", "m/s^2")
 
 
 @dataclass(frozen=True)
@@ -180,7 +152,7 @@ def break_point_geometry(points, step_length: float | None = None) -> BreakPoint
             consecutive point, or a non-positive step length.
     """
     p = _polyline(points)
-    l_step = np.inf if step_length is None else _positive_scalar(step_length, "step_length", "m")
+    l_step = np.inf if step_length is None else positive_scalar(step_length, "step_length", "m")
     chords = np.diff(p, axis=0)
     lengths = np.linalg.norm(chords, axis=1)  # l_i, i = 1..n
     directions = chords / lengths[:, None]  # (cos theta_ix, cos theta_iy, cos theta_iz) (eq. 3)
@@ -224,8 +196,8 @@ def break_point_limits(points, v_max: float, a_max: float, step_length: float | 
     Raises:
         ValueError: as :func:`break_point_geometry`, or non-positive / non-finite limits.
     """
-    v_m = _positive_scalar(v_max, "v_max", "m/s")
-    a_m = _positive_scalar(a_max, "a_max", "m/s^2")
+    v_m = positive_scalar(v_max, "v_max", "m/s")
+    a_m = positive_scalar(a_max, "a_max", "m/s^2")
     geometry = break_point_geometry(points, step_length)
     k = geometry.direction_change
     limits = np.full(k.shape, v_m)
@@ -354,11 +326,11 @@ class AccDecCase(IntEnum):
 
 
 def _segment_inputs(length, v_start, v_end, v_max, a_max):
-    length = _positive_scalar(length, "length", "m")
-    v_m = _positive_scalar(v_max, "v_max", "m/s")
+    length = positive_scalar(length, "length", "m")
+    v_m = positive_scalar(v_max, "v_max", "m/s")
     acc = average_acceleration(a_max)
-    v_s = _nonnegative_scalar(v_start, "v_start", "m/s")
-    v_e = _nonnegative_scalar(v_end, "v_end", "m/s")
+    v_s = nonnegative_scalar(v_start, "v_start", "m/s")
+    v_e = nonnegative_scalar(v_end, "v_end", "m/s")
     for name, value in (("v_start", v_s), ("v_end", v_e)):
         if value > v_m * (1.0 + _RTOL):
             raise ValueError(f"{name} = {value} m/s must be <= v_max = {v_m} m/s")
@@ -687,7 +659,7 @@ class CartesianPlan:
 
     def sample_uniform(self, period: float) -> CartesianSample:
         """Dense samples every ``period`` seconds from 0, plus the final time [s]."""
-        dt = _positive_scalar(period, "period", "s")
+        dt = positive_scalar(period, "period", "s")
         times = np.arange(0.0, self.duration, dt)
         return self.sample(np.append(times, self.duration))
 
