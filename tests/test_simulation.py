@@ -57,11 +57,11 @@ def test_log_grid_is_uniform_at_one_millisecond(quintic_result):
 
 def test_reference_follows_the_closed_form_plan(quintic_result, quintic_planner):
     # Independent of the Simulator: the plan's closed-form q(t), qd(t), qdd(t) on the log grid.
-    q, qd, qdd = quintic_planner.plan.sample(quintic_result.t)
+    q, qd, qdd = quintic_planner.law.sample(quintic_result.t)
     np.testing.assert_allclose(quintic_result.q_ref, q, atol=1e-6)
     np.testing.assert_allclose(quintic_result.qd_ref, qd, atol=1e-6)
     np.testing.assert_allclose(quintic_result.qdd_ref, qdd, atol=1e-9)
-    assert quintic_result.duration == pytest.approx(quintic_planner.plan.duration, abs=1e-3)
+    assert quintic_result.duration == pytest.approx(quintic_planner.law.duration, abs=1e-3)
 
 
 def test_limits_hold_at_every_logged_sample(quintic_result):
@@ -79,7 +79,7 @@ def test_pd_loop_tracks_the_reference(quintic_result, quintic_planner):
     # Measured on this scenario: 3.5e-5 rad and 3.2e-5 m with inverse-dynamics feed-forward.
     assert metrics["tracking_error_joint_max_rad"] < 5e-5
     assert metrics["tracking_error_tcp_max_m"] < 5e-5
-    np.testing.assert_allclose(quintic_result.q_meas[-1], quintic_planner.plan.q_goal, atol=1e-5)
+    np.testing.assert_allclose(quintic_result.q_meas[-1], quintic_planner.law.q_goal, atol=1e-5)
     np.testing.assert_allclose(quintic_result.qd_meas[-1], 0.0, atol=1e-5)
 
 
@@ -109,7 +109,7 @@ class PlannerFailingAt(QuinticPtpPlanner):
 
 
 def test_a_run_that_fails_part_way_keeps_its_log_and_the_reason(tmp_path):
-    plan = short_move().plan
+    plan = short_move().law
     result = simulate(PlannerFailingAt(0.4, plan, 1.05, 1.40))
     assert not result.succeeded
     assert "singular configuration (test fault)" in result.failure and "t = 0.4" in result.failure
@@ -139,7 +139,7 @@ def test_speed_override_slows_the_clock_and_keeps_velocity_continuous():
     c = planner.GetOutputPort("scaling").Eval(context)[0]
     assert c == pytest.approx(0.5 * np.exp(-1.0) + 0.5, rel=1e-9)
     tau = 0.5 * 1.0 + 0.5 * (1 - np.exp(-1.0))
-    q, qd, _ = planner.plan.sample(tau)
+    q, qd, _ = planner.law.sample(tau)
     state = planner.GetOutputPort("desired_state").Eval(context)
     np.testing.assert_allclose(state[:6], q, atol=1e-7)
     np.testing.assert_allclose(state[6:], qd * c, atol=1e-7)

@@ -20,21 +20,23 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem, ValueProducer
 
-from drake_traj import robot
+from drake_traj.planners.scaling import relaxed_scaling, scaled_clock
 
 
 class PlannerSystem(LeafSystem):
     """Base of all planners: state layout, ports and the speed-override input.
 
     Args:
-        q_initial: joint positions at t = 0 [rad], shape (6,); the reference starts at rest.
+        q_initial: joint positions at t = 0 [rad or m], shape (n,); the reference starts at rest.
         initial_scaling: c at t = 0 (eq. 18 anchor c0 with t0 = 0).
     """
 
     def __init__(self, q_initial, *, initial_scaling: float = 1.0):
         super().__init__()
-        n = robot.NUM_JOINTS
-        q_initial = robot._as_joint_vector(q_initial, "q_initial")
+        q_initial = np.array(q_initial, dtype=float)
+        if q_initial.ndim != 1 or not len(q_initial) or not np.all(np.isfinite(q_initial)):
+            raise ValueError(f"q_initial must be a non-empty vector of finite joint positions, got {q_initial}")
+        n = len(q_initial)
         self.num_joints = n
         self._q_initial = q_initial
         self.DeclareContinuousState(BasicVector(np.concatenate([q_initial, np.zeros(n)])), n, n, 0)
@@ -106,3 +108,65 @@ class PlannerSystem(LeafSystem):
 
     def _calc_scaling_output(self, context, output):
         output.SetAtIndex(0, self.scaling(context))
+
+
+class TimeLawPlanner(PlannerSystem):
+    """A planner that follows a closed-form joint time law on a scaled planner clock.
+
+    ``law`` provides ``q_start`` (n,), ``duration`` [s] and ``rates_at(tau) -> (qd, qdd)``, the
+    law's joint velocity and acceleration at law time tau. The clock tau advances at the scaling
+    rate c: with c = 1 the reference is the law itself. c starts at ``speed_cap`` and its goal is
+    ``speed_cap`` times the ``speed_override`` input (sampled every ``update_period``); c relaxes
+    towards the goal by eq. 18 of seed 000, so tau, c and dc/dt have closed forms and the reference
+    stays C^1 in velocity: qd = q_law'(tau) c and qdd = q_law''(tau) c^2 + q_law'(tau) dc/dt.
+    With c held at a constant value, velocity scales by c and acceleration by c^2, so a law that
+    breaks limits by a factor can be slowed into them with ``speed_cap`` < 1. While c changes,
+    |qdd| may exceed the law's peak c^2 |q_law''| by up to |q_law'| |dc/dt|.
+
+    Discrete state: ``scaling`` = [c, t0, c0] and ``clock`` = [tau at t0, goal of c].
+
+    Args:
+        law: the time law (see above).
+        velocity_limit, acceleration_limit: the limits the reference promises, per joint.
+        speed_cap: the largest clock rate c, in (0, 1].
+        update_period: how often the speed override is read [s].
+    """
+
+    def __init__(self, law, velocity_limit, acceleration_limit, *, speed_cap: float = 1.0, update_period: float = 0.01):
+        if not np.isfinite(speed_cap) or not 0.0 < speed_cap <= 1.0:
+            raise ValueError(f"speed_cap must be in (0, 1], got {speed_cap}")
+        if not np.isfinite(update_period) or update_period <= 0:
+            raise ValueError(f"update_period must be a positive number of seconds, got {update_period}")
+        super().__init__(law.q_start, initial_scaling=speed_cap)
+        self.law = law
+        self.speed_cap = float(speed_cap)
+        self.velocity_limit = np.asarray(velocity_limit, dtype=float)
+        self.acceleration_limit = np.asarray(acceleration_limit, dtype=float)
+        self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, speed_cap]))
+        self.DeclarePeriodicDiscreteUpdateEvent(update_period, 0.0, self._read_speed_override)
+
+    def _clock(self, context):
+        """(tau [s], c, dc/dt [1/s]) at the context's time."""
+        _, t0, c0 = context.get_discrete_state(self.scaling_state_index).get_value()
+        tau0, goal = context.get_discrete_state(self.clock_state_index).get_value()
+        t = context.get_time()
+        c, c_rate = relaxed_scaling(t, t0, c0, goal)
+        return tau0 + scaled_clock(t, t0, c0, goal), float(c), float(c_rate)
+
+    def evaluate(self, context) -> tuple[np.ndarray, float]:
+        tau, c, c_rate = self._clock(context)
+        qd_law, qdd_law = self.law.rates_at(tau)
+        return qdd_law * c**2 + qd_law * c_rate, c
+
+    def finished(self, context) -> bool:
+        return self._clock(context)[0] >= self.law.duration
+
+    def _read_speed_override(self, context, discrete_state):
+        goal = self.speed_cap * self.speed_override(context)
+        tau, c, _ = self._clock(context)
+        scaling = discrete_state.get_mutable_vector(self.scaling_state_index)
+        if goal != context.get_discrete_state(self.clock_state_index).get_value()[1]:
+            scaling.SetFromVector([c, context.get_time(), c])  # new eq. 18 anchor (t0, c0)
+            discrete_state.get_mutable_vector(self.clock_state_index).SetFromVector([tau, goal])
+        else:
+            scaling.SetAtIndex(0, c)

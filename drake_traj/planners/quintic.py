@@ -25,8 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from drake_traj import robot
-from drake_traj.planners.base import PlannerSystem
-from drake_traj.planners.scaling import relaxed_scaling, scaled_clock
+from drake_traj.planners.base import TimeLawPlanner
 
 __all__ = [
     "QuinticPlan",
@@ -580,19 +579,9 @@ def plan_synchronized_quintic(
     return QuinticPlan(tuple(segments))
 
 
-class QuinticPtpPlanner(PlannerSystem):
-    """Planner system for a :class:`QuinticPlan` under the planner contract.
-
-    The plan is followed on a planner clock tau that advances at the scaling rate c: with
-    c = 1 the reference is the plan itself. A ``speed_override`` input (sampled every
-    ``update_period``) sets the goal of c, which relaxes towards it by eq. 18 of seed 000, so
-    tau, c and dc/dt have closed forms and the reference stays C^1 in velocity:
-    qd = q_plan'(tau) c and qdd = q_plan''(tau) c^2 + q_plan'(tau) dc/dt.
-    With c held at any constant value <= 1 the plan's limits hold (velocity scales by c,
-    acceleration by c^2); while c is changing, |qdd| may exceed the plan's peak by up to
-    |q_plan'| |dc/dt| (at most v_max |goal - c| per second at the paper's rate of 1/s).
-
-    Discrete state: ``scaling`` = [c, t0, c0] and ``clock`` = [tau at t0, goal of c].
+class QuinticPtpPlanner(TimeLawPlanner):
+    """Planner system for a :class:`QuinticPlan`: a :class:`TimeLawPlanner` whose waypoints are
+    the flange positions at the joint goals.
 
     Args:
         plan: the joint-space plan (from :func:`plan_synchronized_quintic`).
@@ -601,41 +590,13 @@ class QuinticPtpPlanner(PlannerSystem):
     """
 
     def __init__(self, plan: QuinticPlan, velocity_limit, acceleration_limit, *, update_period: float = 0.01):
-        super().__init__(plan.q_start, initial_scaling=1.0)
-        if not np.isfinite(update_period) or update_period <= 0:
-            raise ValueError(f"update_period must be a positive number of seconds, got {update_period}")
-        self.plan = plan
-        self.velocity_limit = _limit_vector(velocity_limit, "velocity_limit", plan.num_joints)
-        self.acceleration_limit = _limit_vector(acceleration_limit, "acceleration_limit", plan.num_joints)
-        self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, 1.0]))
-        self.DeclarePeriodicDiscreteUpdateEvent(update_period, 0.0, self._read_speed_override)
-
-    def _clock(self, context):
-        """(tau [s], c, dc/dt [1/s]) at the context's time."""
-        _, t0, c0 = context.get_discrete_state(self.scaling_state_index).get_value()
-        tau0, goal = context.get_discrete_state(self.clock_state_index).get_value()
-        t = context.get_time()
-        c, c_rate = relaxed_scaling(t, t0, c0, goal)
-        return tau0 + scaled_clock(t, t0, c0, goal), float(c), float(c_rate)
-
-    def evaluate(self, context) -> tuple[np.ndarray, float]:
-        tau, c, c_rate = self._clock(context)
-        qd_plan, qdd_plan = self.plan.rates_at(tau)
-        return qdd_plan * c**2 + qd_plan * c_rate, c
-
-    def finished(self, context) -> bool:
-        return self._clock(context)[0] >= self.plan.duration
+        super().__init__(
+            plan,
+            _limit_vector(velocity_limit, "velocity_limit", plan.num_joints),
+            _limit_vector(acceleration_limit, "acceleration_limit", plan.num_joints),
+            update_period=update_period,
+        )
 
     def task_waypoints(self) -> np.ndarray:
         """Flange positions at the joint goals [m]."""
-        return np.array([robot.flange_pose(segment.q_goal)[:3, 3] for segment in self.plan.segments])
-
-    def _read_speed_override(self, context, discrete_state):
-        goal = self.speed_override(context)
-        tau, c, _ = self._clock(context)
-        scaling = discrete_state.get_mutable_vector(self.scaling_state_index)
-        if goal != context.get_discrete_state(self.clock_state_index).get_value()[1]:
-            scaling.SetFromVector([c, context.get_time(), c])  # new eq. 18 anchor (t0, c0)
-            discrete_state.get_mutable_vector(self.clock_state_index).SetFromVector([tau, goal])
-        else:
-            scaling.SetAtIndex(0, c)
+        return np.array([robot.flange_pose(segment.q_goal)[:3, 3] for segment in self.law.segments])
