@@ -349,3 +349,292 @@ def singularity_measure(q):
     q = np.asarray(q, dtype=float)
     c2, c23, s234 = np.cos(q[..., 1]), np.cos(q[..., 1] + q[..., 2]), np.sin(q[..., 1:4].sum(-1))
     return _singularity_factors(np.sin(q[..., 4]), np.sin(q[..., 2]), c2, c23, s234, np)
+
+
+# --------------------------------------------------------------------------------------------
+# Analytic inverse kinematics of the flange (closed form from the standard-DH chain above).
+# --------------------------------------------------------------------------------------------
+#
+# Derivation (frames of dh_frames; z1 = (s1, -c1, 0), x1 = (c1, s1, 0) is the arm plane direction):
+#   * wrist centre o5 = p - d6 z6. Joints 2, 3, 4 rotate about z1, a2/a3 lie in the arm plane and
+#     d5 z4 is perpendicular to z1, so o5 . z1 = d4: with (r, psi) the polar coordinates of o5
+#     in the base xy-plane, r sin(q1 - psi) = d4 and r cos(q1 - psi) = h = o5 . x1 =
+#     a2 c2 + a3 c23 + d5 s234 (the shoulder factor of det J_g), h = +-sqrt(r^2 - d4^2).
+#   * z6 = c5 z1 - s5 x4, x6 . z1 = s5 c6, y6 . z1 = -s5 s6: c5 = z6 . z1, |s5| = |(x6, y6) . z1|
+#     (sign: wrist branch), q6 = atan2(-y6 . z1 / s5, x6 . z1 / s5).
+#   * x4 = (c5 z1 - z6) / s5 = (c1 c234, s1 c234, s234) gives q234.
+#   * o4 = o5 - d5 z4: the planar 2R arm u + i v = e^{i q2} (a2 + a3 e^{i q3}) with
+#     u = o4 . x1, v = o4_z - d1 (elbow branch: sign of s3); q4 = q234 - q2 - q3.
+# Branch signs are therefore (sign h, sign sin q3, sign sin q5): the three factors of
+# det J_g = a2 a3 s3 s5 h, constant along any path that avoids the singularities.
+
+# |h| / (|a2| + |a3|), |sin q3| and |sin q5| below this are singular; sin q3 and h come from square
+# roots and are resolved only to about sqrt(machine eps) ~ 1.5e-8, so the tolerance sits above that.
+IK_SINGULAR_TOLERANCE = 1e-7
+IK_BRANCHES = tuple((s, e, w) for s in (1, -1) for e in (1, -1) for w in (1, -1))
+IK_PATH_MAX_STEP = 0.5  # [rad], largest joint step between consecutive path samples
+
+
+def ik_branch(q) -> tuple[int, int, int]:
+    """(shoulder, elbow, wrist) branch signs of configuration q, as used by :func:`inverse_kinematics`.
+
+    shoulder = sign(a2 c2 + a3 c23 + d5 s234) (wrist centre on the +x1 / -x1 side of the joint-1
+    axis), elbow = sign(sin q3), wrist = sign(sin q5); 0 where the factor is exactly zero.
+    """
+    q = _as_joint_vector(q)
+    h = _A2 * math.cos(q[1]) + _A3 * math.cos(q[1] + q[2]) + _D5 * math.sin(q[1] + q[2] + q[3])
+    return tuple(int(np.sign(v)) for v in (h, math.sin(q[2]), math.sin(q[4])))
+
+
+def _describe_pose(pose: np.ndarray) -> str:
+    phi = zyx_euler_from_rotation(pose[:3, :3])
+    return (
+        f"pose (x, y, z) = ({pose[0, 3]:.6g}, {pose[1, 3]:.6g}, {pose[2, 3]:.6g}) m, "
+        f"(phi_X, phi_Y, phi_Z) = ({phi[0]:.6g}, {phi[1]:.6g}, {phi[2]:.6g}) rad"
+    )
+
+
+def _as_flange_pose(pose, name: str = "pose") -> np.ndarray:
+    """A 4x4 homogeneous transform, or a task pose [x, y, z, phi_X, phi_Y, phi_Z], as a checked 4x4."""
+    pose = np.asarray(pose, dtype=float)
+    if pose.shape == (6,):
+        if not np.all(np.isfinite(pose)):
+            raise ValueError(f"{name} must be finite, got {pose}")
+        out = np.eye(4)
+        out[:3, :3] = rotation_from_zyx_euler(pose[3:])
+        out[:3, 3] = pose[:3]
+        return out
+    if pose.shape != (4, 4):
+        raise ValueError(
+            f"{name} must be a 4x4 transform or a task pose of shape (6,), got shape {pose.shape}"
+        )
+    if not np.all(np.isfinite(pose)):
+        raise ValueError(f"{name} must be finite, got {pose.tolist()}")
+    if not np.allclose(pose[3], [0.0, 0.0, 0.0, 1.0], atol=1e-12, rtol=0.0):
+        raise ValueError(f"{name} must have last row [0, 0, 0, 1], got {pose[3].tolist()}")
+    rotation = pose[:3, :3]
+    orthogonality = np.max(np.abs(rotation.T @ rotation - np.eye(3)))
+    if orthogonality > 1e-6 or np.linalg.det(rotation) <= 0.0:
+        raise ValueError(
+            f"{name} rotation block is not a proper rotation (|R^T R - I|max = {orthogonality:.3g}, "
+            f"det R = {np.linalg.det(rotation):.6g})"
+        )
+    return pose
+
+
+def _ik_solve(pose: np.ndarray, tol: float):
+    """All branch solutions of the 4x4 flange pose.
+
+    Returns (solutions, failures, flags): solutions maps branch -> q (wrapped); failures maps branch
+    -> reason for branches without a real solution; flags = dict(shoulder=bool, wrist=set of shoulder
+    signs, elbow=set of branches) marking singular factors. Raises ValueError when the pose is out of
+    reach (no branch has a solution and none is wrist-singular).
+    """
+    rot, p = pose[:3, :3], pose[:3, 3]
+    z6 = rot[:, 2]
+    o5 = p - _D6 * z6
+    r = math.hypot(o5[0], o5[1])
+    h_sq = r * r - _D4 * _D4
+    reach = abs(_A2) + abs(_A3)
+    if h_sq < -(tol * reach) ** 2:
+        raise ValueError(
+            f"{_describe_pose(pose)} is out of reach: the wrist centre (flange - d6 z) is "
+            f"{r:.6g} m from the joint-1 axis, closer than the shoulder offset d4 = {_D4} m"
+        )
+    h_abs = math.sqrt(max(h_sq, 0.0))
+    shoulder_singular = h_abs < tol * reach
+    psi = math.atan2(o5[1], o5[0])
+    solutions, failures = {}, {}
+    elbow_singular = set()
+    wrist_singular = set()
+    for shoulder in (1, -1):
+        q1 = psi + math.atan2(_D4, shoulder * h_abs)
+        c1, s1 = math.cos(q1), math.sin(q1)
+        z1 = np.array([s1, -c1, 0.0])
+        c5 = float(z6 @ z1)
+        s5c6 = float(rot[:, 0] @ z1)  # x6 . z1 = s5 c6
+        ms5s6 = float(rot[:, 1] @ z1)  # y6 . z1 = -s5 s6
+        s5_abs = math.hypot(s5c6, ms5s6)
+        if s5_abs < tol:
+            wrist_singular.add(shoulder)
+            continue
+        for wrist in (1, -1):
+            s5 = wrist * s5_abs
+            q5 = math.atan2(s5, c5)
+            q6 = math.atan2(-ms5s6 / s5, s5c6 / s5)
+            x4 = (c5 * z1 - z6) / s5
+            q234 = math.atan2(x4[2], c1 * x4[0] + s1 * x4[1])
+            c234, s234 = math.cos(q234), math.sin(q234)
+            o4 = o5 - _D5 * np.array([c1 * s234, s1 * s234, -c234])
+            u = c1 * o4[0] + s1 * o4[1]
+            v = o4[2] - _D1
+            dist = math.hypot(u, v)
+            c3 = (dist * dist - _A2 * _A2 - _A3 * _A3) / (2.0 * _A2 * _A3)
+            if abs(c3) > 1.0 + tol:
+                for elbow in (1, -1):
+                    failures[(shoulder, elbow, wrist)] = (
+                        f"the wrist-1 joint would be {dist:.6g} m from the shoulder joint, outside the "
+                        f"reach [{abs(abs(_A2) - abs(_A3)):.6g}, {reach:.6g}] m of the upper arm and forearm"
+                    )
+                continue
+            c3 = min(1.0, max(-1.0, c3))
+            s3_abs = math.sqrt(1.0 - c3 * c3)
+            for elbow in (1, -1):
+                if s3_abs < tol:
+                    elbow_singular.add((shoulder, elbow, wrist))
+                q3 = math.atan2(elbow * s3_abs, c3)
+                q2 = math.atan2(v, u) - math.atan2(_A3 * elbow * s3_abs, _A2 + _A3 * c3)
+                q4 = q234 - q2 - q3
+                q = wrap_angle(np.array([q1, q2, q3, q4, q5, q6]))
+                solutions[(shoulder, elbow, wrist)] = q
+    flags = dict(shoulder=shoulder_singular, wrist=wrist_singular, elbow=elbow_singular)
+    if not solutions and not wrist_singular:
+        centre = math.hypot(r, o5[2] - _D1)
+        max_centre = math.hypot(reach + _D5, _D4)
+        reasons = "; ".join(dict.fromkeys(failures.values()))
+        raise ValueError(
+            f"{_describe_pose(pose)} is out of reach: the wrist centre (flange - d6 z) is {centre:.6g} m "
+            f"from the shoulder point (0, 0, d1) (the arm reaches at most {max_centre:.6g} m); {reasons}"
+        )
+    return solutions, failures, flags
+
+
+def _raise_wrist_singular(pose: np.ndarray) -> None:
+    raise SingularConfigurationError(
+        f"{_describe_pose(pose)} is at a wrist singularity (sin q5 = 0: flange z axis parallel to "
+        f"joint axes 2-4): q4 and q6 are not determined individually, the wrist branch is undefined"
+    )
+
+
+def _unique_rows(solutions, atol: float = 1e-12) -> np.ndarray:
+    rows = []
+    for q in solutions:
+        if not any(np.max(np.abs(wrap_angle(q - other))) <= atol for other in rows):
+            rows.append(q)
+    return np.array(rows).reshape(-1, NUM_JOINTS)
+
+
+def inverse_kinematics_all(pose, *, singular_tol: float = IK_SINGULAR_TOLERANCE) -> np.ndarray:
+    """All real joint solutions q (k, 6), k <= 8, with flange_pose(q) = pose; each wrapped to (-pi, pi].
+
+    ``pose``: 4x4 transform of ``tool0`` in the base frame, or task pose [x, y, z, phi_X, phi_Y, phi_Z].
+    Rows are ordered by branch as in ``IK_BRANCHES`` ((shoulder, elbow, wrist) signs, see
+    :func:`ik_branch`); branches without a real solution are left out, and solutions that coincide
+    (at a shoulder or elbow singularity) are listed once.
+
+    Raises ValueError naming the pose and the reason (distances) when no branch reaches the pose,
+    and SingularConfigurationError at a wrist singularity (sin q5 = 0: a continuum of solutions).
+    """
+    pose = _as_flange_pose(pose)
+    solutions, _, flags = _ik_solve(pose, singular_tol)
+    if flags["wrist"]:
+        _raise_wrist_singular(pose)
+    return _unique_rows([solutions[b] for b in IK_BRANCHES if b in solutions])
+
+
+def _nearest_equivalent(q: np.ndarray, near: np.ndarray) -> np.ndarray:
+    """q shifted joint-wise by multiples of 2 pi towards ``near``, kept inside POSITION_LIMIT."""
+    shifted = q + 2 * np.pi * np.round((near - q) / (2 * np.pi))
+    outside = np.abs(shifted) > POSITION_LIMIT
+    shifted[outside] -= 2 * np.pi * np.sign(shifted[outside])
+    return shifted
+
+
+def inverse_kinematics(
+    pose,
+    *,
+    branch=None,
+    near=None,
+    singular_tol: float = IK_SINGULAR_TOLERANCE,
+) -> np.ndarray:
+    """One joint solution q (6,) of a flange pose: 4x4 transform or task pose [x, y, z, phi_X, phi_Y, phi_Z].
+
+    branch: (shoulder, elbow, wrist) signs, each +1 or -1 (see :func:`ik_branch`); the result is
+        wrapped to (-pi, pi] unless ``near`` is also given.
+    near: joint vector; the solution (of ``branch`` if given, else of all branches) closest to it in
+        joint space, each joint shifted by multiples of 2 pi towards ``near`` (within POSITION_LIMIT),
+        so that solving along a continuous path gives a continuous q.
+    With neither, the first branch of ``IK_BRANCHES`` that has a solution.
+
+    Raises ValueError naming the pose and the reason (distances) when the pose (or the requested
+    branch) is out of reach; SingularConfigurationError at a wrist singularity (sin q5 = 0; for
+    ``branch``, of that shoulder branch), and at a shoulder (wrist centre on the cylinder of
+    radius d4 about the joint-1 axis) or elbow (sin q3 = 0) singularity when ``branch`` asks for a
+    shoulder or elbow sign, which is undefined there.
+    """
+    pose = _as_flange_pose(pose)
+    if branch is not None:
+        branch = tuple(int(b) for b in np.asarray(branch).reshape(-1)) if np.size(branch) == 3 else None
+        if branch is None or any(b not in (-1, 1) for b in branch):
+            raise ValueError("branch must be three signs (shoulder, elbow, wrist), each +1 or -1")
+    if near is not None:
+        near = _as_joint_vector(near, "near")
+    solutions, failures, flags = _ik_solve(pose, singular_tol)
+    if flags["wrist"] and (branch is None or branch[0] in flags["wrist"]):
+        _raise_wrist_singular(pose)
+    if branch is not None:
+        if flags["shoulder"]:
+            raise SingularConfigurationError(
+                f"{_describe_pose(pose)} is at a shoulder singularity (wrist centre on the cylinder of "
+                f"radius d4 = {_D4} m about the joint-1 axis): the shoulder branch is undefined"
+            )
+        if branch in flags["elbow"]:
+            raise SingularConfigurationError(
+                f"{_describe_pose(pose)} is at an elbow singularity (sin q3 = 0, arm fully stretched or "
+                f"folded): the elbow branch is undefined"
+            )
+        if branch not in solutions:
+            raise ValueError(
+                f"{_describe_pose(pose)} is out of reach of branch (shoulder, elbow, wrist) = {branch}: "
+                f"{failures.get(branch, 'no real solution')}"
+            )
+        candidates = [solutions[branch]]
+    else:
+        candidates = [solutions[b] for b in IK_BRANCHES if b in solutions]
+    if near is None:
+        return candidates[0].copy()
+    shifted = [_nearest_equivalent(q, near) for q in candidates]
+    return min(shifted, key=lambda q: float(np.sum((q - near) ** 2)))
+
+
+def inverse_kinematics_path(
+    poses,
+    q_start,
+    *,
+    max_step: float = IK_PATH_MAX_STEP,
+    singular_tol: float = IK_SINGULAR_TOLERANCE,
+) -> np.ndarray:
+    """Joint path (N, 6) through the flange poses (N, 4, 4) or task poses (N, 6), one branch throughout.
+
+    Sample 0 is the solution nearest ``q_start``, every later sample the solution nearest the previous
+    one (2 pi wrapping resolved towards it, see :func:`inverse_kinematics`). Raises ValueError naming
+    the sample index when a sample is out of reach or singular (SingularConfigurationError), or when
+    a joint moves more than ``max_step`` [rad] between consecutive samples (or from ``q_start`` to
+    sample 0): the path jumps branches or needs finer sampling.
+    """
+    poses = np.asarray(poses, dtype=float)
+    if poses.ndim not in (2, 3) or poses.shape[1:] not in ((4, 4), (6,)) or poses.shape[0] == 0:
+        raise ValueError(f"poses must have shape (N, 4, 4) or (N, 6) with N >= 1, got {poses.shape}")
+    q_prev = _as_joint_vector(q_start, "q_start")
+    if not max_step > 0.0:
+        raise ValueError(f"max_step must be positive, got {max_step}")
+    path = np.empty((poses.shape[0], NUM_JOINTS))
+    for i, pose in enumerate(poses):
+        try:
+            q = inverse_kinematics(pose, near=q_prev, singular_tol=singular_tol)
+        except SingularConfigurationError as err:
+            raise SingularConfigurationError(f"path sample {i}: {err}") from err
+        except ValueError as err:
+            raise ValueError(f"path sample {i}: {err}") from err
+        step = np.abs(q - q_prev)
+        if np.max(step) > max_step:
+            joint = int(np.argmax(step))
+            where = "q_start" if i == 0 else f"sample {i - 1}"
+            raise ValueError(
+                f"path sample {i}: joint {joint + 1} moves {step[joint]:.4g} rad from {where} "
+                f"(limit {max_step} rad): the path leaves the branch {ik_branch(q_prev)} "
+                f"(now {ik_branch(q)}) or is sampled too coarsely"
+            )
+        path[i] = q
+        q_prev = q
+    return path
