@@ -13,6 +13,8 @@ time grid starting at t = 0).
 
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
 
 import numpy as np
 from pydrake.geometry import (
@@ -42,42 +44,98 @@ DEFAULT_KP = (4000.0, 4000.0, 2000.0, 500.0, 500.0, 300.0)
 DEFAULT_KD = (200.0, 200.0, 100.0, 20.0, 20.0, 10.0)
 
 
+@dataclass(frozen=True)
+class RobotModel:
+    """What the closed loop needs to know about a robot.
+
+    Attributes:
+        name: a label.
+        model_path: returns the URDF path (its root link ``base`` is welded to the world; each
+            joint J has an actuator ``J_actuator``).
+        joint_names: actuated joints, in the order of q.
+        effort_limit: per joint [N m or N].
+        tcp_pose: q -> [x, y, z, phi_X, phi_Y, phi_Z] of the tool (orientation zeros where the
+            robot only places a point).
+        kp, kd: default PD gains per joint.
+    """
+
+    name: str
+    model_path: Callable[[], Path]
+    joint_names: tuple
+    effort_limit: np.ndarray
+    tcp_pose: Callable[[np.ndarray], np.ndarray]
+    kp: tuple
+    kd: tuple
+
+    @property
+    def num_joints(self) -> int:
+        return len(self.joint_names)
+
+
+UR10E = RobotModel("ur10e", robot.model_path, robot.JOINT_NAMES, robot.EFFORT_LIMIT, robot.task_pose, DEFAULT_KP, DEFAULT_KD)
+
+
 @dataclass
 class ControllerGains:
-    """PD gains of the simulated joint controller and the feed-forward choice."""
+    """PD gains of the simulated joint controller and the feed-forward choice.
 
-    kp: list[float] = field(default_factory=lambda: list(DEFAULT_KP))
-    kd: list[float] = field(default_factory=lambda: list(DEFAULT_KD))
+    Empty ``kp`` / ``kd`` take the robot's defaults (:attr:`RobotModel.kp`, ``kd``).
+    """
+
+    kp: list[float] = field(default_factory=list)
+    kd: list[float] = field(default_factory=list)
     feedforward_acceleration: bool = True
 
-    def validate(self) -> None:
+    def for_robot(self, model: RobotModel) -> "ControllerGains":
+        """These gains with empty lists filled from ``model``, validated for its joint count."""
+        gains = ControllerGains(list(self.kp) or list(model.kp), list(self.kd) or list(model.kd),
+                                self.feedforward_acceleration)
+        gains.validate(model.num_joints)
+        return gains
+
+    def validate(self, num_joints: int) -> None:
         """Raise ValueError naming the gain that is of the wrong length, non-finite or negative."""
         for name in ("kp", "kd"):
             gains = np.asarray(getattr(self, name), dtype=float)
-            if gains.shape != (robot.NUM_JOINTS,):
-                raise ValueError(f"controller.{name} must have {robot.NUM_JOINTS} entries, got shape {gains.shape}")
+            if gains.shape != (num_joints,):
+                raise ValueError(f"controller.{name} must have {num_joints} entries, got shape {gains.shape}")
             if not np.all(np.isfinite(gains)) or np.any(gains < 0):
                 raise ValueError(f"controller.{name} must be finite and non-negative, got {gains.tolist()}")
         if not np.all(np.asarray(self.kp) > 0):
             raise ValueError(f"controller.kp must be positive, got {self.kp}")
 
 
-def add_ur10e(plant: MultibodyPlant):
-    """Parse models/ur10e.urdf into ``plant``, weld its base to the world; returns the instance."""
-    (instance,) = Parser(plant).AddModels(str(robot.model_path()))
+def robot_model(name: str) -> RobotModel:
+    """The closed-loop description of ``name``: "ur10e" or one of seed 001's robots."""
+    if name == UR10E.name:
+        return UR10E
+    from drake_traj import paper_robots
+
+    if name not in paper_robots.ROBOT_NAMES:
+        raise ValueError(f"robot must be one of {(UR10E.name,) + paper_robots.ROBOT_NAMES}, got {name!r}")
+    return paper_robots.closed_loop_model(name)
+
+
+def add_robot(plant: MultibodyPlant, model: RobotModel):
+    """Parse ``model``'s URDF into ``plant`` and weld its ``base`` to the world; returns the instance."""
+    (instance,) = Parser(plant).AddModels(str(model.model_path()))
     plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(robot.BASE_FRAME, instance))
     return instance
 
 
-class TcpPose(LeafSystem):
-    """Measured TCP pose k(q) = [x, y, z, phi_X, phi_Y, phi_Z] from the plant state [q; qd]."""
+def add_ur10e(plant: MultibodyPlant):
+    """Parse models/ur10e.urdf into ``plant``, weld its base to the world; returns the instance."""
+    return add_robot(plant, UR10E)
 
-    def __init__(self):
+
+class TcpPose(LeafSystem):
+    """Measured TCP pose from the plant state [q; qd], by ``tcp_pose(q)`` (6 values)."""
+
+    def __init__(self, tcp_pose: Callable[[np.ndarray], np.ndarray], num_joints: int):
         super().__init__()
-        n = robot.NUM_JOINTS
-        self._state = self.DeclareVectorInputPort("state", 2 * n)
+        self._state = self.DeclareVectorInputPort("state", 2 * num_joints)
         self.DeclareVectorOutputPort(
-            "pose", 6, lambda context, out: out.SetFromVector(robot.task_pose(self._state.Eval(context)[:n]))
+            "pose", 6, lambda context, out: out.SetFromVector(tcp_pose(self._state.Eval(context)[:num_joints]))
         )
 
 
@@ -89,16 +147,16 @@ class OneStepLookahead(LeafSystem):
     |qd| h, i.e. 1 mrad at 1 rad/s and h = 1 ms).
     """
 
-    def __init__(self, time_step: float):
+    def __init__(self, time_step: float, num_joints: int):
         super().__init__()
-        n = robot.NUM_JOINTS
+        n = self._n = num_joints
         self._h = time_step
         self._state = self.DeclareVectorInputPort("desired_state", 2 * n)
         self._acceleration = self.DeclareVectorInputPort("desired_acceleration", n)
         self.DeclareVectorOutputPort("state", 2 * n, self._calc)
 
     def _calc(self, context, output):
-        n = robot.NUM_JOINTS
+        n = self._n
         state = self._state.Eval(context)
         qdd = self._acceleration.Eval(context)
         q, qd, h = state[:n], state[n:], self._h
@@ -119,6 +177,7 @@ class ClosedLoop:
 def build_closed_loop(
     planner: PlannerSystem,
     *,
+    robot_model: RobotModel = UR10E,
     gains: ControllerGains | None = None,
     time_step: float = 1e-3,
     log_period: float = 1e-3,
@@ -128,13 +187,16 @@ def build_closed_loop(
 
     Args:
         planner: any system under the planner contract.
-        gains: PD gains and feed-forward choice (defaults: :class:`ControllerGains`).
+        robot_model: the robot (default the UR10e).
+        gains: PD gains and feed-forward choice (defaults: the robot's gains, with feed-forward).
         time_step: plant discrete step [s].
         log_period: uniform logging period [s].
         meshcat: when given, the robot is drawn there (``MeshcatVisualizer``).
     """
-    gains = gains or ControllerGains()
-    gains.validate()
+    gains = (gains or ControllerGains()).for_robot(robot_model)
+    n = robot_model.num_joints
+    if planner.num_joints != n:
+        raise ValueError(f"the planner has {planner.num_joints} joints, robot {robot_model.name} has {n}")
     for name, value in (("time_step", time_step), ("log_period", log_period)):
         if not np.isfinite(value) or value <= 0:
             raise ValueError(f"{name} must be a positive number of seconds, got {value}")
@@ -143,8 +205,8 @@ def build_closed_loop(
     plant, scene_graph = AddMultibodyPlant(
         MultibodyPlantConfig(time_step=time_step, discrete_contact_approximation="sap"), builder
     )
-    instance = add_ur10e(plant)
-    for joint_name, kp, kd in zip(robot.JOINT_NAMES, gains.kp, gains.kd):
+    instance = add_robot(plant, robot_model)
+    for joint_name, kp, kd in zip(robot_model.joint_names, gains.kp, gains.kd):
         actuator = plant.GetJointActuatorByName(f"{joint_name}_actuator", instance)
         actuator.set_controller_gains(PdControllerGains(p=kp, d=kd))
     plant.Finalize()
@@ -155,7 +217,7 @@ def build_closed_loop(
     )
 
     builder.AddSystem(planner)
-    lookahead = builder.AddSystem(OneStepLookahead(time_step))
+    lookahead = builder.AddSystem(OneStepLookahead(time_step, n))
     builder.Connect(planner.GetOutputPort("desired_state"), lookahead.GetInputPort("desired_state"))
     builder.Connect(planner.GetOutputPort("desired_acceleration"), lookahead.GetInputPort("desired_acceleration"))
     builder.Connect(lookahead.get_output_port(), plant.get_desired_state_input_port(instance))
@@ -172,7 +234,7 @@ def build_closed_loop(
         )
     builder.Connect(feedforward.get_output_port_generalized_force(), plant.get_actuation_input_port(instance))
 
-    tcp = builder.AddSystem(TcpPose())
+    tcp = builder.AddSystem(TcpPose(robot_model.tcp_pose, n))
     builder.Connect(plant.get_state_output_port(instance), tcp.get_input_port())
 
     def log(port):
@@ -198,6 +260,7 @@ def simulate(
     planner: PlannerSystem,
     *,
     name: str = "run",
+    robot_model: RobotModel = UR10E,
     gains: ControllerGains | None = None,
     time_step: float = 1e-3,
     log_period: float = 1e-3,
@@ -219,7 +282,9 @@ def simulate(
     for label, value in (("settle_time", settle_time), ("max_duration", max_duration)):
         if not np.isfinite(value) or value < 0:
             raise ValueError(f"{label} must be a non-negative number of seconds, got {value}")
-    loop = build_closed_loop(planner, gains=gains, time_step=time_step, log_period=log_period, meshcat=meshcat)
+    loop = build_closed_loop(
+        planner, robot_model=robot_model, gains=gains, time_step=time_step, log_period=log_period, meshcat=meshcat
+    )
     simulator = Simulator(loop.diagram)
     simulator.set_target_realtime_rate(realtime_rate)
     integrator = simulator.get_mutable_integrator()
@@ -259,7 +324,7 @@ def simulate(
     logs = {key: logger.FindLog(context) for key, logger in loop.loggers.items()}
     count = min(log.num_samples() for log in logs.values())
     data = {key: log.data()[:, :count].T for key, log in logs.items()}
-    n = robot.NUM_JOINTS
+    n = robot_model.num_joints
     return SimulationResult(
         name=name,
         t=logs["reference"].sample_times()[:count].copy(),
@@ -271,9 +336,10 @@ def simulate(
         tau=data["torque"],
         scaling=data["scaling"][:, 0],
         tcp=data["tcp"],
+        tcp_ref=np.array([robot_model.tcp_pose(q) for q in data["reference"][:, :n]]).reshape(-1, 6),
         velocity_limit=np.broadcast_to(planner.velocity_limit, (n,)).astype(float),
         acceleration_limit=np.broadcast_to(planner.acceleration_limit, (n,)).astype(float),
-        effort_limit=robot.EFFORT_LIMIT.copy(),
+        effort_limit=np.array(robot_model.effort_limit, dtype=float),
         waypoints=planner.task_waypoints(),
         duration=finish_time[0],
         failure=failure,

@@ -652,3 +652,25 @@ def paper_loop_placement(robot_name: str) -> LoopPlacement:
         offset=offset,
         reason=reason,
     )
+
+
+def closed_loop_model(name: str):
+    """The closed-loop description (:class:`drake_traj.diagram.RobotModel`) of robot ``name``.
+
+    The tool point has no orientation here (the paper's robots place a point): its pose is
+    [fk(q), 0, 0, 0]. Default PD gains 2000 (N m/rad or N/m) and 100 (N m s/rad or N s/m) on every
+    joint; the inverse-dynamics feed-forward does most of the work.
+    """
+    from drake_traj.diagram import RobotModel
+
+    arm = get_robot(name)
+    count = len(arm.joint_names)
+    return RobotModel(
+        name=name,
+        model_path=arm.model_path,
+        joint_names=tuple(arm.joint_names),
+        effort_limit=np.array(arm.effort_limit, dtype=float),
+        tcp_pose=lambda q: np.concatenate([arm.fk(q), np.zeros(3)]),
+        kp=(2000.0,) * count,
+        kd=(100.0,) * count,
+    )

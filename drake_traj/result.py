@@ -3,7 +3,8 @@
 All arrays are time-major (one row per logged sample) on a uniform grid ``t`` [s]:
 ``q_ref``, ``qd_ref``, ``qdd_ref`` (planner reference, rad, rad/s, rad/s^2), ``q_meas``, ``qd_meas``
 (plant state), ``tau`` (net joint torque applied by the drives, N m), ``scaling`` (c), ``tcp``
-(measured flange pose k(q) = [x, y, z, phi_X, phi_Y, phi_Z], m and rad, base frame).
+(measured flange pose k(q) = [x, y, z, phi_X, phi_Y, phi_Z], m and rad, base frame) and
+``tcp_ref`` (the same of the reference q_ref).
 """
 
 from __future__ import annotations
@@ -15,9 +16,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from drake_traj import robot
-
-ARRAY_NAMES = ("t", "q_ref", "qd_ref", "qdd_ref", "q_meas", "qd_meas", "tau", "scaling", "tcp")
+ARRAY_NAMES = ("t", "q_ref", "qd_ref", "qdd_ref", "q_meas", "qd_meas", "tau", "scaling", "tcp", "tcp_ref")
 _LIMIT_NAMES = ("velocity_limit", "acceleration_limit", "effort_limit", "waypoints")
 
 
@@ -35,9 +34,10 @@ class SimulationResult:
     tau: np.ndarray
     scaling: np.ndarray
     tcp: np.ndarray
+    tcp_ref: np.ndarray
     velocity_limit: np.ndarray
     acceleration_limit: np.ndarray
-    effort_limit: np.ndarray = field(default_factory=lambda: robot.EFFORT_LIMIT.copy())
+    effort_limit: np.ndarray
     waypoints: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     duration: float = float("nan")
     failure: str | None = None
@@ -47,17 +47,13 @@ class SimulationResult:
     def succeeded(self) -> bool:
         return self.failure is None
 
-    def reference_tcp(self) -> np.ndarray:
-        """k(q_ref) at every sample, shape (N, 6)."""
-        return np.array([robot.task_pose(q) for q in self.q_ref])
-
     def jerk(self) -> np.ndarray:
         """Reference jerk [rad/s^3] by finite differences of qdd_ref, shape (N-1, 6)."""
         return np.diff(self.qdd_ref, axis=0) / np.diff(self.t)[:, None]
 
     def metrics(self) -> dict:
         """Scalar and per-joint figures of merit, JSON-ready."""
-        tcp_error = np.linalg.norm(self.reference_tcp()[:, :3] - self.tcp[:, :3], axis=1)
+        tcp_error = np.linalg.norm(self.tcp_ref[:, :3] - self.tcp[:, :3], axis=1)
         simulated = float(self.t[-1]) if len(self.t) else 0.0
         jerk = self.jerk()
         return {
@@ -160,7 +156,7 @@ class SimulationResult:
         """The measured and reference TCP paths in 3-D (base frame) with the waypoints."""
         figure = Figure(figsize=(7, 6), layout="constrained")
         ax = figure.add_subplot(projection="3d")
-        reference = self.reference_tcp()
+        reference = self.tcp_ref
         ax.plot(*reference[:, :3].T, label="reference", linewidth=2)
         ax.plot(*self.tcp[:, :3].T, "--", label="measured", linewidth=1)
         if len(self.waypoints):

@@ -15,7 +15,7 @@ import numpy as np
 from pydrake.common.yaml import yaml_load_typed
 
 from drake_traj import robot
-from drake_traj.diagram import ControllerGains
+from drake_traj.diagram import ControllerGains, robot_model
 
 # Seed 000's start configuration q(0) [rad]; its flange pose is p0 = [-0.174, -0.524, 0.273, pi, 0, 3pi/4].
 PAJAK_Q0 = [-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4]
@@ -66,9 +66,16 @@ class PajakTask:
 
 @dataclass
 class Scenario:
-    """One experiment: start, planner, controller and simulation settings (times in seconds)."""
+    """One experiment: robot, start, planner, controller and simulation settings (times in seconds).
+
+    ``robot`` is "ur10e" or one of seed 001's robots ("anthropomorphic", "scara", "cartesian").
+    ``q_initial`` is the UR10e's start (the task-space planners start there; planners of the
+    other robots start from the inverse kinematics of their path). Empty controller gains take
+    the robot's defaults.
+    """
 
     name: str = "unnamed"
+    robot: str = "ur10e"
     q_initial: list[float] = field(default_factory=lambda: list(PAJAK_Q0))
     planner: Union[QuinticPtp, PajakTask] = field(default_factory=QuinticPtp)
     controller: ControllerGains = field(default_factory=ControllerGains)
@@ -79,6 +86,7 @@ class Scenario:
 
     def validate(self) -> None:
         """Raise ValueError naming the first field that is malformed."""
+        model = robot_model(self.robot)
         q = np.asarray(self.q_initial, dtype=float)
         if q.shape != (robot.NUM_JOINTS,):
             raise ValueError(f"q_initial must have {robot.NUM_JOINTS} entries, got shape {q.shape}")
@@ -95,7 +103,7 @@ class Scenario:
             smallest_allowed = 0.0 if label == "settle_time" else np.nextafter(0.0, 1.0)
             if not np.isfinite(value) or value < smallest_allowed:
                 raise ValueError(f"{label} must be a finite, positive number of seconds, got {value}")
-        self.controller.validate()
+        self.controller.for_robot(model)
 
 
 def default_scenario_path() -> Path:

@@ -50,7 +50,7 @@ def test_sim3_reaches_the_goal_through_every_neighbourhood(sim3):
     goal = P.paper_parameters(3).waypoints[-1]
     assert np.linalg.norm(robot.task_pose(sim3.q_ref[finish])[:3] - goal[:3]) < 1e-3
     assert np.linalg.norm(sim3.tcp[-1, :3] - goal[:3]) < 1e-3  # measured, after settling
-    distances = np.linalg.norm(sim3.reference_tcp()[:, None, :3] - sim3.waypoints[None], axis=2)
+    distances = np.linalg.norm(sim3.tcp_ref[:, None, :3] - sim3.waypoints[None], axis=2)
     assert np.all(distances.min(axis=0) < 0.05)
 
 

@@ -1071,7 +1071,7 @@ class PajakPlanner(PlannerSystem):
             raise ValueError(f"update_period must be a positive number of seconds, got {update_period}")
         self.law = PajakLaw(parameters)
         initial = self.law.initial_discrete()
-        super().__init__(q_initial, initial_scaling=float(initial[C]))
+        super().__init__(robot._as_joint_vector(q_initial, "q_initial"), initial_scaling=float(initial[C]))
         self.task_state_index = self.DeclareDiscreteState(initial[C0 + 1 :])
         self.velocity_limit = self.law.qd_max[0]
         self.acceleration_limit = self.law.qdd_max[0]
