@@ -14,7 +14,7 @@ from pathlib import Path
 
 from pydrake.geometry import Meshcat
 
-from drake_traj.diagram import simulate
+from drake_traj.diagram import robot_model, simulate
 from drake_traj.meshcat import draw_task, export_html
 from drake_traj.scenario import default_scenario_path, load_scenario, make_planner
 
@@ -29,6 +29,7 @@ def run(scenario_path, out_dir, *, live_meshcat: bool = False) -> int:
     result = simulate(
         make_planner(scenario),
         name=scenario.name,
+        robot_model=robot_model(scenario.robot),
         gains=scenario.controller,
         time_step=scenario.time_step,
         log_period=scenario.log_period,

@@ -156,11 +156,15 @@ class SimulationResult:
         """The measured and reference TCP paths in 3-D (base frame) with the waypoints."""
         figure = Figure(figsize=(7, 6), layout="constrained")
         ax = figure.add_subplot(projection="3d")
-        reference = self.tcp_ref
-        ax.plot(*reference[:, :3].T, label="reference", linewidth=2)
+        ax.plot(*self.tcp_ref[:, :3].T, label="reference", linewidth=2)
         ax.plot(*self.tcp[:, :3].T, "--", label="measured", linewidth=1)
         if len(self.waypoints):
             ax.scatter(*self.waypoints.T, color="tab:orange", s=60, label="waypoints")
+        points = np.vstack([self.tcp_ref[:, :3], self.tcp[:, :3], self.waypoints.reshape(-1, 3)])
+        centre = (points.max(axis=0) + points.min(axis=0)) / 2
+        half = max(float(np.ptp(points, axis=0).max()) / 2, 1e-3)  # equal scales on all axes
+        for set_limits, middle in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+            set_limits(middle - half, middle + half)
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
         ax.set_zlabel("z [m]")

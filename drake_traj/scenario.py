@@ -65,6 +65,28 @@ class PajakTask:
 
 
 @dataclass
+class BorygaLoop:
+    """Seed 001's loop path B -> M -> loop -> M -> E (Boryga), then inverse kinematics on the
+    scenario's robot.
+
+    B, M, E [m] in the robot's base frame; left empty, the paper's example (Table 1) is placed in
+    the robot's workspace: by :func:`drake_traj.paper_robots.paper_loop_placement` for seed 001's
+    robots, and for the UR10e translated so that B is the flange at ``q_initial`` (the loop then
+    lies in the horizontal plane through it, traced at the flange orientation of ``q_initial``).
+    delta [m] and v_max [m/s] as in the paper. velocity_limit / acceleration_limit per joint;
+    empty: the robot's published velocity limits and no acceleration limit.
+    """
+
+    B: list[float] = field(default_factory=list)
+    M: list[float] = field(default_factory=list)
+    E: list[float] = field(default_factory=list)
+    delta: float = 0.02
+    v_max: float = 0.25
+    velocity_limit: list[float] = field(default_factory=list)
+    acceleration_limit: list[float] = field(default_factory=list)
+
+
+@dataclass
 class Scenario:
     """One experiment: robot, start, planner, controller and simulation settings (times in seconds).
 
@@ -77,7 +99,7 @@ class Scenario:
     name: str = "unnamed"
     robot: str = "ur10e"
     q_initial: list[float] = field(default_factory=lambda: list(PAJAK_Q0))
-    planner: Union[QuinticPtp, PajakTask] = field(default_factory=QuinticPtp)
+    planner: Union[QuinticPtp, PajakTask, BorygaLoop] = field(default_factory=QuinticPtp)
     controller: ControllerGains = field(default_factory=ControllerGains)
     time_step: float = 0.001
     log_period: float = 0.001
@@ -134,6 +156,8 @@ def make_planner(scenario: Scenario):
 
     config = scenario.planner
     try:
+        if isinstance(config, BorygaLoop):
+            return _make_boryga_planner(scenario, config)
         if isinstance(config, PajakTask):
             settings = {name: value for name, value in vars(config).items() if name != "update_period"}
             return PajakPlanner(PajakParameters(**settings), scenario.q_initial, update_period=config.update_period)
@@ -148,3 +172,35 @@ def make_planner(scenario: Scenario):
         return QuinticPtpPlanner(plan, config.velocity_limit, config.acceleration_limit)
     except ValueError as error:
         raise ValueError(f"scenario {scenario.name!r}, planner: {error}") from error
+
+
+def _make_boryga_planner(scenario: Scenario, config: BorygaLoop):
+    from drake_traj import paper_robots
+    from drake_traj.planners.boryga import BorygaLoopPlanner, PaperRobotLoopLaw, Ur10eLoopLaw, plan_loop_path
+
+    points = [np.asarray(getattr(config, name), dtype=float) for name in ("B", "M", "E")]
+    if any(len(point) for point in points):
+        if not all(point.shape == (3,) for point in points):
+            raise ValueError(f"B, M and E must all be 3-vectors [m] or all empty, got {[p.tolist() for p in points]}")
+    elif scenario.robot == "ur10e":
+        offset = robot.flange_pose(scenario.q_initial)[:3, 3] - np.asarray(paper_robots.PAPER_LOOP["B"])
+        points = [np.asarray(paper_robots.PAPER_LOOP[name]) + offset for name in ("B", "M", "E")]
+    else:
+        placement = paper_robots.paper_loop_placement(scenario.robot)
+        points = [placement.B, placement.M, placement.E]
+    plan = plan_loop_path(*points, config.v_max, delta=config.delta)
+    if scenario.robot == "ur10e":
+        q_initial = np.asarray(scenario.q_initial, dtype=float)
+        law = Ur10eLoopLaw(plan, robot.task_pose(q_initial)[3:], robot.ik_branch(q_initial))
+        default_velocity = robot.VELOCITY_LIMIT
+    else:
+        arm = paper_robots.get_robot(scenario.robot)
+        law = PaperRobotLoopLaw(plan, arm)
+        default_velocity = np.asarray(arm.velocity_limit, dtype=float)
+    count = len(law.q_start)
+    velocity = np.asarray(config.velocity_limit or default_velocity, dtype=float)
+    acceleration = np.asarray(config.acceleration_limit or [np.inf] * count, dtype=float)
+    for name, limit in (("velocity_limit", velocity), ("acceleration_limit", acceleration)):
+        if limit.shape != (count,) or np.any(~(limit > 0)):
+            raise ValueError(f"{name} must have {count} positive entries, got {limit.tolist()}")
+    return BorygaLoopPlanner(law, velocity, acceleration)

@@ -42,6 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drake_traj import robot
+from drake_traj.planners.base import TimeLawPlanner
 from drake_traj.validation import finite_array, positive_scalar
 
 __all__ = [
@@ -698,3 +700,106 @@ def plan_loop_path(B, M, E, v_max, delta=None, radius=None) -> LoopPathPlan:
     """
     geometry = loop_geometry(B, M, E, delta=delta, radius=radius)
     return LoopPathPlan(geometry, loop_time_law(geometry, v_max))
+
+
+# --------------------------------------------------------------------------------------------
+# Joint motion on a robot and the planner system (DESIGN.md contract).
+# --------------------------------------------------------------------------------------------
+
+
+class PaperRobotLoopLaw:
+    """The loop path's joint motion on one of seed 001's robots, by their closed-form IK
+    (eq. 15-32): the time law a :class:`TimeLawPlanner` follows.
+
+    Args:
+        plan: the loop path (:func:`plan_loop_path`), in the robot's base frame.
+        arm: a robot of :mod:`drake_traj.paper_robots` (``fk``, ``ik``, ``joint_trajectory``).
+    """
+
+    def __init__(self, plan: LoopPathPlan, arm):
+        self.plan = plan
+        self.arm = arm
+        self.duration = plan.duration
+        self.q_start = arm.ik(plan.sample(0.0)[0])
+
+    def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """(qd, qdd) at law time tau [s] (eq. 15-32 and J^-1 for the rates)."""
+        _, qd, qdd = self.arm.joint_trajectory(self.plan, np.array([tau]))
+        return qd[0], qdd[0]
+
+
+class Ur10eLoopLaw:
+    """The loop path's joint motion on the UR10e: the flange traces the path at a fixed
+    orientation, joints by the closed-form IK on one branch, rates by the analytic Jacobian:
+    qd = J^-1 [v; 0], qdd = J^-1 ([a; 0] - dJ/dt qd).
+
+    Args:
+        plan: the loop path in the UR10e base frame [m].
+        orientation: the fixed Z-Y-X Euler angles of the flange [rad].
+        branch: IK branch signs (shoulder, elbow, wrist), see :func:`drake_traj.robot.ik_branch`.
+    """
+
+    def __init__(self, plan: LoopPathPlan, orientation, branch):
+        self.plan = plan
+        self.orientation = np.asarray(orientation, dtype=float)
+        self.branch = tuple(branch)
+        self.duration = plan.duration
+        self.q_start = self.configuration(0.0)
+
+    def configuration(self, tau: float) -> np.ndarray:
+        """q [rad] with the flange on the path at law time tau [s]."""
+        position = self.plan.sample(tau)[0]
+        return robot.inverse_kinematics(np.concatenate([position, self.orientation]), branch=self.branch)
+
+    def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        position, velocity, acceleration = self.plan.sample(tau)[:3]
+        q = robot.inverse_kinematics(np.concatenate([position, self.orientation]), branch=self.branch)
+        jacobian = robot.analytic_jacobian(q)
+        qd = np.linalg.solve(jacobian, np.concatenate([velocity, np.zeros(3)]))
+        _, bias = robot.analytic_jacobian_and_bias(q, qd)
+        qdd = np.linalg.solve(jacobian, np.concatenate([acceleration, np.zeros(3)]) - bias)
+        return qd, qdd
+
+
+def joint_speed_cap(law, velocity_limit, acceleration_limit, *, samples: int = 4001) -> tuple[float, dict]:
+    """The largest constant clock rate c <= 1 that keeps ``law`` within the joint limits.
+
+    With a constant c, joint velocity scales by c and acceleration by c^2, so
+    c = min(1, min_j v_lim_j / peak|qd_j|, sqrt(min_j a_lim_j / peak|qdd_j|)), peaks taken on
+    ``samples`` uniform samples and at the path's junction times (both sides of each jump).
+
+    Returns:
+        (c, peaks) with peaks = {"qd": per-joint peak |qd|, "qdd": per-joint peak |qdd|} at c = 1.
+    """
+    times = np.union1d(np.linspace(0.0, law.duration, samples), law.plan.breakpoints)
+    times = np.union1d(times, np.clip(law.plan.breakpoints - 1e-9, 0.0, law.duration))
+    rates = [law.rates_at(float(t)) for t in times]
+    peak_qd = np.max(np.abs([r[0] for r in rates]), axis=0)
+    peak_qdd = np.max(np.abs([r[1] for r in rates]), axis=0)
+    with np.errstate(divide="ignore"):
+        cap = min(
+            1.0,
+            float(np.min(np.asarray(velocity_limit) / peak_qd)),
+            float(np.sqrt(np.min(np.asarray(acceleration_limit) / peak_qdd))),
+        )
+    return cap, {"qd": peak_qd, "qdd": peak_qdd}
+
+
+class BorygaLoopPlanner(TimeLawPlanner):
+    """Seed 001's loop motion on a robot under the planner contract: the joint law of
+    :class:`PaperRobotLoopLaw` or :class:`Ur10eLoopLaw`, slowed by a constant clock rate
+    (:func:`joint_speed_cap`) where it would break the joint limits.
+
+    Args:
+        law: the joint law.
+        velocity_limit, acceleration_limit: per-joint limits to keep [rad/s or m/s, rad/s^2 or m/s^2].
+    """
+
+    def __init__(self, law, velocity_limit, acceleration_limit, *, update_period: float = 0.01):
+        cap, self.peaks = joint_speed_cap(law, velocity_limit, acceleration_limit)
+        super().__init__(law, velocity_limit, acceleration_limit, speed_cap=cap, update_period=update_period)
+
+    def task_waypoints(self) -> np.ndarray:
+        """B, M and E [m]."""
+        geometry = self.law.plan.geometry
+        return np.array([geometry.B, geometry.M, geometry.E])
