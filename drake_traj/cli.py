@@ -26,8 +26,9 @@ def run(scenario_path, out_dir, *, live_meshcat: bool = False) -> int:
     meshcat = Meshcat()
     if live_meshcat:
         print(f"Meshcat: {meshcat.web_url()}", flush=True)
+    planner = make_planner(scenario)
     result = simulate(
-        make_planner(scenario),
+        planner,
         name=scenario.name,
         robot_model=robot_model(scenario.robot),
         gains=scenario.controller,
@@ -40,6 +41,8 @@ def run(scenario_path, out_dir, *, live_meshcat: bool = False) -> int:
     )
     result.save(out_dir)
     result.save_figures(out_dir)
+    for stem, figure in planner.figures().items():
+        figure.savefig(out_dir / f"{stem}.png", dpi=110)
     draw_task(meshcat, result)
     export_html(meshcat, out_dir / "meshcat.html")
     metrics = result.metrics()

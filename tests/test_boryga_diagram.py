@@ -86,3 +86,11 @@ def test_bad_loop_scenarios_name_the_reason(tmp_path):
     path.write_text(text.replace("robot: scara", "robot: puma"))
     with pytest.raises(ValueError, match="robot must be one of"):
         load_scenario(path)
+
+
+def test_cli_writes_the_loop_path_figure(tmp_path):
+    from drake_traj import cli
+
+    assert cli.main(["run", str(DIAGRAMS / "boryga_loop_cartesian.yaml"), "--out", str(tmp_path)]) == 0
+    for stem in ("loop_path", "joints", "tcp_path"):
+        assert (tmp_path / f"{stem}.png").stat().st_size > 10_000

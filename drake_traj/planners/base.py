@@ -66,6 +66,10 @@ class PlannerSystem(LeafSystem):
         """TCP positions [m] the task passes through (base frame), shape (m, 3), for plots."""
         return np.zeros((0, 3))
 
+    def figures(self) -> dict:
+        """Planner-specific figures {file stem: matplotlib Figure} (e.g. the paper's path plots)."""
+        return {}
+
     def initial_positions(self) -> np.ndarray:
         """q at t = 0 [rad]: where the robot starts."""
         return self._q_initial.copy()

@@ -799,7 +799,39 @@ class BorygaLoopPlanner(TimeLawPlanner):
         cap, self.peaks = joint_speed_cap(law, velocity_limit, acceleration_limit)
         super().__init__(law, velocity_limit, acceleration_limit, speed_cap=cap, update_period=update_period)
 
+    def figures(self) -> dict:
+        return {"loop_path": loop_path_figure(self.law.plan)}
+
     def task_waypoints(self) -> np.ndarray:
         """B, M and E [m]."""
         geometry = self.law.plan.geometry
         return np.array([geometry.B, geometry.M, geometry.E])
+
+
+def loop_path_figure(plan: LoopPathPlan, *, samples: int = 4001):
+    """The paper's figs. 5-7 for ``plan``: position, velocity and acceleration per axis and their
+    norms (speed along the path, acceleration magnitude) against time, junctions marked."""
+    from matplotlib.figure import Figure
+
+    t = np.linspace(0.0, plan.duration, samples)
+    position, velocity, acceleration = plan.sample(t)[:3]
+    figure = Figure(figsize=(9, 8), layout="constrained")
+    axes = figure.subplots(3, 1, sharex=True)
+    for ax, data, label, norm_label in (
+        (axes[0], position, "position [m]", None),
+        (axes[1], velocity, "velocity [m/s]", "speed"),
+        (axes[2], acceleration, "acceleration [m/s$^2$]", "|a|"),
+    ):
+        for k, axis in enumerate("xyz"):
+            ax.plot(t, data[:, k], label=axis)
+        if norm_label:
+            ax.plot(t, np.linalg.norm(data, axis=1), "k--", label=norm_label)
+        for time, name in zip(plan.breakpoints, ("B", "M", "T1", "T2", "M", "E")):
+            ax.axvline(time, color="grey", linewidth=0.6)
+            if ax is axes[0]:
+                ax.annotate(name, (time, 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom")
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+        ax.legend(ncol=4, fontsize="small")
+    axes[-1].set_xlabel("t [s]")
+    return figure
