@@ -50,12 +50,23 @@ off gives the paper's method as printed, with the ERRATA corrections):
    or a non-finite value raise :class:`PlanningError` naming time, configuration and cause.
 4. ``preserve_damping``: with c < 1 the literal law has damping c Λ_V against stiffness c Λ_P,
    which breaks condition (11) below c* = 4 Λ_P / Λ_V² = 0.907, and the TCP overshoots the
-   final goal (0.8 mm in sim 3, 10 cm on a direct move with the paper's limits). The damping is
-   raised to c Λ_V max(1, sqrt(c*/c_r)) (c_r: the eq. 18 value, = c up to one update period
-   while the limits are active), which is critical damping for c < c*. It is applied while
-   converging to a fixed target (p_w; each waypoint in stop mode), ramped in with σ during the
-   last blend so q̈ stays continuous; q̈ stays linear in c, so cases 1-4 remain exact. The price
-   is time: sim 3 takes 5.86 s instead of 5.35 s.
+   final goal (0.76 mm in sim 3, 2.1 cm on a direct move with the paper's limits). Damping is
+   added only where a component e_j of the error is heading into a sign change, and only as
+   much as it takes (:func:`approach_damping`): with K = c_r Λ_P (c_r: the eq. 18 value, = c
+   up to one update period while the limits are active) and the approach rate
+   r_j = -ė_j/e_j, the damping D_j = r_j + K/r_j makes ė_j = -r_j e_j an invariant line of
+   ë = -D ė - K e (dr/dt = r² - D r + K = 0), so e_j decays as exp(-r_j t) and never changes
+   sign. It holds r_j from 2 sqrt(K) (the critical damping coefficient) up, is ramped in
+   smoothly from c_r Λ_V at r_j = sqrt(K) (the critically damped rate), and is c_r Λ_V below
+   that, i.e. the literal law while the TCP is far from the goal relative to its speed. The
+   added term is c J⁻¹ (D - c_r Λ_V) ė / c_r: q̈ stays linear in c (cases 1-4 exact) and
+   continuous. Applied while converging to a fixed target (p_w; each waypoint in stop mode),
+   ramped in with σ during the last blend. Sim 3 takes 5.28 s (literal 5.35 s with the
+   overshoot, paper 5.32 s); critical damping on the whole final approach (c Λ_V
+   sqrt(c*/c_r), the first version of this fix) also stops the overshoot but takes 5.86 s,
+   because it slows the TCP long before any overshoot is possible. Caveat: when the limits
+   bind while braking (c < c_r, or the improvement-2 fallback with c near 0, where the TCP
+   coasts) no damping can act, and random tasks with hard limits can still overshoot.
 
 Equation numbers in comments are the paper's.
 """
@@ -80,6 +91,7 @@ __all__ = [
     "PAPER_METHOD",
     "PlanningError",
     "acceleration_terms",
+    "approach_damping",
     "blend_progress",
     "blended_target",
     "choose_scaling",
@@ -182,7 +194,8 @@ class PajakParameters:
             when the TCP leaves the ball).
         bounded_scaling: improvement 2, c in [0, 1], limits kept by braking when no c works.
         damped_inverse: improvement 3, damped least squares near a singular J.
-        preserve_damping: improvement 4, condition (11) kept for c < 1 near the final goal.
+        preserve_damping: improvement 4, no error component changes sign (overshoot) near the
+            final goal, whatever c.
         scaling_rate: rate of eq. 18 [1/s] (1 in the paper).
         singularity_threshold: damped least squares below this :func:`drake_traj.robot.singularity_measure`.
         max_damping: damping λ of the damped least squares at a singular J.
@@ -351,6 +364,27 @@ def velocity_penalty(qd, qd_min, qd_max, rho: float, vartheta: float, *, smooth:
     # ∂κ/∂q̇_i = κ'(d) ∂d/∂q̇_i, with ∂d/∂q̇_i = -1/span near q̇_max and +1/span near q̇_min;
     # eq. 15 pushes away from the nearer limit.
     return np.where(upper, -magnitude, magnitude)
+
+
+def approach_damping(error, error_rate, stiffness, damping, delta):
+    """Damping [1/s] per error component that keeps it from changing sign (improvement 4).
+
+    For ë = -D ė - K e per component, the approach rate r = -ė/e obeys dr/dt = r² - D r + K.
+    With D = r + K/r it is constant: ė = -r e is invariant and e decays as exp(-r t) without
+    crossing 0. Returned: D = the given ``damping`` for r <= sqrt(K) (the literal law), ramped
+    (smoothstep in r) up to λ + K/λ at r = λ = 2 sqrt(K), and r + K/r above λ; never below
+    ``damping``. Continuous in the state. r = -ė e / (e² + δ²): δ only keeps r finite at e = 0;
+    a component heading for 0 is held before it gets there (also a lateral one).
+
+    Args (broadcast together, e.g. (N, 6)): error e, error_rate ė = J q̇, stiffness K > 0,
+    damping (the unmodified one, c_r Λ_V), delta δ > 0.
+    """
+    rate = -(error * error_rate) / (error * error + delta * delta)
+    root = np.sqrt(stiffness)
+    held = np.maximum(rate, 2.0 * root)
+    hold = held + stiffness / held
+    x = np.clip(rate / root - 1.0, 0.0, 1.0)
+    return np.maximum(damping, damping + (hold - damping) * (x * x * (3.0 - 2.0 * x)))
 
 
 def damping_factor(measure, threshold, max_damping):
@@ -545,6 +579,13 @@ class PajakLaw:
         self.blend_distance = self.blend_length * self.neighbourhood
         # c below which condition (11) fails for the scaled gains c Λ_V, c Λ_P: 4 Λ_P / Λ_V² = 0.907
         self.critical_scaling = np.max(4.0 * self.kp / self.kv**2, axis=1)
+        # improvement 4: regularisation δ of the approach rate at e_j = 0, 1e-4 ε (orientation
+        # through _ORIENTATION_LENGTH); a relative δ (a fraction of |e|) lets small lateral
+        # components cross 0 and overshot more random tasks
+        delta = 1e-4 * self.accuracy[:, None]
+        self.approach_delta = np.concatenate(
+            [np.repeat(delta, 3, axis=1), np.repeat(delta / _ORIENTATION_LENGTH, 3, axis=1)], axis=1
+        )
         self._rows = np.arange(count)
         self._zeros = np.zeros(count)
         self._ones = np.ones(count)
@@ -618,25 +659,25 @@ class PajakLaw:
             qdd = a + b_v + b_p  # eq. 16 (eq. 13 without the penalty)
             return _Evaluation(qdd, c, c_r, saturated, pose, target, sigma, measure, cy)
         c_r = relaxed_scaling(t, d[:, T0], d[:, C0], 1.0, self.scaling_rate)[0]  # eq. 18
+        b = b_v + b_p
         if self.preserve_damping:
-            # improvement 4: damping c·h Λ_V with h = max(1, sqrt(c*/c_r)), c* = 4 Λ_P / Λ_V²,
-            # restores condition (11) (critical damping) for c < c*. Applied while converging to
-            # a fixed target (p_w; every waypoint in stop mode), ramped in with σ during the last
-            # blend so that q̈ stays continuous.
+            # improvement 4: per error component, the damping that keeps it from changing sign
+            # (approach_damping), with the gains scaled by c_r so that q̈ stays linear in c.
+            # Applied while converging to a fixed target (p_w; every waypoint in stop mode),
+            # ramped in with σ during the last blend so that q̈ stays continuous.
             if not self.blend_waypoints:
                 weight = self._ones
             elif (i >= self.num_waypoints - 2).any():
                 weight = np.where(i >= self.num_waypoints - 1, 1.0, np.where(i == self.num_waypoints - 2, sigma, 0.0))
             else:
                 weight = None
-            if weight is not None and (c_r < self.critical_scaling).any():
-                boost = np.sqrt(self.critical_scaling / np.minimum(np.maximum(c_r, 1e-3), 1.0))
-                boost = 1.0 + weight * np.maximum(boost - 1.0, 0.0)
-                b = boost[:, None] * (b_v - penalty) + penalty + b_p
-            else:
-                b = b_v + b_p
-        else:
-            b = b_v + b_p
+            if weight is not None:
+                scale = np.minimum(np.maximum(c_r, 1e-3), 1.0)[:, None]
+                error_rate = (jac @ qd[:, :, None])[:, :, 0]  # ė = J q̇
+                damping = approach_damping(error, error_rate, scale * self.kp, scale * self.kv, self.approach_delta)
+                added = weight[:, None] * (damping / scale - self.kv)  # per unit of c
+                if (added > 0.0).any():
+                    b = b - _solve(jac, (added * error_rate)[:, :, None], lam2)[:, :, 0]
         lower, upper = -self.qdd_max, self.qdd_max
         if self.bounded_scaling and self.limit_velocity and (np.abs(qd) > self.viability_onset).any():
             # improvement 2: the box also keeps q̇ viable: q̈_i <= K (q̇_max - q̇_i) (and the
