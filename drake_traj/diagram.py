@@ -106,13 +106,18 @@ class ControllerGains:
 
 
 def robot_model(name: str) -> RobotModel:
-    """The closed-loop description of ``name``: "ur10e" or one of seed 001's robots."""
+    """The closed-loop description of ``name``: "ur10e", "li_4dof" (seed 002) or one of seed 001's robots."""
     if name == UR10E.name:
         return UR10E
-    from drake_traj import paper_robots
+    from drake_traj import li_robot, paper_robots
+
+    if name == "li_4dof":
+        return li_robot.closed_loop_model()
 
     if name not in paper_robots.ROBOT_NAMES:
-        raise ValueError(f"robot must be one of {(UR10E.name,) + paper_robots.ROBOT_NAMES}, got {name!r}")
+        raise ValueError(
+            f"robot must be one of {(UR10E.name, 'li_4dof') + paper_robots.ROBOT_NAMES}, got {name!r}"
+        )
     return paper_robots.closed_loop_model(name)
 
 

@@ -87,10 +87,30 @@ class BorygaLoop:
 
 
 @dataclass
+class LiClosedPath:
+    """Seed 002 (Li, Zhang, Zhou): look-ahead and cubic ACC/DEC on a tool path, IK, joint
+    re-timing, quintic B-spline, and our repairs so every limit holds.
+
+    points [m]: the tool path in the robot's base frame; left empty, the closed path like Fig. 6
+    (:func:`drake_traj.li_robot.li_closed_path`), for the UR10e translated so that it starts at the
+    flange at ``q_initial`` (horizontal plane, fixed flange orientation). Tool limits default to
+    Table 4 (0.2 m/s, 0.1 m/s^2); joint limits empty: Table 5 for the 4-DOF robot, the UR
+    joint-move defaults (1.05 rad/s, 1.40 rad/s^2) for the UR10e.
+    """
+
+    points: list[list[float]] = field(default_factory=list)
+    tool_velocity_limit: float = 0.2
+    tool_acceleration_limit: float = 0.1
+    velocity_limit: list[float] = field(default_factory=list)
+    acceleration_limit: list[float] = field(default_factory=list)
+
+
+@dataclass
 class Scenario:
     """One experiment: robot, start, planner, controller and simulation settings (times in seconds).
 
-    ``robot`` is "ur10e" or one of seed 001's robots ("anthropomorphic", "scara", "cartesian").
+    ``robot`` is "ur10e", "li_4dof" (seed 002) or one of seed 001's robots ("anthropomorphic",
+    "scara", "cartesian").
     ``q_initial`` is the UR10e's start (the task-space planners start there; planners of the
     other robots start from the inverse kinematics of their path). Empty controller gains take
     the robot's defaults.
@@ -99,7 +119,7 @@ class Scenario:
     name: str = "unnamed"
     robot: str = "ur10e"
     q_initial: list[float] = field(default_factory=lambda: list(PAJAK_Q0))
-    planner: Union[QuinticPtp, PajakTask, BorygaLoop] = field(default_factory=QuinticPtp)
+    planner: Union[QuinticPtp, PajakTask, BorygaLoop, LiClosedPath] = field(default_factory=QuinticPtp)
     controller: ControllerGains = field(default_factory=ControllerGains)
     time_step: float = 0.001
     log_period: float = 0.001
@@ -158,6 +178,8 @@ def make_planner(scenario: Scenario):
     try:
         if isinstance(config, BorygaLoop):
             return _make_boryga_planner(scenario, config)
+        if isinstance(config, LiClosedPath):
+            return _make_li_planner(scenario, config)
         if isinstance(config, PajakTask):
             settings = {name: value for name, value in vars(config).items() if name != "update_period"}
             return PajakPlanner(PajakParameters(**settings), scenario.q_initial, update_period=config.update_period)
@@ -204,3 +226,46 @@ def _make_boryga_planner(scenario: Scenario, config: BorygaLoop):
         if limit.shape != (count,) or np.any(~(limit > 0)):
             raise ValueError(f"{name} must have {count} positive entries, got {limit.tolist()}")
     return BorygaLoopPlanner(law, velocity, acceleration)
+
+
+def _make_li_planner(scenario: Scenario, config: LiClosedPath):
+    from drake_traj import li_robot
+    from drake_traj.planners.li_joint import LiPathPlanner, plan_li_path
+
+    points = np.asarray(config.points, dtype=float).reshape(-1, 3) if config.points else li_robot.li_closed_path()
+    if scenario.robot == "ur10e":
+        q_initial = np.asarray(scenario.q_initial, dtype=float)
+        start = robot.task_pose(q_initial)
+        if not config.points:
+            points = points - points[0] + start[:3]
+
+        def ik(path):
+            poses = np.hstack([path, np.tile(start[3:], (len(path), 1))])
+            return robot.inverse_kinematics_path(poses, q_initial)
+
+        def tool_motion(q, qd, qdd):
+            _, jacobian, bias, _, _ = robot.ur10e_kinematics(q, qd)
+            return (np.einsum("nij,nj->ni", jacobian[:, :3], qd),
+                    np.einsum("nij,nj->ni", jacobian[:, :3], qdd) + bias[:, :3])
+
+        default_velocity = [robot.DEFAULT_JOINT_MOVE_VELOCITY] * robot.NUM_JOINTS
+        default_acceleration = [robot.DEFAULT_JOINT_MOVE_ACCELERATION] * robot.NUM_JOINTS
+    elif scenario.robot == "li_4dof":
+        arm = li_robot.LI_4DOF
+
+        def ik(path):
+            return arm.ik(path)
+
+        def tool_motion(q, qd, qdd):
+            jacobians = np.array([arm.jacobian(row) for row in q])
+            biases = np.array([arm.bias(row, rate) for row, rate in zip(q, qd)])
+            return np.einsum("nij,nj->ni", jacobians, qd), np.einsum("nij,nj->ni", jacobians, qdd) + biases
+
+        default_velocity, default_acceleration = arm.velocity_limits, arm.acceleration_limits
+    else:
+        raise ValueError(f"planner LiClosedPath runs on robot ur10e or li_4dof, not {scenario.robot!r}")
+    velocity = np.asarray(config.velocity_limit or default_velocity, dtype=float)
+    acceleration = np.asarray(config.acceleration_limit or default_acceleration, dtype=float)
+    tool_limits = (config.tool_velocity_limit, config.tool_acceleration_limit)
+    plan = plan_li_path(points, ik, tool_motion, velocity, acceleration, *tool_limits)
+    return LiPathPlanner(plan, velocity, acceleration, tool_motion, tool_limits)

@@ -32,7 +32,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
-from drake_traj.planners.li_lookahead import acc_dec_profile
+from drake_traj.planners.base import TimeLawPlanner
+from drake_traj.planners.li_lookahead import acc_dec_profile, plan_cartesian_path
 from drake_traj.validation import positive_scalar
 
 __all__ = [
@@ -725,3 +726,130 @@ def repair_time_stretch(
         iterations=iterations,
         global_fallback=fallback,
     )
+
+
+# --------------------------------------------------------------------------------------------
+# The whole planner: Cartesian stage -> IK -> re-timing -> spline -> repairs, and its system.
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class LiPlan:
+    """All stages of one seed-002 plan.
+
+    Attributes:
+        cartesian: the Cartesian stage (look-ahead and ACC/DEC on the tool path).
+        law: the final joint spline (joint and tool limits hold).
+        repair: the joint-limit repair's report (re-timed duration before, repaired after).
+        tool_stretch: the uniform time factor (>= 1) applied after the joint repair so the tool's
+            speed and acceleration, through FK, keep the tool limits.
+    """
+
+    cartesian: object
+    law: JointSplineLaw
+    repair: RepairReport
+    tool_stretch: float
+
+
+# The tool limits are checked on samples (not exact peaks like the joints'): this many per knot
+# interval, with this relative margin for what lies between them.
+TOOL_SAMPLES_PER_INTERVAL = 64
+TOOL_LIMIT_MARGIN = 2e-3
+
+
+def tool_speed_and_acceleration(law: JointSplineLaw, tool_motion, samples_per_interval: int = TOOL_SAMPLES_PER_INTERVAL):
+    """(t, |v|, |a|) of the tool [s, m/s, m/s^2] on ``samples_per_interval`` samples per knot
+    interval; ``tool_motion(q, qd, qdd) -> (v (N,3), a (N,3))`` is the robot's FK rates."""
+    knots = law.knot_times
+    fractions = np.linspace(0.0, 1.0, samples_per_interval, endpoint=False)
+    t = np.append((knots[:-1, None] + np.diff(knots)[:, None] * fractions).ravel(), knots[-1])
+    velocity, acceleration = tool_motion(*law.sample(t))
+    return t, np.linalg.norm(velocity, axis=1), np.linalg.norm(acceleration, axis=1)
+
+
+def plan_li_path(points, ik, tool_motion, velocity_limit, acceleration_limit, tool_velocity_limit,
+                 tool_acceleration_limit) -> LiPlan:
+    """Seed 002 end to end, with the joint and the tool limits kept.
+
+    1. Cartesian stage on ``points`` (N,3) [m] with the tool limits (eq. 1-13, Fig. 2);
+    2. ``ik(points) -> q (N, n)`` at the path points, timed by the Cartesian stage;
+    3. re-timing (eq. 14), quintic spline (eq. 15-22) and the local joint-limit repair
+       (:func:`repair_time_stretch`, exact joint peaks);
+    4. the tool limits through ``tool_motion`` (FK rates) on TOOL_SAMPLES_PER_INTERVAL samples per
+       knot interval, with TOOL_LIMIT_MARGIN: the
+       spline can run the tool too fast (ERRATA), so the whole motion is stretched uniformly by
+       k = max(peak speed / limit, sqrt(peak |a| / limit)), which scales tool speed by 1/k and
+       acceleration by 1/k^2 and only lowers the joint rates. (Stretching only the offending
+       intervals and refitting was tried: the uneven knots made the spline oscillate more and the
+       motion 2-3 times longer than the uniform stretch.)
+    """
+    cartesian = plan_cartesian_path(points, tool_velocity_limit, tool_acceleration_limit)
+    q = ik(cartesian.points)
+    times = retime_joint_samples(cartesian.segment_times, q, velocity_limit, acceleration_limit)
+    law, report = repair_time_stretch(times, q, velocity_limit, acceleration_limit)
+    _, speed, acceleration = tool_speed_and_acceleration(law, tool_motion)
+    ratio = max(speed.max() / tool_velocity_limit, np.sqrt(acceleration.max() / tool_acceleration_limit))
+    stretch = max(1.0, ratio / (1.0 - TOOL_LIMIT_MARGIN))
+    if stretch > 1.0:
+        law = JointSplineLaw(law.knot_times * stretch, law.samples)
+    return LiPlan(cartesian, law, report, stretch)
+
+
+class LiPathPlanner(TimeLawPlanner):
+    """Seed 002's planner under the contract: follows :attr:`LiPlan.law` on the scaled clock.
+
+    Args:
+        plan: from :func:`plan_li_path`.
+        velocity_limit, acceleration_limit: the joint limits the plan keeps.
+        tool_motion: the robot's FK rates, for the tool speed figure.
+        tool_limits: (speed [m/s], acceleration [m/s^2]) of the tool.
+    """
+
+    def __init__(self, plan: LiPlan, velocity_limit, acceleration_limit, tool_motion, tool_limits):
+        super().__init__(plan.law, velocity_limit, acceleration_limit)
+        self.li_plan = plan
+        self._tool_motion = tool_motion
+        self.tool_limits = tool_limits
+
+    def tool_statistics(self) -> dict:
+        """Tool speed and acceleration peaks and the share of time above 0.5 and 0.8 a_max
+        (the paper's efficiency figure), on dense samples."""
+        t, speed, acceleration = tool_speed_and_acceleration(self.law, self._tool_motion)
+        v_max, a_max = self.tool_limits
+        weights = np.gradient(t)
+        return {
+            "peak_speed": float(speed.max()),
+            "peak_acceleration": float(acceleration.max()),
+            "share_above_half_a_max": float(weights[acceleration > 0.5 * a_max].sum() / t[-1]),
+            "share_above_0.8_a_max": float(weights[acceleration > 0.8 * a_max].sum() / t[-1]),
+        }
+
+    def figures(self) -> dict:
+        from matplotlib.figure import Figure
+
+        cartesian = self.li_plan.cartesian
+        figure = Figure(figsize=(9, 8), layout="constrained")
+        path_ax, speed_ax, accel_ax = figure.subplots(3, 1)
+        length = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(cartesian.points, axis=0), axis=1))])
+        path_ax.plot(1e3 * length, 1e3 * cartesian.limits, label="break-point limit (eq. 4-7)")
+        path_ax.plot(1e3 * length, 1e3 * cartesian.velocities, label="after look-ahead (Fig. 2)")
+        path_ax.set_xlabel("path length [mm]")
+        path_ax.set_ylabel("speed [mm/s]")
+        t, speed, acceleration = tool_speed_and_acceleration(self.law, self._tool_motion)
+        v_max, a_max = self.tool_limits
+        speed_ax.plot(t, 1e3 * speed)
+        speed_ax.axhline(1e3 * v_max, color="grey", linestyle="--")
+        speed_ax.set_ylabel("tool speed [mm/s]")
+        accel_ax.plot(t, 1e3 * acceleration)
+        for level, style in ((1.0, "--"), (0.8, ":"), (0.5, ":")):
+            accel_ax.axhline(1e3 * level * a_max, color="grey", linestyle=style)
+        stats = self.tool_statistics()
+        accel_ax.set_title(
+            f"time above 0.5 a_max: {stats['share_above_half_a_max']:.1%}, "
+            f"above 0.8 a_max: {stats['share_above_0.8_a_max']:.1%}", fontsize="small")
+        accel_ax.set_ylabel("tool |a| [mm/s$^2$]")
+        accel_ax.set_xlabel("t [s] (executed motion)")
+        for ax in (path_ax, speed_ax, accel_ax):
+            ax.grid(True, alpha=0.3)
+        path_ax.legend(fontsize="small")
+        return {"tool_speed": figure}
