@@ -2,8 +2,8 @@
 
     python examples/bench_planner_cost.py [--repeats 5]
 
-For each scenario: the planner's CalcTimeDerivatives cost [µs] at mid-motion (median of 7
-batches of 500), the real-time factor of the planner alone under the Simulator, and of the
+For each scenario: the planner's cost per derivative evaluation [µs] at mid-motion (its
+``evaluate``, which the cached derivatives call once per new context; median of 7 batches of 500), the real-time factor of the planner alone under the Simulator, and of the
 closed-loop diagram (planner + PD-controlled plant + loggers), each the median of ``repeats``
 runs. Prints a Markdown table. A benchmark, not a test: numbers depend on the machine.
 """
@@ -21,18 +21,17 @@ SCENARIOS = (default_scenario_path().parent / "quintic_ptp.yaml", default_scenar
 
 
 def derivative_cost_us(scenario) -> float:
-    """Median µs of one CalcTimeDerivatives at the middle of the motion."""
+    """Median µs of one uncached evaluation (qdd and c) at the middle of the motion."""
     planner = make_planner(scenario)
     simulator = Simulator(planner)
     simulator.get_mutable_integrator().set_maximum_step_size(scenario.time_step)
     simulator.AdvanceTo(2.0)
     context = simulator.get_context()
-    derivatives = planner.AllocateTimeDerivatives()
     batches = []
     for _ in range(7):
         start = time.perf_counter()
         for _ in range(500):
-            planner.CalcTimeDerivatives(context, derivatives)
+            planner.evaluate(context)
         batches.append((time.perf_counter() - start) / 500 * 1e6)
     return statistics.median(batches)
 
