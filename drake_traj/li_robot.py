@@ -62,11 +62,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from importlib import resources
-from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
+
+from drake_traj.point_robot import PointRobot, format_point, joint_vectors, point_array, stack_columns
 
 __all__ = [
     "CARTESIAN_VELOCITY_LIMIT",
@@ -83,41 +83,10 @@ CARTESIAN_ACCELERATION_LIMIT = 0.1  # [m/s^2]
 
 _HALF_PI = 0.5 * math.pi
 _DOMAIN_TOL = 1e-12  # slack on the arccos argument (points exactly on the workspace boundary)
-_LIMIT_TOL = 1e-12  # slack on joint limits [rad]
 _AXIS_TOL = 1e-9  # points closer than this to the joint-1 axis have no defined q1 [m]
 _SINGULAR_TOL = 1e-9  # singularity measure below this: J singular
 
 NUM_JOINTS = 4
-
-
-def _positions(position) -> np.ndarray:
-    array = np.asarray(position, dtype=float)
-    if array.ndim == 0 or array.shape[-1] != 3:
-        raise ValueError(f"positions must have shape (..., 3) [m], got {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError("positions must be finite")
-    return array
-
-
-def _vectors(value, name: str, size: int) -> np.ndarray:
-    array = np.asarray(value, dtype=float)
-    if array.ndim == 0 or array.shape[-1] != size:
-        raise ValueError(f"{name} must have shape (..., {size}), got {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be finite")
-    return array
-
-
-def _joints(q, name: str = "q") -> np.ndarray:
-    return _vectors(q, name, NUM_JOINTS)
-
-
-def _fmt(point) -> str:
-    return "[" + ", ".join(f"{v:.6g}" for v in point) + "]"
-
-
-def _stack(columns) -> np.ndarray:
-    return np.stack(np.broadcast_arrays(*columns), axis=-1)
 
 
 def _wrap(angle):
@@ -126,7 +95,7 @@ def _wrap(angle):
 
 
 @dataclass(frozen=True)
-class Li4Dof:
+class Li4Dof(PointRobot):
     """The 4-DOF collaborative robot of seed 002 (Fig. 5). DH values (Table 3) in m and rad.
 
     Attributes:
@@ -177,14 +146,6 @@ class Li4Dof:
 
     # ---- limits --------------------------------------------------------------------------------
     @property
-    def lower_limits(self) -> np.ndarray:
-        return np.array(self.lower, dtype=float)
-
-    @property
-    def upper_limits(self) -> np.ndarray:
-        return np.array(self.upper, dtype=float)
-
-    @property
     def velocity_limits(self) -> np.ndarray:
         return np.array(self.velocity_limit, dtype=float)
 
@@ -196,26 +157,12 @@ class Li4Dof:
     def effort_limits(self) -> np.ndarray:
         return np.array(self.effort_limit, dtype=float)
 
-    def within_limits(self, q, tol: float = _LIMIT_TOL) -> np.ndarray:
-        """Whether each joint vector of ``q`` (..., 4) is within the position limits."""
-        q = _joints(q)
-        return np.all((q >= self.lower_limits - tol) & (q <= self.upper_limits + tol), axis=-1)
-
-    # ---- model file ----------------------------------------------------------------------------
-    def model_path(self) -> Path:
-        """Absolute path of the URDF shipped with the package (``models/li_4dof.urdf``)."""
-        path = Path(str(resources.files("drake_traj.models").joinpath(self.model_file)))
-        if not path.is_file():
-            raise ValueError(f"{self.name} model file not found: {path}")
-        return path
-
-    # ---- forward kinematics --------------------------------------------------------------------
     def fk_pose(self, q) -> np.ndarray:
         """Homogeneous transform of DH frame 4 (= URDF ``tool0``) in the base, shape (..., 4, 4).
 
         The plain product of the four standard DH matrices of Table 3.
         """
-        q = _joints(q)
+        q = joint_vectors(q, NUM_JOINTS)
         pose = np.broadcast_to(np.eye(4), q.shape[:-1] + (4, 4)).copy()
         for i in range(NUM_JOINTS):
             theta = q[..., i] + self.theta_offset[i]
@@ -232,7 +179,7 @@ class Li4Dof:
 
     def _planar(self, q):
         """Cumulative planar angles and the (u, w) terms of the arm plane."""
-        q = _joints(q)
+        q = joint_vectors(q, NUM_JOINTS)
         l2, l3, l4 = self.lengths
         phi2 = q[..., 1]
         phi3 = phi2 + q[..., 2]
@@ -247,11 +194,11 @@ class Li4Dof:
     def fk(self, q) -> np.ndarray:
         """Position of ``tool0`` in the base frame [m], shape (..., 3) (= fk_pose(q)[..., :3, 3])."""
         q, _, u, w = self._planar(q)
-        return _stack((u * np.cos(q[..., 0]), u * np.sin(q[..., 0]), w))
+        return stack_columns((u * np.cos(q[..., 0]), u * np.sin(q[..., 0]), w))
 
     def pitch(self, q) -> np.ndarray:
         """q2 + q3 + q4: the last link's angle from straight down in the arm plane [rad]."""
-        q = _joints(q)
+        q = joint_vectors(q, NUM_JOINTS)
         return q[..., 1] + q[..., 2] + q[..., 3]
 
     def jacobian(self, q) -> np.ndarray:
@@ -264,9 +211,9 @@ class Li4Dof:
         du3, dw3 = du4 - l3 * s3, dw4 + l3 * c3
         du2, dw2 = du3 - l2 * c2, dw3 - l2 * s2
         zero = np.zeros_like(u)
-        cols = [_stack((-s1 * u, c1 * u, zero))]
+        cols = [stack_columns((-s1 * u, c1 * u, zero))]
         for du, dw in ((du2, dw2), (du3, dw3), (du4, dw4)):
-            cols.append(_stack((c1 * du, s1 * du, dw)))
+            cols.append(stack_columns((c1 * du, s1 * du, dw)))
         return np.stack(cols, axis=-1)
 
     def task_jacobian(self, q) -> np.ndarray:
@@ -278,7 +225,7 @@ class Li4Dof:
     def bias(self, q, qd) -> np.ndarray:
         """dJ/dt(q, qd) qd: the tool acceleration when qdd = 0 [m/s^2], shape (..., 3)."""
         q, (s2, c2, s3, c3, s4, c4), u, _ = self._planar(q)
-        qd = _joints(qd, "qd")
+        qd = joint_vectors(qd, NUM_JOINTS, "qd")
         l2, l3, l4 = self.lengths
         c1, s1 = np.cos(q[..., 0]), np.sin(q[..., 0])
         w1 = qd[..., 0]
@@ -288,7 +235,7 @@ class Li4Dof:
         u_dot = -l2 * c2 * w2 - l3 * s3 * w3 + l4 * c4 * w4
         u_ddot = l2 * s2 * w2**2 - l3 * c3 * w3**2 - l4 * s4 * w4**2
         w_ddot = -l2 * c2 * w2**2 - l3 * s3 * w3**2 + l4 * c4 * w4**2
-        return _stack(
+        return stack_columns(
             (
                 -c1 * w1**2 * u - 2.0 * s1 * w1 * u_dot + c1 * u_ddot,
                 -s1 * w1**2 * u + 2.0 * c1 * w1 * u_dot + s1 * u_ddot,
@@ -344,76 +291,6 @@ class Li4Dof:
         q[bad_domain | on_axis] = np.nan
         return q, problems
 
-    def _solve(self, p: np.ndarray):
-        q, problems = self._ik_raw(p)
-        bad = {index for index, _ in problems}
-        lo, hi = self.lower_limits, self.upper_limits
-        for k in range(NUM_JOINTS):
-            beyond = (q[:, k] < lo[k] - _LIMIT_TOL) | (q[:, k] > hi[k] + _LIMIT_TOL)  # NaN: False
-            for index in np.flatnonzero(beyond):
-                index = int(index)
-                if index in bad:
-                    continue
-                bad.add(index)
-                problems.append(
-                    (index, f"{self.joint_names[k]} = {q[index, k]:.6g} rad is beyond its limits "
-                            f"[{lo[k]:.6g}, {hi[k]:.6g}] rad")
-                )
-        problems.sort(key=lambda item: item[0])
-        return q, problems
-
-    def _message(self, p, problems, label, times) -> str:
-        index, reason = problems[0]
-        at = "" if times is None else f" (t = {float(np.ravel(times)[index]):.6g} s)"
-        more = "" if len(problems) == 1 else f"; {len(problems)} of {len(p)} {label}s are out of reach"
-        return (
-            f"{label} {index}{at} at {_fmt(p[index])} m is out of reach of the {self.name} robot: "
-            f"{reason}{more}"
-        )
-
-    def reach_problems(self, positions) -> list[tuple[int, str]]:
-        """All out-of-reach points of ``positions`` (..., 3) as (flat index, reason), index order."""
-        return self._solve(_positions(positions).reshape(-1, 3))[1]
-
-    def is_reachable(self, positions) -> np.ndarray:
-        """Boolean array (...): True where :meth:`ik` has a solution within the joint limits."""
-        p = _positions(positions)
-        ok = np.ones(p.shape[:-1], dtype=bool).reshape(-1)
-        for index, _ in self._solve(p.reshape(-1, 3))[1]:
-            ok[index] = False
-        return ok.reshape(p.shape[:-1])
-
-    def reach_check(self, positions, label: str = "point", times=None) -> None:
-        """Raise ValueError for the first out-of-reach point of ``positions`` (..., 3).
-
-        The message names the robot, the point's flat index (and time, if ``times`` of the same
-        flat length is given), the point, the reason and how many points fail in all.
-        """
-        p = _positions(positions).reshape(-1, 3)
-        problems = self._solve(p)[1]
-        if problems:
-            raise ValueError(self._message(p, problems, label, times))
-
-    def ik(self, position, label: str = "point", times=None) -> np.ndarray:
-        """Closed-form inverse kinematics on the documented branch (module docstring).
-
-        Args:
-            position: tool positions [m], shape (..., 3).
-            label, times: only for the error message (see :meth:`reach_check`).
-
-        Returns:
-            Joint vectors [rad], shape (..., 4), with q2 + q3 + q4 = ``tool_pitch``.
-
-        Raises:
-            ValueError: a point out of reach (index and reason in the message).
-        """
-        p = _positions(position)
-        flat = p.reshape(-1, 3)
-        q, problems = self._solve(flat)
-        if problems:
-            raise ValueError(self._message(flat, problems, label, times))
-        return q.reshape(p.shape[:-1] + (NUM_JOINTS,))
-
     # ---- rates ---------------------------------------------------------------------------------
     def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
         """Joint velocity and acceleration from the tool velocity ``v`` and acceleration ``a``.
@@ -430,9 +307,9 @@ class Li4Dof:
         Raises:
             ValueError: the Jacobian singular at some point (index named).
         """
-        q = _joints(q)
-        v = _positions(v)
-        a = _positions(a)
+        q = joint_vectors(q, NUM_JOINTS)
+        v = point_array(v)
+        a = point_array(a)
         lead = np.broadcast_shapes(q.shape[:-1], v.shape[:-1], a.shape[:-1])
         q = np.broadcast_to(q, lead + (4,)).reshape(-1, 4)
         v = np.broadcast_to(v, lead + (3,)).reshape(-1, 3)
@@ -442,7 +319,7 @@ class Li4Dof:
         if singular.size:
             index = int(singular[0])
             raise ValueError(
-                f"point {index} at q = {_fmt(q[index])}: the {self.name} robot's Jacobian is singular "
+                f"point {index} at q = {format_point(q[index])}: the {self.name} robot's Jacobian is singular "
                 f"(singularity measure {measure[index]:.3g}), joint rates are undefined"
             )
         jac = self.task_jacobian(q)

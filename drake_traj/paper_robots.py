@@ -43,11 +43,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from importlib import resources
-from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
+
+from drake_traj.point_robot import LIMIT_TOL, PointRobot, format_point, joint_vectors, stack_columns
 
 __all__ = [
     "ROBOT_NAMES",
@@ -63,176 +63,16 @@ __all__ = [
 
 ROBOT_NAMES = ("anthropomorphic", "scara", "cartesian")
 
-# Slack on the arccos argument (points exactly on the workspace boundary) and on joint limits.
+# Slack on the arccos argument (points exactly on the workspace boundary).
 _DOMAIN_TOL = 1e-12
-_LIMIT_TOL = 1e-12
 # Points closer than this to the anthropomorphic arm's joint-1 axis have no defined theta1 [m].
 _AXIS_TOL = 1e-9
 # Jacobians with a singularity measure (in [0, 1]) below this are treated as singular.
 _SINGULAR_TOL = 1e-9
 
 
-def _positions(position) -> np.ndarray:
-    array = np.asarray(position, dtype=float)
-    if array.ndim == 0 or array.shape[-1] != 3:
-        raise ValueError(f"positions must have shape (..., 3) [m], got {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError("positions must be finite")
-    return array
-
-
-def _joints(q, name: str = "q") -> np.ndarray:
-    array = np.asarray(q, dtype=float)
-    if array.ndim == 0 or array.shape[-1] != 3:
-        raise ValueError(f"{name} must have shape (..., 3), got {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be finite")
-    return array
-
-
-def _fmt(point) -> str:
-    return "[" + ", ".join(f"{v:.6g}" for v in point) + "]"
-
-
-def _stack(columns) -> np.ndarray:
-    return np.stack(np.broadcast_arrays(*columns), axis=-1)
-
-
-class _PaperRobot:
-    """Shared behaviour; subclasses are frozen dataclasses with the dimensions and limits."""
-
-    name: ClassVar[str]
-    model_file: ClassVar[str]
-    joint_names: ClassVar[tuple[str, str, str]]
-    joint_types: ClassVar[tuple[str, str, str]]  # "revolute" [rad] or "prismatic" [m]
-    lower: tuple[float, float, float]
-    upper: tuple[float, float, float]
-    velocity_limit: tuple[float, float, float]
-    effort_limit: tuple[float, float, float]
-
-    base_frame: ClassVar[str] = "base"
-    tool_frame: ClassVar[str] = "tool0"
-
-    # ---- model file -------------------------------------------------------------------------
-    def model_path(self) -> Path:
-        """Absolute path of the robot's URDF shipped with the package (``models/<model_file>``)."""
-        path = Path(str(resources.files("drake_traj.models").joinpath(self.model_file)))
-        if not path.is_file():
-            raise ValueError(f"{self.name} model file not found: {path}")
-        return path
-
-    # ---- per-robot kinematics (subclasses) --------------------------------------------------
-    def fk(self, q) -> np.ndarray:  # pragma: no cover - abstract
-        """Position of ``tool0`` in the base frame [m], shape (..., 3)."""
-        raise NotImplementedError
-
-    def jacobian(self, q) -> np.ndarray:  # pragma: no cover - abstract
-        """J(q) = d fk / dq, shape (..., 3, 3)."""
-        raise NotImplementedError
-
-    def bias(self, q, qd) -> np.ndarray:  # pragma: no cover - abstract
-        """dJ/dt(q, qd) qd: the tool acceleration when qdd = 0 [m/s^2], shape (..., 3)."""
-        raise NotImplementedError
-
-    def singularity_measure(self, q) -> np.ndarray:  # pragma: no cover - abstract
-        """In [0, 1]; zero exactly where J(q) is singular."""
-        raise NotImplementedError
-
-    def _ik_raw(self, p: np.ndarray):  # pragma: no cover - abstract
-        """(q, reasons): IK of (N, 3) points with NaN rows where the closed form has no solution,
-        and a list of (index, reason) for the domain errors found."""
-        raise NotImplementedError
-
-    # ---- limits ------------------------------------------------------------------------------
-    @property
-    def lower_limits(self) -> np.ndarray:
-        return np.array(self.lower, dtype=float)
-
-    @property
-    def upper_limits(self) -> np.ndarray:
-        return np.array(self.upper, dtype=float)
-
-    def within_limits(self, q, tol: float = _LIMIT_TOL) -> np.ndarray:
-        """Whether each joint vector of ``q`` (..., 3) is within the position limits."""
-        q = _joints(q)
-        return np.all((q >= self.lower_limits - tol) & (q <= self.upper_limits + tol), axis=-1)
-
-    def _unit(self, k: int) -> str:
-        return "rad" if self.joint_types[k] == "revolute" else "m"
-
-    # ---- inverse kinematics -------------------------------------------------------------------
-    def reach_problems(self, positions) -> list[tuple[int, str]]:
-        """All out-of-reach points of ``positions`` (..., 3) as (flat index, reason), index order."""
-        p = _positions(positions).reshape(-1, 3)
-        return self._solve(p)[1]
-
-    def is_reachable(self, positions) -> np.ndarray:
-        """Boolean array (...) : True where :meth:`ik` has a solution within the joint limits."""
-        p = _positions(positions)
-        ok = np.ones(p.shape[:-1], dtype=bool).reshape(-1)
-        for index, _ in self._solve(p.reshape(-1, 3))[1]:
-            ok[index] = False
-        return ok.reshape(p.shape[:-1])
-
-    def reach_check(self, positions, label: str = "point", times=None) -> None:
-        """Raise ValueError for the first out-of-reach point of ``positions`` (..., 3).
-
-        The message names the robot, the point's flat index (and time, if ``times`` of the same
-        flat length is given), the point, the reason and how many points fail in all.
-        """
-        p = _positions(positions).reshape(-1, 3)
-        problems = self._solve(p)[1]
-        if problems:
-            raise ValueError(self._message(p, problems, label, times))
-
-    def _message(self, p, problems, label, times) -> str:
-        index, reason = problems[0]
-        at = "" if times is None else f" (t = {float(np.ravel(times)[index]):.6g} s)"
-        more = "" if len(problems) == 1 else f"; {len(problems)} of {len(p)} {label}s are out of reach"
-        return (
-            f"{label} {index}{at} at {_fmt(p[index])} m is out of reach of the {self.name} robot: "
-            f"{reason}{more}"
-        )
-
-    def _solve(self, p: np.ndarray):
-        q, problems = self._ik_raw(p)
-        bad = {index for index, _ in problems}
-        lo, hi = self.lower_limits, self.upper_limits
-        for k in range(3):
-            beyond = (q[:, k] < lo[k] - _LIMIT_TOL) | (q[:, k] > hi[k] + _LIMIT_TOL)  # NaN: False
-            outside = np.flatnonzero(beyond)
-            for index in outside:
-                index = int(index)
-                if index in bad:
-                    continue
-                bad.add(index)
-                unit = self._unit(k)
-                problems.append(
-                    (index, f"{self.joint_names[k]} = {q[index, k]:.6g} {unit} is beyond its limits "
-                            f"[{lo[k]:.6g}, {hi[k]:.6g}] {unit}")
-                )
-        problems.sort(key=lambda item: item[0])
-        return q, problems
-
-    def ik(self, position, label: str = "point", times=None) -> np.ndarray:
-        """Closed-form inverse kinematics (eq. 18-20, 24-26 with the ERRATA fix, 30-32).
-
-        Args:
-            position: tool positions [m], shape (..., 3).
-            label, times: only for the error message (see :meth:`reach_check`).
-
-        Returns:
-            Joint vectors, shape (..., 3), on the branch documented in the module docstring.
-
-        Raises:
-            ValueError: a point out of reach (index and reason in the message).
-        """
-        p = _positions(position)
-        flat = p.reshape(-1, 3)
-        q, problems = self._solve(flat)
-        if problems:
-            raise ValueError(self._message(flat, problems, label, times))
-        return q.reshape(p.shape)
+class _PaperRobot(PointRobot):
+    """Seed 001's robots: three joints placing a point; adds the rates along a tool motion."""
 
     # ---- rates -------------------------------------------------------------------------------
     def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
@@ -243,9 +83,9 @@ class _PaperRobot:
         Raises:
             ValueError: J(q) singular at some point (index named).
         """
-        q = _joints(q)
-        v = _joints(v, "v")
-        a = _joints(a, "a")
+        q = joint_vectors(q, 3)
+        v = joint_vectors(v, 3, "v")
+        a = joint_vectors(a, 3, "a")
         shape = np.broadcast_shapes(q.shape, v.shape, a.shape)
         q, v, a = (np.broadcast_to(x, shape).reshape(-1, 3) for x in (q, v, a))
         measure = np.broadcast_to(self.singularity_measure(q), (len(q),))
@@ -253,7 +93,7 @@ class _PaperRobot:
         if singular.size:
             index = int(singular[0])
             raise ValueError(
-                f"point {index} at q = {_fmt(q[index])}: the {self.name} robot's Jacobian is singular "
+                f"point {index} at q = {format_point(q[index])}: the {self.name} robot's Jacobian is singular "
                 f"(singularity measure {measure[index]:.3g}), joint rates are undefined"
             )
         jac = np.broadcast_to(self.jacobian(q), (len(q), 3, 3))
@@ -303,7 +143,7 @@ class AnthropomorphicArm(_PaperRobot):
         return self.l2 + self.l3
 
     def _terms(self, q):
-        q = _joints(q)
+        q = joint_vectors(q, 3)
         t1, t2, t3 = q[..., 0], q[..., 1], q[..., 2]
         c1, s1 = np.cos(t1), np.sin(t1)
         c2, s2 = np.cos(t2), np.sin(t2)
@@ -315,25 +155,25 @@ class AnthropomorphicArm(_PaperRobot):
     def fk(self, q) -> np.ndarray:
         """Eq. 15-17: s = (c1 (l2 c2 + l3 c23), s1 (l2 c2 + l3 c23), lambda1 + l2 s2 + l3 s23)."""
         c1, s1, _, _, _, _, r, h = self._terms(q)
-        return _stack((c1 * r, s1 * r, self.lambda1 + h))
+        return stack_columns((c1 * r, s1 * r, self.lambda1 + h))
 
     def jacobian(self, q) -> np.ndarray:
         c1, s1, _, _, c23, s23, r, h = self._terms(q)
         zero = np.zeros_like(r)
-        col1 = _stack((-s1 * r, c1 * r, zero))
-        col2 = _stack((-c1 * h, -s1 * h, r))
-        col3 = _stack((-c1 * self.l3 * s23, -s1 * self.l3 * s23, self.l3 * c23))
+        col1 = stack_columns((-s1 * r, c1 * r, zero))
+        col2 = stack_columns((-c1 * h, -s1 * h, r))
+        col3 = stack_columns((-c1 * self.l3 * s23, -s1 * self.l3 * s23, self.l3 * c23))
         return np.stack((col1, col2, col3), axis=-1)
 
     def bias(self, q, qd) -> np.ndarray:
         c1, s1, c2, s2, c23, s23, r, _ = self._terms(q)
-        qd = _joints(qd, "qd")
+        qd = joint_vectors(qd, 3, "qd")
         w1, w2 = qd[..., 0], qd[..., 1]
         w23 = qd[..., 1] + qd[..., 2]
         r_dot = -self.l2 * s2 * w2 - self.l3 * s23 * w23
         r_ddot = -self.l2 * c2 * w2**2 - self.l3 * c23 * w23**2  # with qdd = 0
         h_ddot = -self.l2 * s2 * w2**2 - self.l3 * s23 * w23**2
-        return _stack(
+        return stack_columns(
             (
                 -c1 * w1**2 * r - 2.0 * s1 * w1 * r_dot + c1 * r_ddot,
                 -s1 * w1**2 * r + 2.0 * c1 * w1 * r_dot + s1 * r_ddot,
@@ -343,7 +183,7 @@ class AnthropomorphicArm(_PaperRobot):
 
     def singularity_measure(self, q) -> np.ndarray:
         """min(|r| / (l2 + l3), |sin theta3|): det J = -l2 l3 r sin(theta3)."""
-        q = _joints(q)
+        q = joint_vectors(q, 3)
         _, _, _, _, _, _, r, _ = self._terms(q)
         return np.minimum(np.abs(r) / self.reach, np.abs(np.sin(q[..., 2])))
 
@@ -415,9 +255,9 @@ class ScaraArm(_PaperRobot):
 
     def fk(self, q) -> np.ndarray:
         """Eq. 21-23: s = (l1 c1 + l2 c12, l1 s1 + l2 s12, lambda1 + lambda2 - lambda3)."""
-        q = _joints(q)
+        q = joint_vectors(q, 3)
         t1, t12 = q[..., 0], q[..., 0] + q[..., 1]
-        return _stack(
+        return stack_columns(
             (
                 self.l1 * np.cos(t1) + self.l2 * np.cos(t12),
                 self.l1 * np.sin(t1) + self.l2 * np.sin(t12),
@@ -426,21 +266,21 @@ class ScaraArm(_PaperRobot):
         )
 
     def jacobian(self, q) -> np.ndarray:
-        q = _joints(q)
+        q = joint_vectors(q, 3)
         t1, t12 = q[..., 0], q[..., 0] + q[..., 1]
         c1, s1, c12, s12 = np.cos(t1), np.sin(t1), np.cos(t12), np.sin(t12)
         zero = np.zeros_like(t1)
-        col1 = _stack((-self.l1 * s1 - self.l2 * s12, self.l1 * c1 + self.l2 * c12, zero))
-        col2 = _stack((-self.l2 * s12, self.l2 * c12, zero))
-        col3 = _stack((zero, zero, zero - 1.0))
+        col1 = stack_columns((-self.l1 * s1 - self.l2 * s12, self.l1 * c1 + self.l2 * c12, zero))
+        col2 = stack_columns((-self.l2 * s12, self.l2 * c12, zero))
+        col3 = stack_columns((zero, zero, zero - 1.0))
         return np.stack((col1, col2, col3), axis=-1)
 
     def bias(self, q, qd) -> np.ndarray:
-        q = _joints(q)
-        qd = _joints(qd, "qd")
+        q = joint_vectors(q, 3)
+        qd = joint_vectors(qd, 3, "qd")
         t1, t12 = q[..., 0], q[..., 0] + q[..., 1]
         w1, w12 = qd[..., 0], qd[..., 0] + qd[..., 1]
-        return _stack(
+        return stack_columns(
             (
                 -self.l1 * np.cos(t1) * w1**2 - self.l2 * np.cos(t12) * w12**2,
                 -self.l1 * np.sin(t1) * w1**2 - self.l2 * np.sin(t12) * w12**2,
@@ -450,7 +290,7 @@ class ScaraArm(_PaperRobot):
 
     def singularity_measure(self, q) -> np.ndarray:
         """|sin theta2|: det J = -l1 l2 sin(theta2) (arm stretched or folded)."""
-        return np.abs(np.sin(_joints(q)[..., 1]))
+        return np.abs(np.sin(joint_vectors(q, 3)[..., 1]))
 
     def _ik_raw(self, p):
         x, y, z = p[:, 0], p[:, 1], p[:, 2]
@@ -471,7 +311,7 @@ class ScaraArm(_PaperRobot):
                 f"|l1 - l2| = {abs(self.l1 - self.l2):.6g} m (arccos argument of eq. 25 = "
                 f"{arg2[index]:.6g} < -1)")))
         bad_domain = np.abs(arg2) > 1.0 + _DOMAIN_TOL
-        negative = (stroke < -_LIMIT_TOL) & ~bad_domain
+        negative = (stroke < -LIMIT_TOL) & ~bad_domain
         for index in np.flatnonzero(negative):
             problems.append((int(index), (
                 f"negative stroke lambda3 = {stroke[index]:.6g} m (eq. 26): s_z = {z[index]:.6g} m is "
@@ -513,18 +353,18 @@ class CartesianRobot(_PaperRobot):
 
     def fk(self, q) -> np.ndarray:
         """Eq. 27-29: s = (-lambda3, lambda2, lambda1 + l2)."""
-        q = _joints(q)
-        return _stack((-q[..., 2], q[..., 1], q[..., 0] + self.l2))
+        q = joint_vectors(q, 3)
+        return stack_columns((-q[..., 2], q[..., 1], q[..., 0] + self.l2))
 
     def jacobian(self, q) -> np.ndarray:
-        q = _joints(q)
+        q = joint_vectors(q, 3)
         return np.broadcast_to(_CARTESIAN_J, q.shape[:-1] + (3, 3)).copy()
 
     def bias(self, q, qd) -> np.ndarray:
-        return np.zeros(np.broadcast_shapes(_joints(q).shape, _joints(qd, "qd").shape))
+        return np.zeros(np.broadcast_shapes(joint_vectors(q, 3).shape, joint_vectors(qd, 3, "qd").shape))
 
     def singularity_measure(self, q) -> np.ndarray:
-        return np.ones(_joints(q).shape[:-1])
+        return np.ones(joint_vectors(q, 3).shape[:-1])
 
     def _ik_raw(self, p):
         # eq. 30-32; only the joint ranges can put a point out of reach.

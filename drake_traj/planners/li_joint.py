@@ -34,7 +34,6 @@ from scipy.interpolate import BSpline, make_interp_spline
 
 from drake_traj.planners.base import TimeLawPlanner
 from drake_traj.planners.li_lookahead import acc_dec_profile, plan_cartesian_path
-from drake_traj.validation import positive_scalar
 
 __all__ = [
     "JointSplineLaw",
