@@ -13,7 +13,6 @@ import re
 
 import numpy as np
 import pytest
-from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
