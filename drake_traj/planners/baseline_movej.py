@@ -1,0 +1,346 @@
+"""UR-style "MoveJ" with radius blending: the baseline of seed 000's experiment 1.
+
+Seed 000 (Pająk 2024), experiment 1, ran its task on the real UR10e with the controller's own
+"MoveJ" command between the waypoints, with the default joint limits 1.05 rad/s and 1.40 rad/s^2
+and "radius blending" of 0.05 m around each waypoint so the robot does not stop there. The paper
+reports that the controller respects the acceleration limit between the waypoints but exceeds it
+in the blends: up to 2.48 rad/s^2 against 1.40 (its Table 3 and Fig. 19).
+
+UR does not publish its controller, so this module implements an APPROXIMATION of it, built from
+UR's own description of MoveJ and of blending:
+
+1. Segments. Joint waypoints q_0..q_m give m segments q_k -> q_{k+1}. Each segment follows a
+   synchronised trapezoidal velocity profile q(tau) = q_k + s(tau) D_k, D_k = q_{k+1} - q_k, with
+   one normalised profile s: [0, T_k] -> [0, 1] shared by all joints. s is the time-optimal
+   trapezoid (triangle if the cruise speed is not reached) under ds/dt <= min_j v_j / |D_kj| and
+   |d2s/dt2| <= min_j a_j / |D_kj|. With equal limits on all joints this is exactly "the leading
+   axis (the one with the longest minimum time, i.e. the largest |D_kj|) runs at its velocity and
+   acceleration limit, the others are scaled to finish together"; with per-joint limits the
+   constraining joint reaches its limit and no joint exceeds its own.
+2. Blends. With radius r > 0, around every intermediate waypoint q_k (0 < k < m) the next segment
+   starts before the current one ends, while the TCP (here: the flange origin, as in seed 000) is
+   within r of the waypoint's TCP position p_k. On segment k-1 the TCP enters the sphere at local
+   time tau_in (last time with |p(q) - p_k| = r, found by FK sampling and bisection); on segment k
+   it leaves the sphere at tau_out (first such time). The overlap lasts
+   delta_k = min(T_{k-1} - tau_in, tau_out) (the shorter of the two in-sphere times) and segment k
+   starts at t_k = t_{k-1} + T_{k-1} - delta_k.
+3. Superposition. Over the whole motion q(t) = q_0 + sum_k s_k(t - t_k) D_k (each s_k held at 0
+   before and at 1 after its segment), so in an overlap the joint velocities and accelerations of
+   the two segments add. The leaving segment decelerates at the limit while the next accelerates
+   at the limit; where a joint reverses direction the two add to up to twice the limit. That is
+   the flaw the paper measured: the joint-space blend exceeds the acceleration (and may exceed the
+   velocity) limit. Position stays C^1 and the blended TCP path stays near the waypoint but does
+   not pass through it.
+
+The TCP does not move along a straight line (this is a joint move), and the real controller's
+blend shape, its handling of the speed in the blend and its radius reduction are not modelled.
+Blend spheres of consecutive waypoints (including the first and last point) must not overlap:
+like UR's controller, which refuses overlapping blends, a radius of half a waypoint distance or
+more raises ValueError.
+
+Consecutive identical waypoints are dropped (no zero-length segments).
+"""
+
+from __future__ import annotations
+
+from bisect import bisect_right
+
+import numpy as np
+
+from drake_traj import robot
+from drake_traj.planners.base import TimeLawPlanner
+
+__all__ = [
+    "MovejBlendLaw",
+    "MovejPlanner",
+    "paper_task_joint_waypoints",
+    "trapezoid_profile",
+]
+
+_SAMPLES_PER_SEGMENT = 200  # FK samples for locating the sphere crossings (then bisection)
+_BISECTION_STEPS = 60
+
+
+def _limit_vector(value, name: str, n: int) -> np.ndarray:
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be a number or {n} numbers: {exc}") from exc
+    if array.ndim == 0:
+        array = np.full(n, float(array))
+    if array.shape != (n,):
+        raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
+    if not np.all(np.isfinite(array)) or np.any(array <= 0.0):
+        raise ValueError(f"{name} must be finite and > 0, got {array.tolist()}")
+    return array
+
+
+def _flange_position(q) -> np.ndarray:
+    return robot.flange_pose(q)[:3, 3]
+
+
+def trapezoid_profile(tau, ta: float, duration: float, accel: float):
+    """Normalised trapezoidal profile s(tau) on [0, duration] and its time derivatives.
+
+    Accelerates at ``accel`` for ``ta`` seconds, cruises at accel * ta, decelerates at ``accel``
+    over the last ``ta`` seconds (ta = duration / 2 for a triangle); s(0) = 0, s(duration) = 1.
+    s is held at 0 before and at 1 from ``duration`` on, with zero derivatives: the profile is
+    half-open, [0, duration), so at a stop between two segments only the next one is active.
+
+    Returns:
+        (s, ds/dt, d2s/dt2), arrays of the shape of ``tau``.
+    """
+    tau = np.asarray(tau, dtype=float)
+    u = duration - tau
+    speed = accel * ta
+    accelerating = (tau >= 0.0) & (tau < ta)
+    decelerating = (tau >= duration - ta) & (u > 0.0) & ~accelerating
+    cruising = (tau >= ta) & (tau < duration - ta)
+    s = np.where(
+        tau <= 0.0,
+        0.0,
+        np.where(
+            accelerating,
+            0.5 * accel * tau**2,
+            np.where(cruising, 0.5 * accel * ta**2 + speed * (tau - ta), np.where(u > 0.0, 1.0 - 0.5 * accel * u**2, 1.0)),
+        ),
+    )
+    sd = np.where(accelerating, accel * tau, np.where(cruising, speed, np.where(decelerating, accel * u, 0.0)))
+    sdd = np.where(accelerating, accel, np.where(decelerating, -accel, 0.0))
+    return s, sd, sdd
+
+
+class MovejBlendLaw:
+    """UR-style MoveJ through joint waypoints with radius blending, as a time law (module doc).
+
+    Args:
+        q_waypoints: joint waypoints q_0..q_m [rad], shape (m + 1, n), m >= 1; q_0 is the start.
+        velocity_limit: joint speed limit [rad/s], > 0, scalar or shape (n,).
+        acceleration_limit: joint acceleration limit [rad/s^2], > 0, scalar or shape (n,).
+        blend_radius: r [m] >= 0 around every intermediate waypoint's TCP position; 0 stops at
+            every waypoint.
+        tcp_position: callable q -> TCP position (3,) [m]; default the UR10e flange origin
+            (requires n = 6 when r > 0).
+
+    Attributes:
+        q_start, q_goal (n,), duration [s], q_waypoints (m + 1, n), segment_starts (m,),
+        segment_durations (m,), blend_overlaps (m - 1,) [s] (delta_k, 0 without blending).
+    """
+
+    def __init__(self, q_waypoints, velocity_limit, acceleration_limit, blend_radius: float = 0.0, *, tcp_position=None):
+        try:
+            waypoints = np.array(q_waypoints, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"q_waypoints must be an (m + 1, n) array of joint positions: {exc}") from exc
+        if waypoints.ndim != 2 or waypoints.shape[0] < 2 or waypoints.shape[1] < 1:
+            raise ValueError(f"q_waypoints must have shape (m + 1, n) with m >= 1, n >= 1, got shape {waypoints.shape}")
+        if not np.all(np.isfinite(waypoints)):
+            raise ValueError("q_waypoints must be finite")
+        n = waypoints.shape[1]
+        self.num_joints = n
+        self.velocity_limit = _limit_vector(velocity_limit, "velocity_limit", n)
+        self.acceleration_limit = _limit_vector(acceleration_limit, "acceleration_limit", n)
+        try:
+            radius = float(blend_radius)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"blend_radius must be a number of metres: {exc}") from exc
+        if not np.isfinite(radius) or radius < 0.0:
+            raise ValueError(f"blend_radius must be finite and >= 0 [m], got {blend_radius}")
+        self.blend_radius = radius
+        if tcp_position is None:
+            if radius > 0.0 and n != robot.NUM_JOINTS:
+                raise ValueError(f"tcp_position is required for blending with n = {n} joints (the default is the UR10e flange)")
+            tcp_position = _flange_position
+        self._tcp = tcp_position
+
+        keep = np.concatenate([[True], np.any(np.diff(waypoints, axis=0) != 0.0, axis=1)])
+        waypoints = waypoints[keep]
+        self.q_waypoints = waypoints
+        self.q_start = waypoints[0].copy()
+        self.q_goal = waypoints[-1].copy()
+        displacements = np.diff(waypoints, axis=0)  # D_k, (m, n)
+        m = len(displacements)
+
+        # Per segment: the normalised trapezoid (accel A, ramp time ta, duration T).
+        accels, ramps, durations = [], [], []
+        for d in displacements:
+            size = np.abs(d)
+            moving = size > 0.0
+            vs = np.min(self.velocity_limit[moving] / size[moving])
+            acs = np.min(self.acceleration_limit[moving] / size[moving])
+            if vs * vs / acs < 1.0:  # the cruise speed is reached: trapezoid
+                ta = vs / acs
+                duration = 1.0 / vs + ta
+            else:  # triangle
+                ta = np.sqrt(1.0 / acs)
+                duration = 2.0 * ta
+            accels.append(float(acs))
+            ramps.append(float(ta))
+            durations.append(float(duration))
+
+        overlaps = np.zeros(max(m - 1, 0))
+        if radius > 0.0 and m >= 1:
+            points = np.array([self._tcp(q) for q in waypoints])
+            gaps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+            if np.any(2.0 * radius >= gaps):
+                k = int(np.argmin(gaps))
+                raise ValueError(
+                    f"blend_radius = {radius} m is too large: the TCP positions of waypoints {k} and {k + 1} are "
+                    f"{gaps[k]:.4f} m apart, blend spheres must not overlap (radius < {0.5 * gaps.min():.4f} m)"
+                )
+            for k in range(1, m):
+                tau_in = self._sphere_crossing(k - 1, points[k], last=True, ramps=ramps, accels=accels, durations=durations)
+                tau_out = self._sphere_crossing(k, points[k], last=False, ramps=ramps, accels=accels, durations=durations)
+                overlaps[k - 1] = min(durations[k - 1] - tau_in, tau_out)
+
+        starts = np.zeros(m)
+        for k in range(1, m):
+            starts[k] = starts[k - 1] + durations[k - 1] - overlaps[k - 1]
+        self.displacements = displacements
+        self.segment_starts = starts
+        self.segment_durations = np.array(durations)
+        self.segment_ramps = np.array(ramps)
+        self.segment_accels = np.array(accels)
+        self.blend_overlaps = overlaps
+        self.duration = float(starts[-1] + durations[-1]) if m else 0.0
+        # Plain-Python copies for the scalar hot path.
+        self._starts = starts.tolist()
+        self._ends = (starts + self.segment_durations).tolist()
+        self._ramps = ramps
+        self._accels = accels
+        self._durations = durations
+        self._d = [d.copy() for d in displacements]
+        self._zero = np.zeros(n)
+
+    def _sphere_crossing(self, k, centre, *, last, ramps, accels, durations):
+        """Local time on segment k where |tcp - centre| = r: the last (entering) or first (leaving)."""
+        q0, d, r = self.q_waypoints[k], self.q_waypoints[k + 1] - self.q_waypoints[k], self.blend_radius
+
+        def distance(tau):
+            s, _, _ = trapezoid_profile(tau, ramps[k], durations[k], accels[k])
+            return float(np.linalg.norm(self._tcp(q0 + float(s) * d) - centre))
+
+        taus = np.linspace(0.0, durations[k], _SAMPLES_PER_SEGMENT + 1)
+        outside = np.array([distance(t) >= r for t in taus])
+        if last:  # the segment ends at the centre (inside); last sample outside, then bisect forwards
+            index = np.flatnonzero(outside)
+            if not len(index):
+                return 0.0
+            lo, hi = taus[index[-1]], taus[min(index[-1] + 1, len(taus) - 1)]
+            inside_at_hi = True
+        else:  # the segment starts at the centre; first sample outside, bisect backwards
+            index = np.flatnonzero(outside)
+            if not len(index):
+                return durations[k]
+            lo, hi = taus[max(index[0] - 1, 0)], taus[index[0]]
+            inside_at_hi = False
+        for _ in range(_BISECTION_STEPS):
+            mid = 0.5 * (lo + hi)
+            if (distance(mid) < r) == inside_at_hi:
+                hi = mid
+            else:
+                lo = mid
+        return 0.5 * (lo + hi)
+
+    # --- evaluation ----------------------------------------------------------------------------
+    def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """(qd [rad/s], qdd [rad/s^2]) at law time ``tau`` [s]: the planner's hot path.
+
+        At most two segments are active at once (blend spheres do not overlap), so this checks the
+        segment that started last before ``tau`` and its predecessor.
+        """
+        k = bisect_right(self._starts, tau) - 1
+        if k < 0:
+            return self._zero.copy(), self._zero.copy()
+        qd = None
+        qdd = None
+        for j in (k - 1, k) if k > 0 else (k,):
+            local = tau - self._starts[j]
+            duration = self._durations[j]
+            if local < 0.0 or local >= duration:  # segments are half-open [t_k, t_k + T_k)
+                continue
+            ta, acc = self._ramps[j], self._accels[j]
+            if local < ta:
+                sd, sdd = acc * local, acc
+            elif local < duration - ta:
+                sd, sdd = acc * ta, 0.0
+            else:
+                sd, sdd = acc * (duration - local), -acc
+            d = self._d[j]
+            if qd is None:
+                qd, qdd = sd * d, sdd * d
+            else:
+                qd = qd + sd * d
+                qdd = qdd + sdd * d
+        if qd is None:
+            return self._zero.copy(), self._zero.copy()
+        return qd, qdd
+
+    def sample(self, t):
+        """(q [rad], qd [rad/s], qdd [rad/s^2]) at law times ``t`` [s], each of shape t.shape + (n,).
+
+        q = q_0 + sum_k s_k(t - t_k) D_k (superposed segments); before 0 the law rests at q_0, after
+        its duration at the last waypoint.
+        """
+        t = np.asarray(t, dtype=float)
+        flat = t.reshape(-1)
+        q = np.tile(self.q_start, (len(flat), 1))
+        qd = np.zeros_like(q)
+        qdd = np.zeros_like(q)
+        for k, d in enumerate(self.displacements):
+            s, sd, sdd = trapezoid_profile(
+                flat - self.segment_starts[k], self.segment_ramps[k], self.segment_durations[k], self.segment_accels[k]
+            )
+            q += s[:, None] * d
+            qd += sd[:, None] * d
+            qdd += sdd[:, None] * d
+        if len(self.displacements):
+            q[flat >= self.duration] = self.q_goal  # exact end (no rounding of the sum)
+        shape = t.shape + (self.num_joints,)
+        return q.reshape(shape), qd.reshape(shape), qdd.reshape(shape)
+
+    def blend_intervals(self) -> np.ndarray:
+        """(start, end) law times [s] of the overlaps, shape (m - 1, 2); start == end without blending."""
+        ends = self.segment_starts[:-1] + self.segment_durations[:-1]
+        return np.stack([ends - self.blend_overlaps, ends], axis=1) if len(ends) else np.zeros((0, 2))
+
+    def tcp_positions(self) -> np.ndarray:
+        """TCP positions of the waypoints q_0..q_m [m], shape (m + 1, 3)."""
+        return np.array([self._tcp(q) for q in self.q_waypoints])
+
+
+def paper_task_joint_waypoints() -> np.ndarray:
+    """Joint waypoints of seed 000's task: q(0), then IK of p1, p2, p3, p_f, each near the previous.
+
+    q(0) = [-pi/2, -pi/2, -3pi/4, -pi/4, pi/2, pi/4]; shape (5, 6) [rad].
+    """
+    from drake_traj.planners.pajak import paper_initial_configuration, paper_parameters
+
+    q = paper_initial_configuration()
+    waypoints = [q]
+    for pose in paper_parameters().waypoints:
+        q = robot.inverse_kinematics(pose, near=q)
+        waypoints.append(q)
+    return np.array(waypoints)
+
+
+class MovejPlanner(TimeLawPlanner):
+    """Planner system for a :class:`MovejBlendLaw` (UR MoveJ baseline, see the module doc).
+
+    The promised limits are the law's; note that the blends exceed them (that is the baseline's
+    known flaw), while without blending the reference respects them.
+
+    Args:
+        law: the MoveJ time law.
+        speed_cap: the largest clock rate c, in (0, 1].
+        update_period: how often the speed override is read [s].
+    """
+
+    def __init__(self, law: MovejBlendLaw, *, speed_cap: float = 1.0, update_period: float = 0.01):
+        if not isinstance(law, MovejBlendLaw):
+            raise ValueError(f"law must be a MovejBlendLaw, got {type(law).__name__}")
+        super().__init__(law, law.velocity_limit, law.acceleration_limit, speed_cap=speed_cap, update_period=update_period)
+
+    def task_waypoints(self) -> np.ndarray:
+        """Flange positions at the goal waypoints q_1..q_m [m], shape (m, 3)."""
+        return np.array([robot.flange_pose(q)[:3, 3] for q in self.law.q_waypoints[1:]])
