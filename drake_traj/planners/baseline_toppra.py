@@ -1,0 +1,304 @@
+"""Time-optimal baseline: Drake's TOPP-RA along a fixed geometric joint-space path.
+
+Given the joint path another planner followed (e.g. its logged ``q_ref``), this module answers
+"how fast could that same geometric path be traversed under the same joint velocity and
+acceleration limits?". The answer T* is the time-optimal path parameterisation (TOPP) computed by
+Drake's :class:`pydrake.multibody.optimization.Toppra` (Pham & Pham 2018, reachability analysis),
+starting and ending at rest.
+
+Pipeline:
+
+1. :func:`geometric_path_from_samples`: samples (N, n) -> a C^2 cubic spline q(s), s the
+   cumulative joint-space arc length [rad] (so |dq/ds| ~= 1 and Toppra's path velocity s_dot is
+   close to the joint-space speed).
+2. :func:`time_optimal_along_path`: Toppra with per-joint velocity and acceleration limits ->
+   (T*, q(t) = q(s(t))) as a :class:`PathParameterizedTrajectory`.
+3. :class:`ToppraLaw` / :class:`ToppraPlanner`: the result as a time law for
+   :class:`drake_traj.planners.base.TimeLawPlanner`, so it runs in the same closed loop.
+
+Why a C^2 cubic (``CubicWithContinuousSecondDerivatives``) and not ``CubicShapePreserving``:
+the joint acceleration along the path is qdd = q'(s) s_ddot + q''(s) s_dot^2, so Toppra's
+acceleration constraints involve q''(s). A shape-preserving (Fritsch-Carlson) cubic is only C^1:
+q'' jumps at every knot, and Toppra, which evaluates q'' at discrete grid points, sees one side of
+each jump only, so the sampled time law could exceed the limit on the other side. The C^2 spline
+has continuous q''; its weakness (overshoot between unevenly spaced or noisy knots) is avoided by
+decimating the samples to knots roughly evenly spaced in arc length, on a dense, smooth log.
+"""
+
+from __future__ import annotations
+
+from bisect import bisect_right
+
+import numpy as np
+from pydrake.multibody.optimization import CalcGridPointsOptions, Toppra, ToppraDiscretization
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import RevoluteJoint, SpatialInertia, UnitInertia
+from pydrake.trajectories import PathParameterizedTrajectory, PiecewisePolynomial
+
+from drake_traj.planners.base import TimeLawPlanner
+
+__all__ = [
+    "ToppraLaw",
+    "ToppraPlanner",
+    "geometric_path_from_samples",
+    "time_optimal_along_path",
+]
+
+
+def _limit_vector(value, name: str, num_joints: int) -> np.ndarray:
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be a number or a vector of numbers: {exc}") from exc
+    if array.ndim == 0:
+        array = np.full(num_joints, float(array))
+    if array.shape != (num_joints,):
+        raise ValueError(f"{name} must be a scalar or have shape ({num_joints},), got shape {array.shape}")
+    if not np.all(np.isfinite(array)) or np.any(array <= 0.0):
+        j = int(np.argmax(~(np.isfinite(array) & (array > 0.0))))
+        raise ValueError(f"{name}[{j}] (joint {j}) must be finite and > 0, got {array[j]}")
+    return array
+
+
+# --------------------------------------------------------------------------------------------
+# 1. Geometric path from samples.
+# --------------------------------------------------------------------------------------------
+
+
+def geometric_path_from_samples(
+    q_samples, *, max_knots: int = 200, repeat_tolerance: float = 1e-9
+) -> PiecewisePolynomial:
+    """A smooth joint-space path q(s) through ``q_samples``, s the joint-space arc length [rad].
+
+    Consecutive samples closer than ``repeat_tolerance`` [rad, Euclidean in joint space] to the
+    last kept one are dropped (the planner standing still, before the start or while settling).
+    The kept samples are parameterised by their cumulative arc length, decimated to at most
+    ``max_knots`` knots evenly spaced in arc length (always keeping the first and the last), and
+    interpolated by a not-a-knot C^2 cubic spline (see the module docstring for why C^2).
+    Two distinct samples give the straight segment between them (first-order hold: q'' = 0).
+
+    Args:
+        q_samples: joint positions [rad], shape (N, n), in path order.
+        max_knots: the largest number of spline knots (>= 3).
+        repeat_tolerance: samples this close to the previous kept one are repeats [rad].
+
+    Returns:
+        PiecewisePolynomial of n rows, on s in [0, L], L the arc length of the kept polyline [rad].
+
+    Raises:
+        ValueError: wrong shape, non-finite values, or fewer than two distinct samples.
+    """
+    q = np.asarray(q_samples, dtype=float)
+    if q.ndim != 2 or q.shape[1] == 0:
+        raise ValueError(f"q_samples must have shape (N, n), got shape {q.shape}")
+    if not np.all(np.isfinite(q)):
+        raise ValueError("q_samples must be finite")
+    if max_knots < 3:
+        raise ValueError(f"max_knots must be >= 3, got {max_knots}")
+    keep = [0]
+    for k in range(1, len(q)):
+        if np.linalg.norm(q[k] - q[keep[-1]]) > repeat_tolerance:
+            keep.append(k)
+    q = q[keep]
+    if len(q) < 2:
+        raise ValueError(
+            f"q_samples must contain at least 2 distinct configurations (more than {repeat_tolerance} rad "
+            f"apart) to define a path, got {len(q)} after dropping repeats"
+        )
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1))])
+    if len(q) == 2:
+        return PiecewisePolynomial.FirstOrderHold(arc, q.T)
+    if len(q) > max_knots:
+        # Knots: the samples nearest to evenly spaced arc lengths (kept on the true path).
+        index = np.unique(np.searchsorted(arc, np.linspace(0.0, arc[-1], max_knots)))
+        index = np.unique(np.concatenate([[0], np.minimum(index, len(q) - 1), [len(q) - 1]]))
+        q, arc = q[index], arc[index]
+    # Re-measure arc length on the kept knots so the breaks are strictly increasing.
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1))])
+    return PiecewisePolynomial.CubicWithContinuousSecondDerivatives(arc, q.T, periodic_end_condition=False)
+
+
+# --------------------------------------------------------------------------------------------
+# 2. Toppra.
+# --------------------------------------------------------------------------------------------
+
+
+def _joint_chain_plant(num_joints: int) -> MultibodyPlant:
+    """A finalized plant of ``num_joints`` revolute joints (q = v), only to size Toppra's problem.
+
+    Joint velocity and acceleration limits do not depend on the dynamics, so any plant with the
+    right number of positions will do; this avoids parsing a URDF for every call.
+    """
+    plant = MultibodyPlant(0.0)
+    parent = plant.world_body()
+    inertia = SpatialInertia(1.0, np.zeros(3), UnitInertia(0.01, 0.01, 0.01))
+    for j in range(num_joints):
+        body = plant.AddRigidBody(f"link{j}", inertia)
+        plant.AddJoint(RevoluteJoint(f"joint{j}", parent.body_frame(), body.body_frame(), [0.0, 0.0, 1.0]))
+        parent = body
+    plant.Finalize()
+    return plant
+
+
+def time_optimal_along_path(
+    path,
+    velocity_limit,
+    acceleration_limit,
+    plant: MultibodyPlant | None = None,
+    grid_points=None,
+    *,
+    discretization: ToppraDiscretization = ToppraDiscretization.kInterpolation,
+) -> tuple[float, PathParameterizedTrajectory]:
+    """Time-optimal traversal of ``path`` from rest to rest under joint limits (Drake's Toppra).
+
+    Constraints |qd_j| <= velocity_limit_j and |qdd_j| <= acceleration_limit_j hold at Toppra's
+    grid points (``kInterpolation`` by default: the acceleration constraint of each grid interval
+    is also imposed at its far end, the more conservative of Drake's two schemes); between grid
+    points they hold approximately (see the tests for the measured worst ratio).
+
+    Args:
+        path: joint path q(s) (any Drake Trajectory of n rows, e.g. from
+            :func:`geometric_path_from_samples`).
+        velocity_limit, acceleration_limit: per joint [rad/s, rad/s^2], > 0 (scalar or (n,)).
+        plant: a finalized MultibodyPlant with n positions (q = v); default a plain n-joint chain.
+        grid_points: None (Drake's ``CalcGridPoints`` with max_err 1e-4, at least 200 points and
+            segments <= L / 200), an int (that many points evenly spaced in s) or an increasing
+            array from path.start_time() to path.end_time().
+        discretization: Toppra's constraint discretisation.
+
+    Returns:
+        (T* [s], trajectory): the optimal duration and q(t) = path(s(t)) on t in [0, T*]
+        (rows n, with derivatives via ``EvalDerivative`` / ``MakeDerivative``).
+
+    Raises:
+        ValueError: bad limits or grid, a plant of the wrong size, or Toppra finding no
+            parameterisation (the message says why that can happen).
+    """
+    n = path.rows()
+    kv = _limit_vector(velocity_limit, "velocity_limit", n)
+    ka = _limit_vector(acceleration_limit, "acceleration_limit", n)
+    s0, s1 = path.start_time(), path.end_time()
+    if not s1 > s0:
+        raise ValueError(f"path must have a positive length in s, got [{s0}, {s1}]")
+    if plant is None:
+        plant = _joint_chain_plant(n)
+    elif plant.num_positions() != n or plant.num_velocities() != n:
+        raise ValueError(
+            f"plant must have {n} positions and velocities to match the path, got "
+            f"{plant.num_positions()} and {plant.num_velocities()}"
+        )
+    if grid_points is None:
+        options = CalcGridPointsOptions(max_err=1e-4, max_iter=100, max_seg_length=(s1 - s0) / 200, min_points=200)
+        grid = np.asarray(Toppra.CalcGridPoints(path, options), dtype=float).ravel()
+    elif np.ndim(grid_points) == 0:
+        if int(grid_points) < 2:
+            raise ValueError(f"grid_points must be at least 2, got {grid_points}")
+        grid = np.linspace(s0, s1, int(grid_points))
+    else:
+        grid = np.asarray(grid_points, dtype=float).ravel()
+        if len(grid) < 2 or np.any(np.diff(grid) <= 0) or not np.isclose(grid[0], s0) or not np.isclose(grid[-1], s1):
+            raise ValueError(
+                f"grid_points must increase strictly from the path start {s0} to its end {s1}, "
+                f"got {len(grid)} points from {grid[0] if len(grid) else None} to {grid[-1] if len(grid) else None}"
+            )
+        grid[0], grid[-1] = s0, s1
+    toppra = Toppra(path, plant, grid)
+    toppra.AddJointVelocityLimit(-kv, kv)
+    toppra.AddJointAccelerationLimit(-ka, ka, discretization)
+    s_of_t = toppra.SolvePathParameterization()
+    if s_of_t is None:
+        raise ValueError(
+            "Toppra found no feasible time parameterisation of the path (the reachability analysis "
+            "failed: usually the path's curvature q''(s) is so large somewhere that no path speed "
+            "keeps every joint acceleration within its limit while starting and stopping at rest, "
+            "e.g. a kink left by noisy or badly decimated samples; try a smoother path or more grid points)"
+        )
+    duration = float(s_of_t.end_time() - s_of_t.start_time())
+    if not np.isfinite(duration) or duration <= 0.0:
+        raise ValueError(f"Toppra returned an invalid duration {duration} s")
+    return duration, PathParameterizedTrajectory(path, s_of_t)
+
+
+# --------------------------------------------------------------------------------------------
+# 3. Time law and planner.
+# --------------------------------------------------------------------------------------------
+
+
+class ToppraLaw:
+    """A Toppra trajectory as a time law for :class:`TimeLawPlanner` (law time tau in [0, T*]).
+
+    ``rates_at`` is the simulator's hot path (~4000 calls per simulated second), so the
+    trajectory's velocity is sampled once, every ``sample_period`` [s], and ``rates_at`` returns
+    its linear interpolation and, as acceleration, the slope of the current table cell (a few
+    microseconds per call, no pybind round trip). Velocity and acceleration are thus mutually
+    consistent: integrating the law's qdd reproduces its qd at every table point exactly, and
+    the simulated q ends within O(sample_period^2) of the path's end. (Toppra's s_ddot is
+    piecewise constant, so qdd jumps; the cell slope is the mean over the cell.) Outside [0, T*]
+    the law rests (zero rates).
+
+    Args:
+        trajectory: q(t) on [t0, t0 + T*] (e.g. from :func:`time_optimal_along_path`).
+        sample_period: spacing of the precomputed rate table [s].
+    """
+
+    def __init__(self, trajectory, *, sample_period: float = 5e-4):
+        if not sample_period > 0:
+            raise ValueError(f"sample_period must be > 0 s, got {sample_period}")
+        self.trajectory = trajectory
+        self._t0 = float(trajectory.start_time())
+        self.duration = float(trajectory.end_time()) - self._t0
+        if not self.duration > 0:
+            raise ValueError(f"trajectory must have a positive duration, got {self.duration} s")
+        self.q_start = np.asarray(trajectory.value(self._t0), dtype=float).ravel()
+        self.q_end = np.asarray(trajectory.value(self._t0 + self.duration), dtype=float).ravel()
+        self.num_joints = len(self.q_start)
+        count = max(2, int(np.ceil(self.duration / sample_period)) + 1)
+        self._tau = np.linspace(0.0, self.duration, count)
+        self._dt = self._tau[1] - self._tau[0]
+        self._qd = np.array([trajectory.EvalDerivative(self._t0 + t, 1).ravel() for t in self._tau])
+        self._qd[0] = self._qd[-1] = 0.0  # rest to rest
+        self._qdd = np.diff(self._qd, axis=0) / self._dt  # cell k: the slope from qd[k] to qd[k+1]
+        self._zero = np.zeros(self.num_joints)
+
+    def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """(qd [rad/s], qdd [rad/s^2]) at law time ``tau`` [s] (interpolated table; rest outside)."""
+        if not 0.0 <= tau <= self.duration:
+            return self._zero.copy(), self._zero.copy()
+        x = tau / self._dt
+        k = min(int(x), len(self._tau) - 2)
+        w = x - k
+        return self._qd[k] + w * (self._qd[k + 1] - self._qd[k]), self._qdd[k].copy()
+
+    def sample(self, t):
+        """Exact (q, qd, qdd) of the trajectory at law times ``t`` [s] (clipped to [0, T*]).
+
+        Returns arrays of shape t.shape + (n,).
+        """
+        t_arr = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        flat = t_arr.ravel()
+        q = np.array([self.trajectory.value(self._t0 + x).ravel() for x in flat])
+        qd = np.array([self.trajectory.EvalDerivative(self._t0 + x, 1).ravel() for x in flat])
+        qdd = np.array([self.trajectory.EvalDerivative(self._t0 + x, 2).ravel() for x in flat])
+        shape = t_arr.shape + (self.num_joints,)
+        return q.reshape(shape), qd.reshape(shape), qdd.reshape(shape)
+
+
+class ToppraPlanner(TimeLawPlanner):
+    """Planner system replaying a :class:`ToppraLaw` (the time-optimal baseline) in the closed loop.
+
+    Args:
+        law: the Toppra law.
+        velocity_limit, acceleration_limit: the limits Toppra was given [rad/s, rad/s^2].
+        speed_cap, update_period: as :class:`TimeLawPlanner`.
+    """
+
+    def __init__(self, law: ToppraLaw, velocity_limit, acceleration_limit, *, speed_cap: float = 1.0,
+                 update_period: float = 0.01):
+        n = law.num_joints
+        super().__init__(
+            law,
+            _limit_vector(velocity_limit, "velocity_limit", n),
+            _limit_vector(acceleration_limit, "acceleration_limit", n),
+            speed_cap=speed_cap,
+            update_period=update_period,
+        )

@@ -1,0 +1,179 @@
+"""Time-optimal baseline (Drake's Toppra along a geometric path): drake_traj.planners.baseline_toppra."""
+
+import numpy as np
+import pytest
+
+from drake_traj.planners.baseline_toppra import (
+    ToppraLaw,
+    ToppraPlanner,
+    geometric_path_from_samples,
+    time_optimal_along_path,
+)
+from drake_traj.planners.quintic import plan_synchronized_quintic, quintic_profile
+
+KV, KA = 1.05, 1.40  # seed 000's joint-move limits [rad/s, rad/s^2]
+Q0 = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
+Q1 = Q0 + np.array([1.6, -0.7, 0.9, 0.4, -0.2, 0.1])
+
+
+def trapezoid_minimum_time(displacement, velocity_limit, acceleration_limit) -> float:
+    """Analytic rest-to-rest minimum time along the straight line q0 + D u, u in [0, 1].
+
+    Every joint moves in proportion, so u_dot <= min_j K_v/|D_j| and |u_ddot| <= min_j K_a/|D_j|:
+    the bang-bang (trapezoid or triangle) profile of the leading joint.
+    """
+    d = np.abs(displacement)
+    moving = d > 0
+    v = np.min(velocity_limit / d[moving])
+    a = np.min(acceleration_limit / d[moving])
+    return 1.0 / v + v / a if v * v / a < 1.0 else 2.0 * np.sqrt(1.0 / a)
+
+
+def curved_samples(count=2000):
+    """A smooth curved joint path (a tilted loop through three joints, others drifting)."""
+    u = np.linspace(0.0, 1.0, count)
+    q = np.tile(Q0, (count, 1))
+    q[:, 0] += 1.2 * np.sin(np.pi * u)
+    q[:, 1] += 0.8 * (1.0 - np.cos(1.5 * np.pi * u))
+    q[:, 2] += 1.0 * u
+    q[:, 3] += 0.3 * np.sin(2 * np.pi * u)
+    return q
+
+
+def sampled_rates(trajectory, duration, count=8001):
+    t = np.linspace(0.0, duration, count)
+    qd = np.array([trajectory.EvalDerivative(x, 1).ravel() for x in t])
+    qdd = np.array([trajectory.EvalDerivative(x, 2).ravel() for x in t])
+    return qd, qdd
+
+
+def test_straight_line_is_the_bang_bang_optimum():
+    for q_goal, kv, ka in ((Q1, KV, KA), (Q0 + 0.2, KV, KA), (Q1, np.array([1, 1, 2, 2, 3, 3.0]), 2.0)):
+        # Repeats at both ends (a planner standing still) must be dropped.
+        samples = np.vstack([np.tile(Q0, (5, 1)), np.linspace(Q0, q_goal, 50), np.tile(q_goal, (5, 1))])
+        path = geometric_path_from_samples(samples)
+        duration, trajectory = time_optimal_along_path(path, kv, ka)
+        expected = trapezoid_minimum_time(q_goal - Q0, kv, ka)
+        assert duration == pytest.approx(expected, rel=0.01)
+        np.testing.assert_allclose(trajectory.value(trajectory.end_time()).ravel(), q_goal, atol=1e-9)
+        np.testing.assert_allclose(trajectory.value(trajectory.start_time()).ravel(), Q0, atol=1e-9)
+
+
+def test_curved_path_respects_limits_and_beats_other_timings():
+    samples = curved_samples()
+    path = geometric_path_from_samples(samples)
+    # The spline passes through the samples (knots are samples; between, it stays close).
+    s = np.linspace(path.start_time(), path.end_time(), 400)
+    deviation = max(np.min(np.linalg.norm(samples - path.value(x).ravel(), axis=1)) for x in s)
+    assert deviation < 2e-3
+
+    duration, trajectory = time_optimal_along_path(path, KV, KA)
+    qd, qdd = sampled_rates(trajectory, duration)
+    velocity_ratio = np.abs(qd).max() / KV
+    acceleration_ratio = np.abs(qdd).max() / KA
+    print(f"curved path: T* = {duration:.4f} s, worst |qd|/Kv = {velocity_ratio:.4f}, "
+          f"worst |qdd|/Ka = {acceleration_ratio:.4f}")
+    assert velocity_ratio <= 1.01
+    assert acceleration_ratio <= 1.05  # Toppra constrains its discrete grid only
+    assert max(velocity_ratio, acceleration_ratio) > 0.95  # and it is tight somewhere
+
+    # Another feasible timing of the same path: the quintic law s(t) = L r(t / T) (seed 004's
+    # time law), with T the smallest value meeting both limits (qd ~ 1/T, qdd ~ 1/T^2).
+    length = path.end_time()
+    dq = path.MakeDerivative(1)
+    ddq = path.MakeDerivative(2)
+    u = np.linspace(0.0, 1.0, 4001)
+    r, dr, ddr = quintic_profile(u)
+    speed = np.array([dq.value(length * x).ravel() * length * y for x, y in zip(r, dr)])  # * 1/T
+    accel = np.array([ddq.value(length * x).ravel() * (length * y) ** 2 + dq.value(length * x).ravel() * length * z
+                      for x, y, z in zip(r, dr, ddr)])  # * 1/T^2
+    quintic_time = max(np.abs(speed / KV).max(), np.sqrt(np.abs(accel / KA).max()))
+    print(f"curved path: quintic timing {quintic_time:.4f} s")
+    assert duration < quintic_time
+
+
+def test_shorter_than_the_synchronized_quintic_on_a_two_point_path():
+    plan = plan_synchronized_quintic(Q0, [Q1], KV, KA)
+    duration, _ = time_optimal_along_path(geometric_path_from_samples(np.array([Q0, Q1])), KV, KA)
+    print(f"two-point path: T* = {duration:.4f} s, quintic {plan.duration:.4f} s")
+    assert duration < plan.duration
+
+
+def test_law_rates_match_the_trajectory_and_rest_outside():
+    path = geometric_path_from_samples(curved_samples(300))
+    duration, trajectory = time_optimal_along_path(path, KV, KA)
+    law = ToppraLaw(trajectory)
+    assert law.duration == pytest.approx(duration)
+    np.testing.assert_allclose(law.q_start, Q0, atol=1e-9)
+    t = np.linspace(0.0, duration, 37)[1:-1] + 1e-4
+    q, qd, qdd = law.sample(t)
+    for k, tau in enumerate(t):
+        rate, acceleration = law.rates_at(tau)
+        np.testing.assert_allclose(rate, qd[k], atol=5e-3)
+        np.testing.assert_allclose(acceleration, qdd[k], atol=0.1)  # Toppra's s_ddot is piecewise constant
+    for tau in (-0.1, duration + 0.1):
+        rate, acceleration = law.rates_at(tau)
+        assert not rate.any() and not acceleration.any()
+    assert q.shape == (len(t), 6)
+
+
+def test_errors_are_clear():
+    with pytest.raises(ValueError, match="at least 2 distinct"):
+        geometric_path_from_samples(np.tile(Q0, (10, 1)))
+    with pytest.raises(ValueError, match="shape"):
+        geometric_path_from_samples(Q0)
+    path = geometric_path_from_samples(np.array([Q0, Q1]))
+    with pytest.raises(ValueError, match="velocity_limit"):
+        time_optimal_along_path(path, 0.0, KA)
+    with pytest.raises(ValueError, match="acceleration_limit"):
+        time_optimal_along_path(path, KV, [1.0, 1.0, -1.0, 1.0, 1.0, 1.0])
+    with pytest.raises(ValueError, match="grid_points"):
+        time_optimal_along_path(path, KV, KA, grid_points=[0.0, 0.1])
+
+
+def test_toppra_failure_is_reported(monkeypatch):
+    from drake_traj.planners import baseline_toppra
+
+    class NoSolution:
+        def __init__(self, *args):
+            pass
+
+        AddJointVelocityLimit = AddJointAccelerationLimit = lambda self, *args: None
+
+        def SolvePathParameterization(self):
+            return None
+
+    monkeypatch.setattr(baseline_toppra, "Toppra", NoSolution)
+    path = geometric_path_from_samples(np.array([Q0, Q1]))
+    with pytest.raises(ValueError, match="Toppra found no feasible"):
+        time_optimal_along_path(path, KV, KA, grid_points=50)
+
+
+def test_planner_runs_in_the_closed_loop():
+    from drake_traj.diagram import simulate
+
+    path = geometric_path_from_samples(np.array([Q0, Q0 + np.array([0.6, -0.4, 0.3, 0.2, 0.0, 0.1])]))
+    duration, trajectory = time_optimal_along_path(path, KV, KA)
+    planner = ToppraPlanner(ToppraLaw(trajectory), KV, KA)
+    result = simulate(planner, settle_time=0.1, max_duration=10.0)
+    assert result.succeeded, result.failure
+    assert result.duration == pytest.approx(duration, abs=0.02)
+    metrics = result.metrics()
+    assert metrics["max_velocity_over_limit"] <= 1.01
+    assert metrics["max_acceleration_over_limit"] <= 1.05
+    np.testing.assert_allclose(result.q_ref[-1], trajectory.value(trajectory.end_time()).ravel(), atol=1e-5)
+
+
+def test_faster_than_the_pajak_run_on_its_own_path():
+    from drake_traj.diagram import simulate
+    from drake_traj.scenario import load_scenario, make_planner
+
+    result = simulate(make_planner(load_scenario("diagrams/pajak_sim3.yaml")))
+    assert result.succeeded, result.failure
+    samples = result.q_ref[result.t <= result.duration]
+    duration, trajectory = time_optimal_along_path(geometric_path_from_samples(samples), KV, KA)
+    qd, qdd = sampled_rates(trajectory, duration)
+    print(f"pajak_sim3 path: T* = {duration:.4f} s vs the planner's {result.duration:.4f} s "
+          f"(worst |qd|/Kv = {np.abs(qd).max() / KV:.4f}, |qdd|/Ka = {np.abs(qdd).max() / KA:.4f})")
+    assert duration < result.duration
+    np.testing.assert_allclose(trajectory.value(trajectory.end_time()).ravel(), samples[-1], atol=1e-6)
