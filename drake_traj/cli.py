@@ -1,8 +1,11 @@
 """``drake-traj``: run scenarios from the command line.
 
     drake-traj run [SCENARIO.yaml] [--out DIR] [--meshcat]
+    drake-traj bench [--out DIR] [--count N] [--seed S] [--repeats R]
 
-writes DIR/result.npz, DIR/metrics.json, DIR/*.png and DIR/meshcat.html.
+``run`` writes DIR/result.npz, DIR/metrics.json, DIR/*.png and DIR/meshcat.html; ``bench`` runs
+every planner and baseline on seed 000's task and N seeded tasks and writes DIR/bench.csv,
+DIR/bench.md and DIR/bench.png.
 """
 
 from __future__ import annotations
@@ -64,7 +67,17 @@ def main(argv=None) -> int:
                             help=f"scenario YAML (default: {default_scenario_path().name})")
     run_parser.add_argument("--out", default=None, help="output directory (default: out/<scenario name>)")
     run_parser.add_argument("--meshcat", action="store_true", help="serve Meshcat live during the run")
+    bench_parser = commands.add_parser("bench", help="compare every planner and baseline on UR10e tasks")
+    bench_parser.add_argument("--out", default="out/bench", help="output directory (default: out/bench)")
+    bench_parser.add_argument("--count", type=int, default=20, help="seeded random tasks besides the paper's")
+    bench_parser.add_argument("--seed", type=int, default=0)
+    bench_parser.add_argument("--repeats", type=int, default=5, help="planning-time repeats on the paper task")
     args = parser.parse_args(argv)
+    if args.command == "bench":
+        from drake_traj.bench import bench
+
+        bench(args.out, count=args.count, seed=args.seed, repeats=args.repeats)
+        return 0
     try:
         return run(args.scenario or default_scenario_path(), args.out, live_meshcat=args.meshcat)
     except ValueError as error:
