@@ -27,7 +27,6 @@ decimating the samples to knots roughly evenly spaced in arc length, on a dense,
 
 from __future__ import annotations
 
-from bisect import bisect_right
 
 import numpy as np
 from pydrake.multibody.optimization import CalcGridPointsOptions, Toppra, ToppraDiscretization
