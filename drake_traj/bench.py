@@ -156,13 +156,18 @@ def run_task(label, q0, poses, repeats=1) -> list[dict]:
     start = time.perf_counter()
     reference = results["pajak_blend"]
     end = np.searchsorted(reference.t, reference.duration) + 1
-    path = geometric_path_from_samples(reference.q_ref[:end])
-    # A dense grid: Toppra keeps the limits at its grid points only (2.2 % over between them on
-    # the paper task's path with the default grid, 0.08 % with 2000 points).
-    law = ToppraLaw(time_optimal_along_path(path, VELOCITY, ACCELERATION, grid_points=TOPPRA_GRID_POINTS)[1])
-    rows.append(("toppra", simulate(ToppraPlanner(law, VELOCITY, ACCELERATION), name="toppra", settle_time=0.2),
-                 time.perf_counter() - start))
-    return [_row(label, name, result, planning, _optimal_duration(result)) for name, result, planning in rows]
+    table = [_row(label, name, result, planning, _optimal_duration(result)) for name, result, planning in rows]
+    try:
+        path = geometric_path_from_samples(reference.q_ref[:end])
+        # A dense grid: Toppra keeps the limits at its grid points only (2.2 % over between them
+        # on the paper task's path with the default grid, 0.08 % with 2000 points).
+        law = ToppraLaw(time_optimal_along_path(path, VELOCITY, ACCELERATION, grid_points=TOPPRA_GRID_POINTS)[1])
+    except ValueError:  # no parameterisation of this path: the row says so
+        table.append({column: float("nan") for column in COLUMNS} | {"task": label, "planner": "toppra", "succeeded": False})
+        return table
+    result = simulate(ToppraPlanner(law, VELOCITY, ACCELERATION), name="toppra", settle_time=0.2)
+    table.append(_row(label, "toppra", result, time.perf_counter() - start, _optimal_duration(result)))
+    return table
 
 
 def _markdown(rows) -> str:
