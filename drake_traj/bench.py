@@ -194,8 +194,10 @@ def medians(rows) -> list[dict]:
         for column in COLUMNS[2:]:
             values = [float(row[column]) for row in mine]
             finite = [value for value in values if np.isfinite(value)]
-            if column in ("succeeded", "qdd_continuous"):
+            if column == "succeeded":
                 entry[column] = float(np.mean(values))
+            elif column == "qdd_continuous":  # share of the runs that have a log
+                entry[column] = float(np.mean(finite)) if finite else float("nan")
             else:
                 entry[column] = float(np.median(finite)) if finite else float("nan")
         summary.append(entry)
