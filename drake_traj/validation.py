@@ -40,3 +40,18 @@ def finite_array(value, name: str, unit: str, *, shape: tuple | None = None) -> 
         where = "" if array.ndim == 0 else "[" + ", ".join(str(int(i)) for i in bad) + "]"
         raise ValueError(f"{name}{where} must be finite [{unit}], got {np.atleast_1d(array)[tuple(bad)]}")
     return array
+
+
+def positive_vector(value, name: str, n: int) -> np.ndarray:
+    """A per-joint limit: a scalar (every joint) or n values, all finite and > 0."""
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be a number or {n} numbers: {exc}") from exc
+    if array.ndim == 0:
+        array = np.full(n, float(array))
+    if array.shape != (n,):
+        raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
+    if not np.all(np.isfinite(array)) or np.any(array <= 0):
+        raise ValueError(f"{name} must be finite and > 0, got {array.tolist()}")
+    return array

@@ -49,6 +49,7 @@ import numpy as np
 
 from drake_traj import robot
 from drake_traj.planners.base import TimeLawPlanner
+from drake_traj.validation import positive_vector
 
 __all__ = [
     "MovejBlendLaw",
@@ -59,20 +60,6 @@ __all__ = [
 
 _SAMPLES_PER_SEGMENT = 200  # FK samples for locating the sphere crossings (then bisection)
 _BISECTION_STEPS = 60
-
-
-def _limit_vector(value, name: str, n: int) -> np.ndarray:
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a number or {n} numbers: {exc}") from exc
-    if array.ndim == 0:
-        array = np.full(n, float(array))
-    if array.shape != (n,):
-        raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
-    if not np.all(np.isfinite(array)) or np.any(array <= 0.0):
-        raise ValueError(f"{name} must be finite and > 0, got {array.tolist()}")
-    return array
 
 
 def _flange_position(q) -> np.ndarray:
@@ -138,8 +125,8 @@ class MovejBlendLaw:
             raise ValueError("q_waypoints must be finite")
         n = waypoints.shape[1]
         self.num_joints = n
-        self.velocity_limit = _limit_vector(velocity_limit, "velocity_limit", n)
-        self.acceleration_limit = _limit_vector(acceleration_limit, "acceleration_limit", n)
+        self.velocity_limit = positive_vector(velocity_limit, "velocity_limit", n)
+        self.acceleration_limit = positive_vector(acceleration_limit, "acceleration_limit", n)
         try:
             radius = float(blend_radius)
         except (TypeError, ValueError) as exc:

@@ -81,6 +81,7 @@ import numpy as np
 from drake_traj import robot
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.planners.scaling import relaxed_scaling
+from drake_traj.validation import positive_vector
 
 __all__ = [
     "DISCRETE_NAMES",
@@ -259,7 +260,7 @@ class PajakParameters:
             )
         values = {}
         for name in ("position_gain", "velocity_gain", "velocity_limit", "acceleration_limit"):
-            values[name] = _positive_vector(getattr(self, name), name, n)
+            values[name] = positive_vector(getattr(self, name), name, n)
         for name in (
             "rho", "accuracy", "neighbourhood", "scaling_rate", "singularity_threshold", "max_damping",
             "stop_speed", "stall_time", "blend_length",
@@ -294,20 +295,6 @@ class PajakParameters:
             if not isinstance(getattr(self, flag), (bool, np.bool_)):
                 raise ValueError(f"{flag} must be True or False, got {getattr(self, flag)!r}")
         return replace(self, waypoints=waypoints, vartheta=float(vartheta), **values)
-
-
-def _positive_vector(value, name: str, n: int) -> np.ndarray:
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a number or {n} numbers: {exc}") from exc
-    if array.ndim == 0:
-        array = np.full(n, float(array))
-    if array.shape != (n,):
-        raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
-    if not np.all(np.isfinite(array)) or np.any(array <= 0):
-        raise ValueError(f"{name} must be finite and > 0, got {array.tolist()}")
-    return array
 
 
 def paper_initial_configuration() -> np.ndarray:
