@@ -52,6 +52,8 @@ def positive_vector(value, name: str, n: int) -> np.ndarray:
         array = np.full(n, float(array))
     if array.shape != (n,):
         raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
-    if not np.all(np.isfinite(array)) or np.any(array <= 0):
-        raise ValueError(f"{name} must be finite and > 0, got {array.tolist()}")
+    bad = ~np.isfinite(array) | (array <= 0.0)
+    if np.any(bad):
+        j = int(np.argmax(bad))
+        raise ValueError(f"{name}[{j}] (joint {j}) must be finite and > 0, got {array[j]}")
     return array

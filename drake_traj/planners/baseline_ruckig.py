@@ -31,6 +31,7 @@ import ruckig
 
 from drake_traj import robot
 from drake_traj.planners.base import TimeLawPlanner
+from drake_traj.validation import positive_vector
 
 __all__ = ["DEFAULT_JERK_FACTOR", "RuckigPlanner", "RuckigStopLaw", "default_jerk_limit"]
 
@@ -41,23 +42,6 @@ DEFAULT_JERK_FACTOR = 10.0
 def default_jerk_limit(acceleration_limit):
     """The default jerk limit [rad/s^3]: 10 [1/s] times ``acceleration_limit`` [rad/s^2]."""
     return DEFAULT_JERK_FACTOR * np.asarray(acceleration_limit, dtype=float)
-
-
-def _limit(value, name: str, n: int) -> np.ndarray:
-    """A per-joint limit: scalar or shape (n,), finite and > 0, as a float array (n,)."""
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a real number or an array of real numbers: {exc}") from exc
-    if array.ndim == 0:
-        array = np.full(n, float(array))
-    if array.shape != (n,):
-        raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
-    bad = ~np.isfinite(array) | (array <= 0.0)
-    if np.any(bad):
-        j = int(np.argmax(bad))
-        raise ValueError(f"{name}[{j}] (joint {j}) must be finite and > 0, got {array[j]}")
-    return array
 
 
 class RuckigStopLaw:
@@ -96,11 +80,11 @@ class RuckigStopLaw:
             raise ValueError(f"q_waypoints[{k}, {j}] must be finite, got {q[k, j]}")
         n = q.shape[1]
         self.num_joints = n
-        self.velocity_limit = _limit(velocity_limit, "velocity_limit", n)
-        self.acceleration_limit = _limit(acceleration_limit, "acceleration_limit", n)
+        self.velocity_limit = positive_vector(velocity_limit, "velocity_limit", n)
+        self.acceleration_limit = positive_vector(acceleration_limit, "acceleration_limit", n)
         if jerk_limit is None:
             jerk_limit = default_jerk_limit(self.acceleration_limit)
-        self.jerk_limit = _limit(jerk_limit, "jerk_limit", n)
+        self.jerk_limit = positive_vector(jerk_limit, "jerk_limit", n)
         q.setflags(write=False)
         self.q_waypoints = q
 

@@ -35,6 +35,7 @@ from pydrake.multibody.tree import RevoluteJoint, SpatialInertia, UnitInertia
 from pydrake.trajectories import PathParameterizedTrajectory, PiecewisePolynomial
 
 from drake_traj.planners.base import TimeLawPlanner
+from drake_traj.validation import positive_vector
 
 __all__ = [
     "ToppraLaw",
@@ -42,21 +43,6 @@ __all__ = [
     "geometric_path_from_samples",
     "time_optimal_along_path",
 ]
-
-
-def _limit_vector(value, name: str, num_joints: int) -> np.ndarray:
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a number or a vector of numbers: {exc}") from exc
-    if array.ndim == 0:
-        array = np.full(num_joints, float(array))
-    if array.shape != (num_joints,):
-        raise ValueError(f"{name} must be a scalar or have shape ({num_joints},), got shape {array.shape}")
-    if not np.all(np.isfinite(array)) or np.any(array <= 0.0):
-        j = int(np.argmax(~(np.isfinite(array) & (array > 0.0))))
-        raise ValueError(f"{name}[{j}] (joint {j}) must be finite and > 0, got {array[j]}")
-    return array
 
 
 # --------------------------------------------------------------------------------------------
@@ -174,8 +160,8 @@ def time_optimal_along_path(
             parameterisation (the message says why that can happen).
     """
     n = path.rows()
-    kv = _limit_vector(velocity_limit, "velocity_limit", n)
-    ka = _limit_vector(acceleration_limit, "acceleration_limit", n)
+    kv = positive_vector(velocity_limit, "velocity_limit", n)
+    ka = positive_vector(acceleration_limit, "acceleration_limit", n)
     s0, s1 = path.start_time(), path.end_time()
     if not s1 > s0:
         raise ValueError(f"path must have a positive length in s, got [{s0}, {s1}]")
@@ -296,8 +282,8 @@ class ToppraPlanner(TimeLawPlanner):
         n = law.num_joints
         super().__init__(
             law,
-            _limit_vector(velocity_limit, "velocity_limit", n),
-            _limit_vector(acceleration_limit, "acceleration_limit", n),
+            positive_vector(velocity_limit, "velocity_limit", n),
+            positive_vector(acceleration_limit, "acceleration_limit", n),
             speed_cap=speed_cap,
             update_period=update_period,
         )
