@@ -1,3 +1,34 @@
-"""drake_traj: published trajectory planners as Drake systems on a simulated UR10e."""
+"""drake_traj: published trajectory planners as Drake systems on a simulated UR10e.
+
+The public API::
+
+    from drake_traj import load_scenario, make_planner, simulate, SimulationResult
+    scenario = load_scenario("diagrams/pajak.yaml", "sim3")
+    result = simulate(make_planner(scenario), name=scenario.name)
+
+Planner configs (``PajakConfig``, ``QuinticConfig``, ...) build planners with
+:func:`drake_traj.planners.make_planner`; robots come from :func:`get_robot`.
+"""
+
+from drake_traj.diagram import ControllerGains, simulate
+from drake_traj.errors import DrakeTrajError, Failure, PlanningError, SingularConfigurationError
+from drake_traj.planners import (
+    BorygaConfig,
+    LiConfig,
+    MovejConfig,
+    PajakConfig,
+    QuinticConfig,
+    RuckigConfig,
+    ToppraConfig,
+)
+from drake_traj.result import Metrics, SimulationResult
+from drake_traj.robots import Robot, get_robot
+from drake_traj.scenario import Scenario, load_scenario, make_planner
 
 __version__ = "0.1.0"
+
+__all__ = [
+    "BorygaConfig", "ControllerGains", "DrakeTrajError", "Failure", "LiConfig", "Metrics", "MovejConfig",
+    "PajakConfig", "PlanningError", "QuinticConfig", "Robot", "RuckigConfig", "Scenario", "SimulationResult",
+    "SingularConfigurationError", "ToppraConfig", "get_robot", "load_scenario", "make_planner", "simulate",
+]

@@ -1,12 +1,12 @@
 """``drake-traj bench``: every planner and baseline on the same UR10e waypoint tasks, one table.
 
-Tasks: seed 000's task (q(0), p1..pf) and ``count`` seeded random reachable tasks (three
+Tasks: Pająk 2024's task (q(0), p1..pf) and ``count`` seeded random reachable tasks (three
 waypoints, each the flange pose of a random configuration near the previous one). Each task runs,
 through the same PD-controlled UR10e, with the UR joint-move limits (1.05 rad/s, 1.40 rad/s^2):
 
-- ``pajak_blend`` / ``pajak_stop``: seed 000's planner, passing or stopping at the waypoints;
+- ``pajak_blend`` / ``pajak_stop``: Pająk 2024's planner, passing or stopping at the waypoints;
 - ``movej_blend``: UR-style joint moves with a 0.05 m blend radius;
-- ``quintic_stop``: synchronised quintic moves (seed 004) through the IK of the waypoints;
+- ``quintic_stop``: synchronised quintic moves (Benotsmane et al.) through the IK of the waypoints;
 - ``ruckig_stop``: Ruckig's jerk-limited moves through the same joint waypoints;
 - ``toppra``: Drake's Toppra, time-optimal along the geometric path of ``pajak_blend``.
 
@@ -25,13 +25,19 @@ from pathlib import Path
 
 import numpy as np
 
-from drake_traj import robot
 from drake_traj.diagram import simulate
+from drake_traj.planners import (
+    MovejConfig,
+    PajakConfig,
+    QuinticConfig,
+    RuckigConfig,
+    ToppraConfig,
+    make_planner,
+)
 from drake_traj.planners import pajak
-from drake_traj.planners.baseline_movej import MovejBlendLaw, MovejPlanner
-from drake_traj.planners.baseline_ruckig import RuckigPlanner, RuckigStopLaw
-from drake_traj.planners.baseline_toppra import ToppraLaw, ToppraPlanner, geometric_path_from_samples, time_optimal_along_path
-from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
+from drake_traj.planners.baselines.toppra import geometric_path_from_samples, time_optimal_along_path
+from drake_traj.robots import UR10E
+from drake_traj.robots import ur10e as robot
 
 VELOCITY, ACCELERATION = robot.DEFAULT_JOINT_MOVE_VELOCITY, robot.DEFAULT_JOINT_MOVE_ACCELERATION
 BLEND_RADIUS = 0.05  # [m], the paper's experiment 1
@@ -46,7 +52,7 @@ COLUMNS = (
 
 
 def paper_task():
-    """(q0, task poses (4, 6)) of seed 000."""
+    """(q0, task poses (4, 6)) of Pająk 2024."""
     return pajak.paper_initial_configuration(), pajak.paper_parameters(3).waypoints
 
 
@@ -71,37 +77,28 @@ def random_tasks(count: int, seed: int = 0):
 
 def joint_waypoints(q0, poses) -> np.ndarray:
     """q0 and the IK of each pose, each nearest the previous configuration, shape (m + 1, 6)."""
-    configurations = [np.asarray(q0, dtype=float)]
-    for pose in poses:
-        configurations.append(robot.inverse_kinematics(pose, near=configurations[-1]))
-    return np.array(configurations)
+    return np.vstack([q0, robot.inverse_kinematics_path(poses, q0, max_step=np.inf)])
 
 
-def _pajak(q0, poses, blend):
-    return pajak.PajakPlanner(
-        pajak.PajakParameters(waypoints=poses, limit_velocity=True, limit_acceleration=True, blend_waypoints=blend), q0)
-
-
-def _builders(q0, poses, joints):
-    """Planner factories by name (Toppra needs pajak_blend's path, built later)."""
+def _configs(poses, joints) -> dict:
+    """Planner configs by name, all with the UR10e's joint-move limits (Toppra needs
+    pajak_blend's path, built later)."""
+    goals = joints[1:].tolist()
     return {
-        "pajak_blend": lambda: _pajak(q0, poses, True),
-        "pajak_stop": lambda: _pajak(q0, poses, False),
-        "movej_blend": lambda: MovejPlanner(MovejBlendLaw(joints, VELOCITY, ACCELERATION, BLEND_RADIUS)),
-        "quintic_stop": lambda: QuinticPtpPlanner(
-            plan_synchronized_quintic(joints[0], joints[1:], VELOCITY, ACCELERATION), VELOCITY, ACCELERATION),
-        "ruckig_stop": lambda: RuckigPlanner(RuckigStopLaw(joints, VELOCITY, ACCELERATION)),
+        "pajak_blend": PajakConfig(waypoints=poses, blend_waypoints=True),
+        "pajak_stop": PajakConfig(waypoints=poses, blend_waypoints=False),
+        "movej_blend": MovejConfig(goals=goals, blend_radius=BLEND_RADIUS),
+        "quintic_stop": QuinticConfig(goals=goals),
+        "ruckig_stop": RuckigConfig(goals=goals),
     }
 
 
-def _planning_time(name, build, q0, poses, repeats):
-    """Median wall time [s] of building the planner (offline) or integrating the Pająk law alone."""
+def _planning_time(config, q0, repeats):
+    """Median wall time [s] of making the planner and its preflight (for the online Pająk
+    planner, the law integrated alone over the whole task)."""
     def once():
         start = time.perf_counter()
-        if name.startswith("pajak"):
-            pajak.integrate(build().law, q0)
-        else:
-            build()
+        make_planner(config, UR10E, q0).preflight()
         return time.perf_counter() - start
     return statistics.median(once() for _ in range(repeats))
 
@@ -136,12 +133,12 @@ def _row(task, name, result, planning, optimal) -> dict:
     steps = np.abs(np.diff(result.qdd_ref[1:], axis=0))  # after t = 0 (Pająk sims start with a step)
     return {
         "task": task, "planner": name, "succeeded": result.succeeded, "T_s": result.duration,
-        "T_over_optimal": result.duration / optimal, "max_qd_over_limit": metrics["max_velocity_over_limit"],
-        "max_qdd_over_limit": metrics["max_acceleration_over_limit"], "max_jerk": metrics["max_jerk"],
-        "qdd_continuous": bool(steps.max() <= JUMP), "tracking_joint_rad": metrics["tracking_error_joint_max_rad"],
-        "tracking_tcp_m": metrics["tracking_error_tcp_max_m"],
-        "peak_torque_over_limit": max(metrics["peak_torque_over_limit"]), "planning_s": planning,
-        "real_time_factor": metrics["real_time_factor"],
+        "T_over_optimal": result.duration / optimal, "max_qd_over_limit": metrics.max_velocity_over_limit,
+        "max_qdd_over_limit": metrics.max_acceleration_over_limit, "max_jerk": metrics.max_jerk,
+        "qdd_continuous": bool(steps.max() <= JUMP), "tracking_joint_rad": metrics.tracking_error_joint_max_rad,
+        "tracking_tcp_m": metrics.tracking_error_tcp_max_m,
+        "peak_torque_over_limit": max(metrics.peak_torque_over_limit), "planning_s": planning,
+        "real_time_factor": metrics.real_time_factor,
     }
 
 
@@ -149,23 +146,23 @@ def run_task(label, q0, poses, repeats=1) -> list[dict]:
     """All planners on one task; returns one row per planner."""
     joints = joint_waypoints(q0, poses)
     rows, results = [], {}
-    for name, build in _builders(q0, poses, joints).items():
-        planning = _planning_time(name, build, q0, poses, repeats)
-        results[name] = simulate(build(), name=name, settle_time=0.2, max_duration=30.0)
+    for name, config in _configs(poses, joints).items():
+        planning = _planning_time(config, q0, repeats)
+        results[name] = simulate(make_planner(config, UR10E, q0), name=name, settle_time=0.2, max_duration=30.0)
         rows.append((name, results[name], planning))
     start = time.perf_counter()
     reference = results["pajak_blend"]
     end = np.searchsorted(reference.t, reference.duration) + 1
     table = [_row(label, name, result, planning, _optimal_duration(result)) for name, result, planning in rows]
+    # A dense grid: Toppra keeps the limits at its grid points only (2.2 % over between them on
+    # the paper task's path with the default grid, 0.08 % with 2000 points).
+    config = ToppraConfig(path=reference.q_ref[1:end].tolist(), grid_points=TOPPRA_GRID_POINTS)
     try:
-        path = geometric_path_from_samples(reference.q_ref[:end])
-        # A dense grid: Toppra keeps the limits at its grid points only (2.2 % over between them
-        # on the paper task's path with the default grid, 0.08 % with 2000 points).
-        law = ToppraLaw(time_optimal_along_path(path, VELOCITY, ACCELERATION, grid_points=TOPPRA_GRID_POINTS)[1])
+        planner = make_planner(config, UR10E, reference.q_ref[0])
     except ValueError:  # no parameterisation of this path: the row says so
         table.append({column: float("nan") for column in COLUMNS} | {"task": label, "planner": "toppra", "succeeded": False})
         return table
-    result = simulate(ToppraPlanner(law, VELOCITY, ACCELERATION), name="toppra", settle_time=0.2)
+    result = simulate(planner, name="toppra", settle_time=0.2)
     table.append(_row(label, "toppra", result, time.perf_counter() - start, _optimal_duration(result)))
     return table
 

@@ -1,10 +1,10 @@
 """``drake-traj``: run scenarios from the command line.
 
-    drake-traj run [SCENARIO.yaml] [--out DIR] [--meshcat]
+    drake-traj run [SCENARIO.yaml] [--variant NAME] [--out DIR] [--meshcat]
     drake-traj bench [--out DIR] [--count N] [--seed S] [--repeats R]
 
 ``run`` writes DIR/result.npz, DIR/metrics.json, DIR/*.png and DIR/meshcat.html; ``bench`` runs
-every planner and baseline on seed 000's task and N seeded tasks and writes DIR/bench.csv,
+every planner and baseline on Pająk 2024's task and N seeded tasks and writes DIR/bench.csv,
 DIR/bench.md and DIR/bench.png.
 """
 
@@ -17,14 +17,16 @@ from pathlib import Path
 
 from pydrake.geometry import Meshcat
 
-from drake_traj.diagram import robot_model, simulate
+from drake_traj.bench import bench
+from drake_traj.diagram import simulate
 from drake_traj.meshcat import draw_task, export_html
-from drake_traj.scenario import default_scenario_path, load_scenario, make_planner
+from drake_traj.robots import get_robot
+from drake_traj.scenario import DEFAULT_SCENARIO, default_scenario_path, load_scenario, make_planner
 
 
-def run(scenario_path, out_dir, *, live_meshcat: bool = False) -> int:
+def run(scenario_path, out_dir, *, variant: str | None = None, live_meshcat: bool = False) -> int:
     """Simulate one scenario and write its outputs; returns the process exit code."""
-    scenario = load_scenario(scenario_path)
+    scenario = load_scenario(scenario_path, variant)
     out_dir = Path(out_dir) if out_dir else Path("out") / scenario.name
     meshcat = Meshcat()
     if live_meshcat:
@@ -33,7 +35,7 @@ def run(scenario_path, out_dir, *, live_meshcat: bool = False) -> int:
     result = simulate(
         planner,
         name=scenario.name,
-        robot_model=robot_model(scenario.robot),
+        robot=get_robot(scenario.robot),
         gains=scenario.controller,
         time_step=scenario.time_step,
         log_period=scenario.log_period,
@@ -48,7 +50,7 @@ def run(scenario_path, out_dir, *, live_meshcat: bool = False) -> int:
         figure.savefig(out_dir / f"{stem}.png", dpi=110)
     draw_task(meshcat, result)
     export_html(meshcat, out_dir / "meshcat.html")
-    metrics = result.metrics()
+    metrics = result.metrics().to_dict()
     print(json.dumps({key: metrics[key] for key in (
         "name", "succeeded", "failure", "duration_s", "max_velocity_over_limit",
         "max_acceleration_over_limit", "tracking_error_joint_max_rad", "tracking_error_tcp_max_m",
@@ -64,7 +66,8 @@ def main(argv=None) -> int:
     commands = parser.add_subparsers(dest="command", required=True)
     run_parser = commands.add_parser("run", help="simulate a scenario and write its results")
     run_parser.add_argument("scenario", nargs="?", default=None,
-                            help=f"scenario YAML (default: {default_scenario_path().name})")
+                            help=f"scenario YAML (default: {DEFAULT_SCENARIO[0]}, variant {DEFAULT_SCENARIO[1]})")
+    run_parser.add_argument("--variant", default=None, help="the variant to run, in a file of several")
     run_parser.add_argument("--out", default=None, help="output directory (default: out/<scenario name>)")
     run_parser.add_argument("--meshcat", action="store_true", help="serve Meshcat live during the run")
     bench_parser = commands.add_parser("bench", help="compare every planner and baseline on UR10e tasks")
@@ -74,12 +77,13 @@ def main(argv=None) -> int:
     bench_parser.add_argument("--repeats", type=int, default=5, help="planning-time repeats on the paper task")
     args = parser.parse_args(argv)
     if args.command == "bench":
-        from drake_traj.bench import bench
-
         bench(args.out, count=args.count, seed=args.seed, repeats=args.repeats)
         return 0
     try:
-        return run(args.scenario or default_scenario_path(), args.out, live_meshcat=args.meshcat)
+        if args.scenario is None:
+            return run(default_scenario_path(), args.out, variant=args.variant or DEFAULT_SCENARIO[1],
+                       live_meshcat=args.meshcat)
+        return run(args.scenario, args.out, variant=args.variant, live_meshcat=args.meshcat)
     except ValueError as error:
         print(f"drake-traj: error: {error}", file=sys.stderr)
         return 2

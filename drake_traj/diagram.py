@@ -14,7 +14,6 @@ time grid starting at t = 0).
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 from pydrake.geometry import (
@@ -23,7 +22,6 @@ from pydrake.geometry import (
     MeshcatVisualizer,
     MeshcatVisualizerParams,
 )
-from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import (
     AddMultibodyPlant,
     MultibodyPlant,
@@ -35,62 +33,27 @@ from pydrake.systems.controllers import InverseDynamics
 from pydrake.systems.framework import DiagramBuilder, EventStatus, LeafSystem, TriggerType
 from pydrake.systems.primitives import LogVectorOutput
 
-from drake_traj import robot
+from drake_traj.errors import Failure
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.result import SimulationResult
-
-# Default PD gains per joint [N m/rad], [N m s/rad]: see README "Controller" for how they were chosen.
-DEFAULT_KP = (4000.0, 4000.0, 2000.0, 500.0, 500.0, 300.0)
-DEFAULT_KD = (200.0, 200.0, 100.0, 20.0, 20.0, 10.0)
-
-
-@dataclass(frozen=True)
-class RobotModel:
-    """What the closed loop needs to know about a robot.
-
-    Attributes:
-        name: a label.
-        model_path: returns the URDF path (its root link ``base`` is welded to the world; each
-            joint J has an actuator ``J_actuator``).
-        joint_names: actuated joints, in the order of q.
-        effort_limit: per joint [N m or N].
-        tcp_pose: q -> [x, y, z, phi_X, phi_Y, phi_Z] of the tool (orientation zeros where the
-            robot only places a point).
-        kp, kd: default PD gains per joint.
-    """
-
-    name: str
-    model_path: Callable[[], Path]
-    joint_names: tuple
-    effort_limit: np.ndarray
-    tcp_pose: Callable[[np.ndarray], np.ndarray]
-    kp: tuple
-    kd: tuple
-
-    @property
-    def num_joints(self) -> int:
-        return len(self.joint_names)
-
-
-UR10E = RobotModel("ur10e", robot.model_path, robot.JOINT_NAMES, robot.EFFORT_LIMIT, robot.task_pose, DEFAULT_KP, DEFAULT_KD)
-
+from drake_traj.robots import UR10E, Robot
 
 @dataclass
 class ControllerGains:
     """PD gains of the simulated joint controller and the feed-forward choice.
 
-    Empty ``kp`` / ``kd`` take the robot's defaults (:attr:`RobotModel.kp`, ``kd``).
+    Empty ``kp`` / ``kd`` take the robot's defaults (:attr:`Robot.default_gains`).
     """
 
     kp: list[float] = field(default_factory=list)
     kd: list[float] = field(default_factory=list)
     feedforward_acceleration: bool = True
 
-    def for_robot(self, model: RobotModel) -> "ControllerGains":
-        """These gains with empty lists filled from ``model``, validated for its joint count."""
-        gains = ControllerGains(list(self.kp) or list(model.kp), list(self.kd) or list(model.kd),
-                                self.feedforward_acceleration)
-        gains.validate(model.num_joints)
+    def for_robot(self, robot: Robot) -> "ControllerGains":
+        """These gains with empty lists filled from ``robot``'s defaults, validated for its joint count."""
+        kp, kd = robot.default_gains
+        gains = ControllerGains(list(self.kp) or list(kp), list(self.kd) or list(kd), self.feedforward_acceleration)
+        gains.validate(robot.num_joints)
         return gains
 
     def validate(self, num_joints: int) -> None:
@@ -105,38 +68,10 @@ class ControllerGains:
             raise ValueError(f"controller.kp must be positive, got {self.kp}")
 
 
-def robot_model(name: str) -> RobotModel:
-    """The closed-loop description of ``name``: "ur10e", "li_4dof" (seed 002) or one of seed 001's robots."""
-    if name == UR10E.name:
-        return UR10E
-    from drake_traj import li_robot, paper_robots
-
-    if name == "li_4dof":
-        return li_robot.closed_loop_model()
-
-    if name not in paper_robots.ROBOT_NAMES:
-        raise ValueError(
-            f"robot must be one of {(UR10E.name, 'li_4dof') + paper_robots.ROBOT_NAMES}, got {name!r}"
-        )
-    return paper_robots.closed_loop_model(name)
-
-
-def add_robot(plant: MultibodyPlant, model: RobotModel):
-    """Parse ``model``'s URDF into ``plant`` and weld its ``base`` to the world; returns the instance."""
-    (instance,) = Parser(plant).AddModels(str(model.model_path()))
-    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(robot.BASE_FRAME, instance))
-    return instance
-
-
-def add_ur10e(plant: MultibodyPlant):
-    """Parse models/ur10e.urdf into ``plant``, weld its base to the world; returns the instance."""
-    return add_robot(plant, UR10E)
-
-
 class TcpPose(LeafSystem):
     """Measured TCP pose from the plant state [q; qd], by ``tcp_pose(q)`` (6 values)."""
 
-    def __init__(self, tcp_pose: Callable[[np.ndarray], np.ndarray], num_joints: int):
+    def __init__(self, tcp_pose, num_joints: int):
         super().__init__()
         self._state = self.DeclareVectorInputPort("state", 2 * num_joints)
         self.DeclareVectorOutputPort(
@@ -182,7 +117,7 @@ class ClosedLoop:
 def build_closed_loop(
     planner: PlannerSystem,
     *,
-    robot_model: RobotModel = UR10E,
+    robot: Robot = UR10E,
     gains: ControllerGains | None = None,
     time_step: float = 1e-3,
     log_period: float = 1e-3,
@@ -192,16 +127,16 @@ def build_closed_loop(
 
     Args:
         planner: any system under the planner contract.
-        robot_model: the robot (default the UR10e).
+        robot: the robot (default the UR10e).
         gains: PD gains and feed-forward choice (defaults: the robot's gains, with feed-forward).
         time_step: plant discrete step [s].
         log_period: uniform logging period [s].
         meshcat: when given, the robot is drawn there (``MeshcatVisualizer``).
     """
-    gains = (gains or ControllerGains()).for_robot(robot_model)
-    n = robot_model.num_joints
+    gains = (gains or ControllerGains()).for_robot(robot)
+    n = robot.num_joints
     if planner.num_joints != n:
-        raise ValueError(f"the planner has {planner.num_joints} joints, robot {robot_model.name} has {n}")
+        raise ValueError(f"the planner has {planner.num_joints} joints, robot {robot.name} has {n}")
     for name, value in (("time_step", time_step), ("log_period", log_period)):
         if not np.isfinite(value) or value <= 0:
             raise ValueError(f"{name} must be a positive number of seconds, got {value}")
@@ -210,8 +145,8 @@ def build_closed_loop(
     plant, scene_graph = AddMultibodyPlant(
         MultibodyPlantConfig(time_step=time_step, discrete_contact_approximation="sap"), builder
     )
-    instance = add_robot(plant, robot_model)
-    for joint_name, kp, kd in zip(robot_model.joint_names, gains.kp, gains.kd):
+    instance = robot.add_to_plant(plant)
+    for joint_name, kp, kd in zip(robot.joint_names, gains.kp, gains.kd):
         actuator = plant.GetJointActuatorByName(f"{joint_name}_actuator", instance)
         actuator.set_controller_gains(PdControllerGains(p=kp, d=kd))
     plant.Finalize()
@@ -239,7 +174,7 @@ def build_closed_loop(
         )
     builder.Connect(feedforward.get_output_port_generalized_force(), plant.get_actuation_input_port(instance))
 
-    tcp = builder.AddSystem(TcpPose(robot_model.tcp_pose, n))
+    tcp = builder.AddSystem(TcpPose(robot.tcp_pose, n))
     builder.Connect(plant.get_state_output_port(instance), tcp.get_input_port())
 
     def log(port):
@@ -265,7 +200,7 @@ def simulate(
     planner: PlannerSystem,
     *,
     name: str = "run",
-    robot_model: RobotModel = UR10E,
+    robot: Robot = UR10E,
     gains: ControllerGains | None = None,
     time_step: float = 1e-3,
     log_period: float = 1e-3,
@@ -288,7 +223,7 @@ def simulate(
         if not np.isfinite(value) or value < 0:
             raise ValueError(f"{label} must be a non-negative number of seconds, got {value}")
     loop = build_closed_loop(
-        planner, robot_model=robot_model, gains=gains, time_step=time_step, log_period=log_period, meshcat=meshcat
+        planner, robot=robot, gains=gains, time_step=time_step, log_period=log_period, meshcat=meshcat
     )
     simulator = Simulator(loop.diagram)
     simulator.set_target_realtime_rate(realtime_rate)
@@ -318,9 +253,10 @@ def simulate(
     try:
         simulator.AdvanceTo(max_duration)
         if np.isnan(finish_time[0]):
-            failure = f"planner did not finish within max_duration = {max_duration} s"
+            failure = Failure("timeout", f"planner did not finish within max_duration = {max_duration} s",
+                              context.get_time())
     except Exception as error:  # keep the log up to the failure; the reason goes in the result
-        failure = f"{type(error).__name__} at t = {context.get_time():.4f} s: {error}"
+        failure = Failure.from_exception(error, context.get_time())
     wall_time = time.perf_counter() - start
     if loop.visualizer is not None:
         loop.visualizer.StopRecording()
@@ -329,7 +265,7 @@ def simulate(
     logs = {key: logger.FindLog(context) for key, logger in loop.loggers.items()}
     count = min(log.num_samples() for log in logs.values())
     data = {key: log.data()[:, :count].T for key, log in logs.items()}
-    n = robot_model.num_joints
+    n = robot.num_joints
     return SimulationResult(
         name=name,
         t=logs["reference"].sample_times()[:count].copy(),
@@ -341,10 +277,10 @@ def simulate(
         tau=data["torque"],
         scaling=data["scaling"][:, 0],
         tcp=data["tcp"],
-        tcp_ref=np.array([robot_model.tcp_pose(q) for q in data["reference"][:, :n]]).reshape(-1, 6),
+        tcp_ref=np.array([robot.tcp_pose(q) for q in data["reference"][:, :n]]).reshape(-1, 6),
         velocity_limit=np.broadcast_to(planner.velocity_limit, (n,)).astype(float),
         acceleration_limit=np.broadcast_to(planner.acceleration_limit, (n,)).astype(float),
-        effort_limit=np.array(robot_model.effort_limit, dtype=float),
+        effort_limit=robot.effort_limits,
         waypoints=planner.task_waypoints(),
         duration=finish_time[0],
         failure=failure,

@@ -15,7 +15,7 @@ PATH_COLOUR = Rgba(0.9, 0.1, 0.1, 1.0)
 
 
 def draw_task(meshcat: Meshcat, result: SimulationResult, *, waypoint_radius: float = 0.05) -> None:
-    """Waypoint spheres (radius [m], default seed 000's neighbourhood) and the measured TCP path."""
+    """Waypoint spheres (radius [m], default Pająk 2024's neighbourhood) and the measured TCP path."""
     meshcat.Delete("/drake_traj")
     for index, point in enumerate(result.waypoints):
         path = f"/drake_traj/waypoints/{index}"

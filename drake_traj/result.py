@@ -10,19 +10,56 @@ All arrays are time-major (one row per logged sample) on a uniform grid ``t`` [s
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
 
+from drake_traj.errors import Failure
+
+__all__ = ["ARRAY_NAMES", "Metrics", "SimulationResult"]
+
 ARRAY_NAMES = ("t", "q_ref", "qd_ref", "qdd_ref", "q_meas", "qd_meas", "tau", "scaling", "tcp", "tcp_ref")
 _LIMIT_NAMES = ("velocity_limit", "acceleration_limit", "effort_limit", "waypoints")
 
 
+@dataclass(frozen=True)
+class Metrics:
+    """Figures of merit of a run (:meth:`SimulationResult.metrics`); :meth:`to_dict` is the
+    content of ``metrics.json``. Joint quantities are per joint, in rad, rad/s, rad/s^2 (m, m/s,
+    m/s^2 for prismatic joints); ``*_over_limit`` are ratios to the planner's promised limits (the
+    effort limit for torques); ``failure`` is the failure's message (None on success)."""
+
+    name: str
+    succeeded: bool
+    failure: str | None
+    duration_s: float
+    samples: int
+    log_period_s: float | None
+    qd_min: list[float]
+    qd_max: list[float]
+    qdd_min: list[float]
+    qdd_max: list[float]
+    max_velocity_over_limit: float
+    max_acceleration_over_limit: float
+    max_jerk: float
+    tracking_error_joint_max_rad: float
+    tracking_error_tcp_max_m: float
+    peak_torque_nm: list[float]
+    peak_torque_over_limit: list[float]
+    simulated_time_s: float
+    wall_time_s: float
+    real_time_factor: float | None
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict with the field names as keys."""
+        return asdict(self)
+
+
 @dataclass
 class SimulationResult:
-    """One simulated run. ``failure`` is None on success, else the reason the run stopped early."""
+    """One simulated run. ``failure`` is None on success, else why the run stopped early."""
 
     name: str
     t: np.ndarray
@@ -40,7 +77,7 @@ class SimulationResult:
     effort_limit: np.ndarray
     waypoints: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     duration: float = float("nan")
-    failure: str | None = None
+    failure: Failure | None = None
     wall_time: float = float("nan")
 
     @property
@@ -51,33 +88,33 @@ class SimulationResult:
         """Reference jerk [rad/s^3] by finite differences of qdd_ref, shape (N-1, 6)."""
         return np.diff(self.qdd_ref, axis=0) / np.diff(self.t)[:, None]
 
-    def metrics(self) -> dict:
-        """Scalar and per-joint figures of merit, JSON-ready."""
+    def metrics(self) -> Metrics:
+        """Scalar and per-joint figures of merit."""
         tcp_error = np.linalg.norm(self.tcp_ref[:, :3] - self.tcp[:, :3], axis=1)
         simulated = float(self.t[-1]) if len(self.t) else 0.0
         jerk = self.jerk()
-        return {
-            "name": self.name,
-            "succeeded": self.succeeded,
-            "failure": self.failure,
-            "duration_s": self.duration,
-            "samples": int(len(self.t)),
-            "log_period_s": float(np.median(np.diff(self.t))) if len(self.t) > 1 else None,
-            "qd_min": self.qd_ref.min(axis=0).tolist(),
-            "qd_max": self.qd_ref.max(axis=0).tolist(),
-            "qdd_min": self.qdd_ref.min(axis=0).tolist(),
-            "qdd_max": self.qdd_ref.max(axis=0).tolist(),
-            "max_velocity_over_limit": float(np.max(np.abs(self.qd_ref) / self.velocity_limit)),
-            "max_acceleration_over_limit": float(np.max(np.abs(self.qdd_ref) / self.acceleration_limit)),
-            "max_jerk": float(np.abs(jerk).max()) if len(jerk) else 0.0,
-            "tracking_error_joint_max_rad": float(np.abs(self.q_ref - self.q_meas).max()),
-            "tracking_error_tcp_max_m": float(tcp_error.max()),
-            "peak_torque_nm": np.abs(self.tau).max(axis=0).tolist(),
-            "peak_torque_over_limit": (np.abs(self.tau).max(axis=0) / self.effort_limit).tolist(),
-            "simulated_time_s": simulated,
-            "wall_time_s": self.wall_time,
-            "real_time_factor": simulated / self.wall_time if self.wall_time > 0 else None,
-        }
+        return Metrics(
+            name=self.name,
+            succeeded=self.succeeded,
+            failure=None if self.failure is None else self.failure.message,
+            duration_s=self.duration,
+            samples=int(len(self.t)),
+            log_period_s=float(np.median(np.diff(self.t))) if len(self.t) > 1 else None,
+            qd_min=self.qd_ref.min(axis=0).tolist(),
+            qd_max=self.qd_ref.max(axis=0).tolist(),
+            qdd_min=self.qdd_ref.min(axis=0).tolist(),
+            qdd_max=self.qdd_ref.max(axis=0).tolist(),
+            max_velocity_over_limit=float(np.max(np.abs(self.qd_ref) / self.velocity_limit)),
+            max_acceleration_over_limit=float(np.max(np.abs(self.qdd_ref) / self.acceleration_limit)),
+            max_jerk=float(np.abs(jerk).max()) if len(jerk) else 0.0,
+            tracking_error_joint_max_rad=float(np.abs(self.q_ref - self.q_meas).max()),
+            tracking_error_tcp_max_m=float(tcp_error.max()),
+            peak_torque_nm=np.abs(self.tau).max(axis=0).tolist(),
+            peak_torque_over_limit=(np.abs(self.tau).max(axis=0) / self.effort_limit).tolist(),
+            simulated_time_s=simulated,
+            wall_time_s=self.wall_time,
+            real_time_factor=simulated / self.wall_time if self.wall_time > 0 else None,
+        )
 
     # --- persistence ---------------------------------------------------------------------------
     def save(self, directory) -> Path:
@@ -85,9 +122,10 @@ class SimulationResult:
         directory = Path(directory)
         directory.mkdir(parents=True, exist_ok=True)
         arrays = {name: getattr(self, name) for name in ARRAY_NAMES + _LIMIT_NAMES}
-        meta = {"name": self.name, "duration": self.duration, "failure": self.failure, "wall_time": self.wall_time}
+        failure = None if self.failure is None else self.failure.to_dict()
+        meta = {"name": self.name, "duration": self.duration, "failure": failure, "wall_time": self.wall_time}
         np.savez_compressed(directory / "result.npz", meta=json.dumps(meta), **arrays)
-        (directory / "metrics.json").write_text(json.dumps(self.metrics(), indent=2))
+        (directory / "metrics.json").write_text(json.dumps(self.metrics().to_dict(), indent=2))
         return directory
 
     @classmethod
@@ -99,6 +137,8 @@ class SimulationResult:
         with np.load(path) as data:
             meta = json.loads(str(data["meta"]))
             arrays = {f.name: data[f.name] for f in fields(cls) if f.name in data.files}
+        if meta["failure"] is not None:
+            meta["failure"] = Failure.from_dict(meta["failure"])
         return cls(**meta, **arrays)
 
     # --- figures -------------------------------------------------------------------------------

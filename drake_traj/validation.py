@@ -57,3 +57,12 @@ def positive_vector(value, name: str, n: int) -> np.ndarray:
         j = int(np.argmax(bad))
         raise ValueError(f"{name}[{j}] (joint {j}) must be finite and > 0, got {array[j]}")
     return array
+
+
+def limit_or_default(value, default, name: str, n: int) -> np.ndarray:
+    """A per-joint limit from a config (:func:`positive_vector`), ``default`` when it is empty."""
+    if value is None or np.size(value) == 0:
+        if default is None or not np.all(np.isfinite(default)):
+            raise ValueError(f"{name} must be given: the robot has no default {name.replace('_', ' ')}")
+        value = default
+    return positive_vector(value, name, n)

@@ -15,9 +15,9 @@ import time
 from pydrake.systems.analysis import Simulator
 
 from drake_traj.diagram import simulate
-from drake_traj.scenario import default_scenario_path, load_scenario, make_planner
+from drake_traj.scenario import DEFAULT_SCENARIO, default_scenario_path, load_scenario, make_planner
 
-SCENARIOS = (default_scenario_path().parent / "quintic_ptp.yaml", default_scenario_path())
+SCENARIOS = ((default_scenario_path().parent / "quintic_ptp.yaml", None), (default_scenario_path(), DEFAULT_SCENARIO[1]))
 
 
 def derivative_cost_us(scenario) -> float:
@@ -49,7 +49,7 @@ def planner_alone_rtf(scenario) -> float:
 def closed_loop_rtf(scenario) -> float:
     result = simulate(make_planner(scenario), name=scenario.name, gains=scenario.controller,
                       settle_time=scenario.settle_time, max_duration=scenario.max_duration)
-    return result.metrics()["real_time_factor"]
+    return result.metrics().real_time_factor
 
 
 def main() -> None:
@@ -58,8 +58,8 @@ def main() -> None:
     args = parser.parse_args()
     print("| scenario | derivative [µs] | RTF planner alone | RTF closed loop |")
     print("|---|---|---|---|")
-    for path in SCENARIOS:
-        scenario = load_scenario(path)
+    for path, variant in SCENARIOS:
+        scenario = load_scenario(path, variant)
         cost = derivative_cost_us(scenario)
         alone = statistics.median(planner_alone_rtf(scenario) for _ in range(args.repeats))
         loop = statistics.median(closed_loop_rtf(scenario) for _ in range(args.repeats))

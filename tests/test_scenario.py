@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drake_traj import cli
-from drake_traj.scenario import Scenario, default_scenario_path, load_scenario, make_planner
+from drake_traj import QuinticConfig, cli
+from drake_traj.scenario import Scenario, default_scenario_path, load_scenario, make_planner, scenario_variants
 
 from conftest import DIAGRAMS
 
@@ -26,9 +26,10 @@ def test_every_shipped_scenario_loads_and_builds_its_planner():
     paths = sorted(DIAGRAMS.glob("*.yaml"))
     assert paths, "no scenarios in diagrams/"
     for path in paths:
-        scenario = load_scenario(path)
-        assert scenario.name == path.stem
-        make_planner(scenario)
+        for variant in scenario_variants(path) or [None]:
+            scenario = load_scenario(path, variant)
+            assert scenario.name == (path.stem if variant is None else f"{path.stem}_{variant}")
+            make_planner(scenario)
 
 
 def test_default_scenario_is_shipped_with_the_package():
@@ -74,10 +75,25 @@ def test_cli_reports_bad_input_without_a_traceback(tmp_path, capsys):
 
 
 def test_scenario_defaults_are_the_papers_start_and_ur_limits():
-    scenario = Scenario()
-    np.testing.assert_allclose(scenario.q_initial, [-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
-    assert scenario.planner.velocity_limit == [1.05] * 6
-    assert scenario.planner.acceleration_limit == [1.40] * 6
+    scenario = Scenario(planner=QuinticConfig(goals=[[0.0] * 6]))
+    np.testing.assert_allclose(scenario.start_configuration(),
+                               [-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
+    planner = make_planner(scenario)
+    np.testing.assert_array_equal(planner.velocity_limit, [1.05] * 6)
+    np.testing.assert_array_equal(planner.acceleration_limit, [1.40] * 6)
+
+
+def test_variants_are_chosen_by_name(tmp_path):
+    assert scenario_variants(DIAGRAMS / "pajak.yaml") == ["sim1", "sim2", "sim3"]
+    assert scenario_variants(DIAGRAMS / "quintic_ptp.yaml") == []
+    assert load_scenario(DIAGRAMS / "pajak.yaml", "sim2").planner.limit_acceleration is False
+    with pytest.raises(ValueError, match=r"no variant was given; its variants are \['sim1', 'sim2', 'sim3'\]"):
+        load_scenario(DIAGRAMS / "pajak.yaml")
+    with pytest.raises(ValueError, match="there is no variant 'sim4'"):
+        load_scenario(DIAGRAMS / "pajak.yaml", "sim4")
+    with pytest.raises(ValueError, match="holds one scenario, not variants"):
+        load_scenario(DIAGRAMS / "quintic_ptp.yaml", "sim3")
+    assert cli.main(["run", str(DIAGRAMS / "pajak.yaml"), "--variant", "sim4", "--out", str(tmp_path)]) == 2
 
 
 def test_example_runs_and_writes_its_outputs(tmp_path, monkeypatch, capsys):

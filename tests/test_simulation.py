@@ -8,7 +8,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
-from drake_traj import robot
+from drake_traj.robots import ur10e as robot
 from drake_traj.diagram import ControllerGains, simulate
 from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
 from drake_traj.result import ARRAY_NAMES, SimulationResult
@@ -30,7 +30,7 @@ def quintic_planner():
 
 
 def short_move(**kwargs):
-    """A single 1-goal quintic move from seed 000's start (about 1.7 s)."""
+    """A single 1-goal quintic move from Pająk 2024's start (about 1.7 s)."""
     q0 = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
     plan = plan_synchronized_quintic(q0, q0 + [0.6, -0.3, 0.4, -0.5, 0.3, 0.8], 1.05, 1.40)
     return QuinticPtpPlanner(plan, 1.05, 1.40, **kwargs)
@@ -77,8 +77,8 @@ def test_limits_hold_at_every_logged_sample(quintic_result):
 def test_pd_loop_tracks_the_reference(quintic_result, quintic_planner):
     metrics = quintic_result.metrics()
     # Measured on this scenario: 3.5e-5 rad and 3.2e-5 m with inverse-dynamics feed-forward.
-    assert metrics["tracking_error_joint_max_rad"] < 5e-5
-    assert metrics["tracking_error_tcp_max_m"] < 5e-5
+    assert metrics.tracking_error_joint_max_rad < 5e-5
+    assert metrics.tracking_error_tcp_max_m < 5e-5
     np.testing.assert_allclose(quintic_result.q_meas[-1], quintic_planner.law.q_goal, atol=1e-5)
     np.testing.assert_allclose(quintic_result.qd_meas[-1], 0.0, atol=1e-5)
 
@@ -91,8 +91,8 @@ def test_logged_tcp_is_k_of_the_measured_configuration(quintic_result):
 def test_gravity_compensation_alone_tracks_worse_than_inverse_dynamics_feedforward():
     with_feedforward = simulate(short_move(), settle_time=0.1).metrics()
     gravity_only = simulate(short_move(), gains=ControllerGains(feedforward_acceleration=False), settle_time=0.1).metrics()
-    assert gravity_only["tracking_error_joint_max_rad"] > 10 * with_feedforward["tracking_error_joint_max_rad"]
-    assert gravity_only["tracking_error_joint_max_rad"] < 5e-3  # measured 1.05e-3: still a usable PD loop
+    assert gravity_only.tracking_error_joint_max_rad > 10 * with_feedforward.tracking_error_joint_max_rad
+    assert gravity_only.tracking_error_joint_max_rad < 5e-3  # measured 1.05e-3: still a usable PD loop
 
 
 class PlannerFailingAt(QuinticPtpPlanner):
@@ -112,7 +112,8 @@ def test_a_run_that_fails_part_way_keeps_its_log_and_the_reason(tmp_path):
     plan = short_move().law
     result = simulate(PlannerFailingAt(0.4, plan, 1.05, 1.40))
     assert not result.succeeded
-    assert "singular configuration (test fault)" in result.failure and "t = 0.4" in result.failure
+    assert "singular configuration (test fault)" in result.failure.message and "t = 0.4" in result.failure.message
+    assert result.failure.cause == "error" and 0.4 <= result.failure.time <= 0.402
     assert 395 <= len(result.t) <= 402 and np.all(np.isfinite(result.q_ref))
     loaded = SimulationResult.load(result.save(tmp_path))
     assert loaded.failure == result.failure
@@ -121,7 +122,8 @@ def test_a_run_that_fails_part_way_keeps_its_log_and_the_reason(tmp_path):
 
 def test_a_planner_that_never_finishes_is_reported():
     result = simulate(short_move(), max_duration=0.5)
-    assert not result.succeeded and "did not finish" in result.failure
+    assert not result.succeeded and "did not finish" in result.failure.message
+    assert result.failure.cause == "timeout"
     assert np.isnan(result.duration)
 
 

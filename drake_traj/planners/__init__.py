@@ -1,1 +1,49 @@
-"""Planner systems: one module per published planner, plus the shared base and scaling law."""
+"""Planner systems under one contract (:mod:`.base`), each with its config dataclass and ``make``.
+
+The scenario's ``planner`` entry is one of :data:`PLANNER_CONFIGS` (a YAML tag names the type,
+e.g. ``planner: !PajakConfig {...}``); :func:`make_planner` builds the system it describes.
+"""
+
+from __future__ import annotations
+
+from typing import Union
+
+from drake_traj.planners import boryga, pajak, quintic
+from drake_traj.planners.baselines import movej, ruckig, toppra
+from drake_traj.planners.base import PlannerSystem
+from drake_traj.planners.boryga import BorygaConfig
+from drake_traj.planners.baselines.movej import MovejConfig
+from drake_traj.planners.baselines.ruckig import RuckigConfig
+from drake_traj.planners.baselines.toppra import ToppraConfig
+from drake_traj.planners.li import system as li
+from drake_traj.planners.li.system import LiConfig
+from drake_traj.planners.pajak import PajakConfig
+from drake_traj.planners.quintic import QuinticConfig
+from drake_traj.robots.base import Robot
+
+__all__ = [
+    "BorygaConfig", "LiConfig", "MovejConfig", "PLANNER_CONFIGS", "PajakConfig", "PlannerConfig", "PlannerSystem",
+    "QuinticConfig", "RuckigConfig", "ToppraConfig", "make_planner",
+]
+
+# Each config type and the ``make(config, robot, q_initial)`` that builds its planner.
+_MAKERS = {
+    QuinticConfig: quintic.make,
+    PajakConfig: pajak.make,
+    BorygaConfig: boryga.make,
+    LiConfig: li.make,
+    MovejConfig: movej.make,
+    RuckigConfig: ruckig.make,
+    ToppraConfig: toppra.make,
+}
+PLANNER_CONFIGS = tuple(_MAKERS)
+PlannerConfig = Union[QuinticConfig, PajakConfig, BorygaConfig, LiConfig, MovejConfig, RuckigConfig, ToppraConfig]
+
+
+def make_planner(config: PlannerConfig, robot: Robot, q_initial) -> PlannerSystem:
+    """The planner system ``config`` describes, on ``robot``, starting at rest at ``q_initial``."""
+    try:
+        maker = _MAKERS[type(config)]
+    except KeyError:
+        raise TypeError(f"config must be one of {[c.__name__ for c in PLANNER_CONFIGS]}, got {type(config).__name__}") from None
+    return maker(config, robot, q_initial)

@@ -1,11 +1,11 @@
-"""The planner contract (DESIGN.md) as a LeafSystem base class.
+"""The planner contract (docs/design.md) as a LeafSystem base class.
 
 Every planner is a LeafSystem with
 
 - continuous state x = [q; qd] (6 + 6): the joint reference being generated, integrated by the
   Simulator from the planner's acceleration;
 - a discrete state group ``scaling`` = [c, t0, c0]: the scaling coefficient and the anchor of its
-  relaxation (eq. 18 of seed 000), plus planner-specific discrete groups declared by subclasses;
+  relaxation (eq. 18 of Pająk 2024), plus planner-specific discrete groups declared by subclasses;
 - output ports ``desired_state`` [q; qd], ``desired_acceleration`` qdd and ``scaling`` c;
 - an optional input port ``speed_override`` (a value in [0, 1]; unconnected means 1).
 
@@ -21,6 +21,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem, ValueProducer
 
 from drake_traj.planners.scaling import relaxed_scaling, scaled_clock
+from drake_traj.validation import finite_array
 
 
 class PlannerSystem(LeafSystem):
@@ -74,6 +75,11 @@ class PlannerSystem(LeafSystem):
         """q at t = 0 [rad]: where the robot starts."""
         return self._q_initial.copy()
 
+    def preflight(self) -> None:
+        """Check the whole task before t = 0; raise :class:`~drake_traj.errors.PlanningError` if
+        it cannot be completed. Planners that plan the whole motion when they are made have
+        nothing left to check (this default); online planners run their law ahead of time."""
+
     # --- shared ------------------------------------------------------------------------------
     def speed_override(self, context) -> float:
         """The speed override in [0, 1]; 1 when the input is not connected."""
@@ -121,7 +127,7 @@ class TimeLawPlanner(PlannerSystem):
     law's joint velocity and acceleration at law time tau. The clock tau advances at the scaling
     rate c: with c = 1 the reference is the law itself. c starts at ``speed_cap`` and its goal is
     ``speed_cap`` times the ``speed_override`` input (sampled every ``update_period``); c relaxes
-    towards the goal by eq. 18 of seed 000, so tau, c and dc/dt have closed forms and the reference
+    towards the goal by eq. 18 of Pająk 2024, so tau, c and dc/dt have closed forms and the reference
     stays C^1 in velocity: qd = q_law'(tau) c and qdd = q_law''(tau) c^2 + q_law'(tau) dc/dt.
     With c held at a constant value, velocity scales by c and acceleration by c^2, so a law that
     breaks limits by a factor can be slowed into them with ``speed_cap`` < 1. While c changes,
@@ -174,3 +180,14 @@ class TimeLawPlanner(PlannerSystem):
             discrete_state.get_mutable_vector(self.clock_state_index).SetFromVector([tau, goal])
         else:
             scaling.SetAtIndex(0, c)
+
+
+def start_and_goals(q_initial, goals, num_joints: int) -> np.ndarray:
+    """The start ``q_initial`` (n,) followed by the rows of ``goals`` (m, n): shape (m + 1, n)."""
+    start = finite_array(q_initial, "q_initial", "rad", shape=(num_joints,))
+    rows = finite_array(goals, "goals", "rad")
+    if rows.size == 0:
+        raise ValueError("goals must have at least one row of joint positions, got none")
+    if rows.ndim != 2 or rows.shape[1] != num_joints:
+        raise ValueError(f"goals must have shape (m, {num_joints}), got shape {rows.shape}")
+    return np.vstack([start, rows])

@@ -1,6 +1,6 @@
-"""Rectilinear path with a loop through the corner: geometry and time law (seed 001, Boryga).
+"""Rectilinear path with a loop through the corner: geometry and time law (Boryga, Boryga).
 
-Seed 001 (M. Boryga, "Trajectory Planning of an End-Effector for Path with Loop") moves the tool
+Boryga (M. Boryga, "Trajectory Planning of an End-Effector for Path with Loop") moves the tool
 from B to E through a sharp corner M without stopping there. The path is two straight segments,
 B -> M and M -> E, joined by a loop through the corner:
 
@@ -15,12 +15,12 @@ the profile, so the tool stops at E with zero acceleration. The loop circle of r
 at O1 on the bisector of the angle BME, at distance Delta from M, and is tangent to the extensions
 of BM and EM beyond M at T1 and T2 (section 2.2).
 
-Equation numbers below are the paper's. The project ERRATA (seed 001) is trusted over the OCR'd
+Equation numbers below are the paper's. The corrections in docs/papers.md are trusted over the OCR'd
 text: the paper's p_BM of 4.46156e4 m/s^9 transposes digits (4.46516e4), its t_e = 0.815 s is a sum
 of rounded parts (0.81368 s), its total path 0.152 m is 0.15217 m (the 0.036 m it gives "on the
 loop" is the arc alone), its frame "zeta-eta-zeta" is xi-eta-zeta, and the start angle is beta_b in
 eq. 11 and beta_p in section 3 (both pi - beta/2). The transformation T of eq. 12 is not given in
-the paper; the ERRATA's construction is used: xi = (M - O1) / Delta, zeta = unit(a_hat x d_hat),
+the paper; the construction of docs/papers.md is used: xi = (M - O1) / Delta, zeta = unit(a_hat x d_hat),
 eta = zeta x xi, origin O1. With it the arc starts at T1 tangent to BM and ends at T2 heading
 towards M along EM.
 
@@ -36,15 +36,13 @@ Everything here is plain numpy: tests call it directly and the planner system (l
 shell around it. Positions are in the base frame xyz [m]; times in seconds.
 """
 
-from __future__ import annotations
-
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from drake_traj import robot
 from drake_traj.planners.base import TimeLawPlanner
-from drake_traj.validation import finite_array, positive_scalar
+from drake_traj.robots import Robot
+from drake_traj.validation import finite_array, limit_or_default, positive_scalar
 
 __all__ = [
     "PHASES",
@@ -187,7 +185,7 @@ class LoopGeometry:
         beta: arc angle T1 -> T2 about O1 [rad]: pi + the angle between a_hat and d_hat.
         beta_b: start angle of the arc in the xi-eta plane, pi - beta / 2 [rad] (eq. 11; called
             beta_p in the paper's section 3).
-        xi, eta, zeta: axes of the local frame of eq. 12 (ERRATA): xi = (M - O1) / Delta,
+        xi, eta, zeta: axes of the local frame of eq. 12 (docs/papers.md): xi = (M - O1) / Delta,
             zeta = unit(a_hat x d_hat), eta = zeta x xi. Right-handed, orthonormal.
         ds_BM, ds_MT1, ds_arc, ds_T2M, ds_ME: path increments of the five parts [m]
             (ds_arc = beta R is the paper's Delta s^A).
@@ -336,7 +334,7 @@ def loop_geometry(B, M, E, delta=None, radius=None) -> LoopGeometry:
     beta = float(np.pi + corner_angle)  # pi + angle between a_hat and d_hat
     beta_b = float(np.pi - 0.5 * beta)  # eq. 11
 
-    # Local frame of eq. 12 (ERRATA): xi towards M, zeta normal to the path's plane.
+    # Local frame of eq. 12 (docs/papers.md): xi towards M, zeta normal to the path's plane.
     xi = (M - O1) / delta
     zeta = cross / sin_angle
     eta = np.cross(zeta, xi)
@@ -682,7 +680,7 @@ class LoopPathPlan:
 
 
 def plan_loop_path(B, M, E, v_max, delta=None, radius=None) -> LoopPathPlan:
-    """Plan the motion B -> M -> loop -> M -> E of seed 001 (section 2, eq. 1-14).
+    """Plan the motion B -> M -> loop -> M -> E of Boryga (section 2, eq. 1-14).
 
     Args:
         B: start point [m], shape (3,).
@@ -703,62 +701,40 @@ def plan_loop_path(B, M, E, v_max, delta=None, radius=None) -> LoopPathPlan:
 
 
 # --------------------------------------------------------------------------------------------
-# Joint motion on a robot and the planner system (DESIGN.md contract).
+# Joint motion on a robot and the planner system (docs/design.md contract).
 # --------------------------------------------------------------------------------------------
 
 
-class PaperRobotLoopLaw:
-    """The loop path's joint motion on one of seed 001's robots, by their closed-form IK
-    (eq. 15-32): the time law a :class:`TimeLawPlanner` follows.
+class RobotLoopLaw:
+    """The loop path's joint motion on a robot: the time law a :class:`TimeLawPlanner` follows.
+
+    q(tau) is the robot's inverse kinematics of the path point (:meth:`Robot.point_ik`: the
+    closed-form IK of Boryga's robots, eq. 15-32; the UR10e's keeps the flange orientation and IK
+    branch of ``reference``) and the rates come from its Jacobian (:meth:`Robot.joint_rates`).
 
     Args:
         plan: the loop path (:func:`plan_loop_path`), in the robot's base frame.
-        arm: a robot of :mod:`drake_traj.paper_robots` (``fk``, ``ik``, ``joint_trajectory``).
+        robot: the robot.
+        reference: a configuration of the robot giving the tool orientation and IK branch.
     """
 
-    def __init__(self, plan: LoopPathPlan, arm):
+    def __init__(self, plan: LoopPathPlan, robot: Robot, reference):
         self.plan = plan
-        self.arm = arm
-        self.duration = plan.duration
-        self.q_start = arm.ik(plan.sample(0.0)[0])
-
-    def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
-        """(qd, qdd) at law time tau [s] (eq. 15-32 and J^-1 for the rates)."""
-        _, qd, qdd = self.arm.joint_trajectory(self.plan, np.array([tau]))
-        return qd[0], qdd[0]
-
-
-class Ur10eLoopLaw:
-    """The loop path's joint motion on the UR10e: the flange traces the path at a fixed
-    orientation, joints by the closed-form IK on one branch, rates by the analytic Jacobian:
-    qd = J^-1 [v; 0], qdd = J^-1 ([a; 0] - dJ/dt qd).
-
-    Args:
-        plan: the loop path in the UR10e base frame [m].
-        orientation: the fixed Z-Y-X Euler angles of the flange [rad].
-        branch: IK branch signs (shoulder, elbow, wrist), see :func:`drake_traj.robot.ik_branch`.
-    """
-
-    def __init__(self, plan: LoopPathPlan, orientation, branch):
-        self.plan = plan
-        self.orientation = np.asarray(orientation, dtype=float)
-        self.branch = tuple(branch)
+        self.robot = robot
+        self.reference = np.asarray(reference, dtype=float)
         self.duration = plan.duration
         self.q_start = self.configuration(0.0)
 
     def configuration(self, tau: float) -> np.ndarray:
-        """q [rad] with the flange on the path at law time tau [s]."""
-        position = self.plan.sample(tau)[0]
-        return robot.inverse_kinematics(np.concatenate([position, self.orientation]), branch=self.branch)
+        """q with the tool on the path at law time tau [s]."""
+        return self.robot.point_ik(self.plan.sample(tau)[0][None], self.reference)[0]
 
     def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """(qd, qdd) at law time tau [s]."""
         position, velocity, acceleration = self.plan.sample(tau)[:3]
-        q = robot.inverse_kinematics(np.concatenate([position, self.orientation]), branch=self.branch)
-        jacobian = robot.analytic_jacobian(q)
-        qd = np.linalg.solve(jacobian, np.concatenate([velocity, np.zeros(3)]))
-        _, bias = robot.analytic_jacobian_and_bias(q, qd)
-        qdd = np.linalg.solve(jacobian, np.concatenate([acceleration, np.zeros(3)]) - bias)
-        return qd, qdd
+        q = self.robot.point_ik(position[None], self.reference)[0]
+        qd, qdd = self.robot.joint_rates(q, velocity, acceleration)
+        return np.reshape(qd, -1), np.reshape(qdd, -1)
 
 
 def joint_speed_cap(law, velocity_limit, acceleration_limit, *, samples: int = 4001) -> tuple[float, dict]:
@@ -786,8 +762,8 @@ def joint_speed_cap(law, velocity_limit, acceleration_limit, *, samples: int = 4
 
 
 class BorygaLoopPlanner(TimeLawPlanner):
-    """Seed 001's loop motion on a robot under the planner contract: the joint law of
-    :class:`PaperRobotLoopLaw` or :class:`Ur10eLoopLaw`, slowed by a constant clock rate
+    """Boryga's loop motion on a robot under the planner contract: the joint law of
+    :class:`RobotLoopLaw`, slowed by a constant clock rate
     (:func:`joint_speed_cap`) where it would break the joint limits.
 
     Args:
@@ -835,3 +811,145 @@ def loop_path_figure(plan: LoopPathPlan, *, samples: int = 4001):
         ax.legend(ncol=4, fontsize="small")
     axes[-1].set_xlabel("t [s]")
     return figure
+
+
+# ------------------------------------------------------------------------------------------------
+# The paper's example loop and its placement in each workspace.
+# ------------------------------------------------------------------------------------------------
+
+# Boryga, section 3 / Table 1: B, M, E [m], Delta [m], v_max [m/s]. Horizontal plane z = 1 m.
+PAPER_LOOP = {
+    "B": (0.5, 0.5, 1.0),
+    "M": (0.54, 0.53, 1.0),
+    "E": (0.54, 0.5, 1.0),
+    "delta": 0.02,
+    "v_max": 0.25,
+}
+
+
+@dataclass(frozen=True, eq=False)
+class LoopPlacement:
+    """The paper's loop (same shape, Delta and v_max) moved into one robot's workspace.
+
+    Attributes:
+        robot: robot name.
+        B, M, E: placed points [m], read-only arrays (3,).
+        delta: Delta [m]; v_max: loop speed [m/s] (the paper's).
+        offset: translation applied to the paper's Table 1 points [m] (no rotation is needed).
+        reason: where the loop was put and why.
+    """
+
+    robot: str
+    B: np.ndarray
+    M: np.ndarray
+    E: np.ndarray
+    delta: float
+    v_max: float
+    offset: np.ndarray
+    reason: str = field(default="")
+
+    def plan(self):
+        """The placed loop as a time law, :func:`plan_loop_path`."""
+        return plan_loop_path(self.B, self.M, self.E, self.v_max, delta=self.delta)
+
+
+_PLACEMENT = {
+    # Pure translation, so the loop keeps its shape, plane (horizontal), Delta and v_max.
+    "anthropomorphic": (
+        (-0.2, -0.2, -0.5),
+        "translated by (-0.2, -0.2, -0.5) m: B = (0.3, 0.3, 0.5), M = (0.34, 0.33, 0.5), "
+        "E = (0.34, 0.3, 0.5). The paper's path is 0.97-1.03 m from the shoulder against a 0.78 m "
+        "reach (docs/papers.md); here the whole loop is 0.46-0.53 m from the shoulder (59-68 % of the "
+        "reach), 0.17 m above it, in front of the arm near the diagonal x = y as in the paper: the "
+        "elbow stays bent at 95-109 deg, far from the stretched/folded singularities, the joint-1 "
+        "axis and every joint limit.",
+    ),
+    "scara": (
+        (0.0, 0.0, -0.735),
+        "translated down by 0.735 m to z = 0.265 m (mid-stroke lambda3 = 0.1 m); x and y are the "
+        "paper's, so theta1 and theta2 follow the paper's plan. At the paper's z = 1 m the stroke "
+        "would be -0.635 m (docs/papers.md); the horizontal distances 0.71-0.78 m are inside the annulus "
+        "0.12-0.96 m, with theta2 between about -86 and -71 deg (arm well bent, far from its limits).",
+    ),
+    "cartesian": (
+        (0.0, 0.0, 0.0),
+        "not moved: the paper's points are inside the chosen joint ranges (lambda1 = 0.76 m, "
+        "lambda2 = 0.5-0.55 m, lambda3 = -s_x = -0.5 to -0.56 m).",
+    ),
+}
+
+
+def paper_loop_placement(robot_name: str) -> LoopPlacement:
+    """The paper's example loop (Table 1, Delta = 0.02 m, v_max = 0.25 m/s) placed for a robot.
+
+    Returns:
+        LoopPlacement with B, M, E, delta, v_max, the offset from Table 1 and the reason.
+    """
+    if robot_name not in _PLACEMENT:
+        raise ValueError(f"robot must be one of Boryga's {tuple(_PLACEMENT)}, got {robot_name!r}")
+    offset, reason = _PLACEMENT[robot_name]
+    offset = np.array(offset, dtype=float)
+    points = []
+    for key in ("B", "M", "E"):
+        point = np.array(PAPER_LOOP[key], dtype=float) + offset
+        point.setflags(write=False)
+        points.append(point)
+    offset.setflags(write=False)
+    return LoopPlacement(
+        robot=robot_name,
+        B=points[0],
+        M=points[1],
+        E=points[2],
+        delta=PAPER_LOOP["delta"],
+        v_max=PAPER_LOOP["v_max"],
+        offset=offset,
+        reason=reason,
+    )
+
+
+@dataclass
+class BorygaConfig:
+    """Boryga's loop path B -> M -> loop through the corner -> M -> E, traced by the scenario's
+    robot (inverse kinematics): the scenario's ``planner: !BorygaConfig`` entry.
+
+    Attributes:
+        B, M, E: the path's points [m] in the robot's base frame; all empty: the paper's example
+            (Table 1) placed in the robot's workspace (:func:`paper_loop_placement` for Boryga's
+            robots; for another robot translated so that B is the tool at ``q_initial``, the loop
+            in the horizontal plane through it, traced at the tool orientation of ``q_initial``).
+        delta: Δ [m] of the loop (section 2.2).
+        v_max: the speed along the path [m/s].
+        velocity_limit, acceleration_limit: per joint; empty: the robot's rated speeds and no
+            acceleration limit.
+    """
+
+    B: list[float] = field(default_factory=list)
+    M: list[float] = field(default_factory=list)
+    E: list[float] = field(default_factory=list)
+    delta: float = 0.02
+    v_max: float = 0.25
+    velocity_limit: list[float] = field(default_factory=list)
+    acceleration_limit: list[float] = field(default_factory=list)
+
+
+def make(config: BorygaConfig, robot: Robot, q_initial) -> BorygaLoopPlanner:
+    """The loop of ``config`` on ``robot`` (``q_initial`` gives the tool orientation, the IK
+    branch and, for the default placement on robots other than Boryga's, the point B)."""
+    points = [np.asarray(getattr(config, name), dtype=float) for name in ("B", "M", "E")]
+    if any(point.size for point in points):
+        if not all(point.shape == (3,) for point in points):
+            raise ValueError(f"B, M and E must all be 3-vectors [m] or all empty, got {[p.tolist() for p in points]}")
+    elif robot.name in _PLACEMENT:
+        placement = paper_loop_placement(robot.name)
+        points = [placement.B, placement.M, placement.E]
+    else:
+        offset = robot.tool_position(np.asarray(q_initial, dtype=float)) - np.asarray(PAPER_LOOP["B"])
+        points = [np.asarray(PAPER_LOOP[name]) + offset for name in ("B", "M", "E")]
+    law = RobotLoopLaw(plan_loop_path(*points, config.v_max, delta=config.delta), robot, q_initial)
+    n = robot.num_joints
+    velocity = limit_or_default(config.velocity_limit, robot.velocity_limits, "velocity_limit", n)
+    if np.size(config.acceleration_limit):
+        acceleration = limit_or_default(config.acceleration_limit, None, "acceleration_limit", n)
+    else:
+        acceleration = np.full(n, np.inf)
+    return BorygaLoopPlanner(law, velocity, acceleration)

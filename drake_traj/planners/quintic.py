@@ -1,6 +1,6 @@
-"""Synchronised quintic point-to-point planner (seed 004, Benotsmane).
+"""Synchronised quintic point-to-point planner (Benotsmane et al., Benotsmane).
 
-Seed 004 (Benotsmane, Kacemi, Benachenhou: "Calculation methodology for trajectory planning of a
+Benotsmane et al. (Benotsmane, Kacemi, Benachenhou: "Calculation methodology for trajectory planning of a
 6 axis manipulator arm") moves all joints from q^i to q^f along the same fifth-degree time law
 r(t) (eq. 6), so every joint leaves and arrives at the same time. The duration t_f is the minimum
 time of the constraining joint (eq. 8, 9): the slowest joint touches its velocity limit K_v or its
@@ -9,7 +9,7 @@ such moves with a stop (zero velocity and acceleration) at every goal.
 
 Equation numbers below are the paper's. Its numbering is repeated: "(8)" is both the peak
 acceleration and t_f = max_j t_fj; comments say which one is meant. Eq. 9 as printed (K_a^2 under
-the root) is wrong; the project ERRATA (seed 004) gives the corrected form used here,
+the root) is wrong; docs/papers.md gives the corrected form used here,
 t_fj = max(15|D_j| / (8 K_vj), sqrt(10 |D_j| / (sqrt(3) K_aj))), and D_j is the displacement
 q^f_j - q^i_j [rad], not a duration.
 
@@ -17,15 +17,14 @@ The functions and the two dataclasses here are plain numpy: tests call them dire
 planner system is a thin shell around them.
 """
 
-from __future__ import annotations
-
 from bisect import bisect_right
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from drake_traj import robot
 from drake_traj.planners.base import TimeLawPlanner
+from drake_traj.robots import UR10E, Robot
+from drake_traj.validation import limit_or_default
 
 __all__ = [
     "QuinticPlan",
@@ -148,7 +147,7 @@ def quintic_profile(s):
 def _quintic_third_derivative(s: np.ndarray) -> np.ndarray:
     """d^3r/ds^3 = 60 (1 - 6 s + 6 s^2) for s in [0, 1], else 0 [-].
 
-    Not in the paper; it is 60 at both ends, so the end jerk is 60 D / t_f^3 (ERRATA note).
+    Not in the paper; it is 60 at both ends, so the end jerk is 60 D / t_f^3 (docs/papers.md).
     """
     s = np.asarray(s, dtype=float)
     inside = (s >= 0.0) & (s <= 1.0)
@@ -156,7 +155,7 @@ def _quintic_third_derivative(s: np.ndarray) -> np.ndarray:
 
 
 def joint_minimum_times(displacement, velocity_limit, acceleration_limit):
-    """Minimum quintic move time of each joint on its own (eq. 9, corrected per ERRATA).
+    """Minimum quintic move time of each joint on its own (eq. 9, corrected as corrected in docs/papers.md).
 
     t_fj = max(15 |D_j| / (8 K_vj), sqrt(10 |D_j| / (sqrt(3) K_aj))). The first term makes the
     peak velocity (eq. 7) equal K_vj, the second makes the peak acceleration (first eq. 8) equal
@@ -191,7 +190,7 @@ def joint_minimum_times(displacement, velocity_limit, acceleration_limit):
         ) from exc
     abs_d = np.abs(d)
     t_velocity = _PEAK_DR * abs_d / kv  # eq. 9, first term: 15 |D| / (8 K_v)
-    # eq. 9, second term (corrected per ERRATA): sqrt(10 |D| / (sqrt(3) K_a))
+    # eq. 9, second term (corrected as corrected in docs/papers.md): sqrt(10 |D| / (sqrt(3) K_a))
     t_acceleration = np.sqrt(_PEAK_DDR * abs_d / ka)
     return _scalar_or_array(np.maximum(t_velocity, t_acceleration))
 
@@ -463,7 +462,7 @@ class QuinticPlan:
     def jerk(self, t):
         """Reference jerk d^3q/dt^3 = r'''(s) D / t_f^3 [rad/s^3] at plan time ``t``.
 
-        Non-zero at the ends of each moving segment: 60 D / t_f^3 (ERRATA note). At a boundary
+        Non-zero at the ends of each moving segment: 60 D / t_f^3 (docs/papers.md). At a boundary
         between two segments the value of the segment that starts there is returned; at the plan's
         end, the last segment's end value; outside every segment, 0.
 
@@ -587,16 +586,47 @@ class QuinticPtpPlanner(TimeLawPlanner):
         plan: the joint-space plan (from :func:`plan_synchronized_quintic`).
         velocity_limit, acceleration_limit: the limits the plan was made for [rad/s, rad/s^2].
         update_period: how often the speed override is read [s].
+        robot: the robot (for the tool positions at the goals).
     """
 
-    def __init__(self, plan: QuinticPlan, velocity_limit, acceleration_limit, *, update_period: float = 0.01):
+    def __init__(self, plan: QuinticPlan, velocity_limit, acceleration_limit, *, update_period: float = 0.01,
+                 robot: Robot = UR10E):
         super().__init__(
             plan,
             _limit_vector(velocity_limit, "velocity_limit", plan.num_joints),
             _limit_vector(acceleration_limit, "acceleration_limit", plan.num_joints),
             update_period=update_period,
         )
+        self.robot = robot
 
     def task_waypoints(self) -> np.ndarray:
-        """Flange positions at the joint goals [m]."""
-        return np.array([robot.flange_pose(segment.q_goal)[:3, 3] for segment in self.law.segments])
+        """Tool positions at the joint goals [m]."""
+        return self.robot.tool_position(np.array([segment.q_goal for segment in self.law.segments]))
+
+
+@dataclass
+class QuinticConfig:
+    """Synchronised quintic point-to-point moves through joint goals (Benotsmane et al.), a stop
+    at each: the scenario's ``planner: !QuinticConfig`` entry.
+
+    Attributes:
+        goals: joint goals [rad or m], one row of n per goal, visited in order from the start.
+        velocity_limit, acceleration_limit: per joint [rad/s, rad/s^2]; empty: the robot's
+            joint-move limits (UR10e: 1.05 rad/s, 1.40 rad/s^2).
+    """
+
+    goals: list[list[float]] = field(default_factory=list)
+    velocity_limit: list[float] = field(default_factory=list)
+    acceleration_limit: list[float] = field(default_factory=list)
+
+
+def make(config: QuinticConfig, robot: Robot, q_initial) -> QuinticPtpPlanner:
+    """The planner of ``config`` on ``robot`` from ``q_initial``, the goals checked against the
+    robot's joint ranges."""
+    default_velocity, default_acceleration = robot.joint_move_limits
+    velocity = limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", robot.num_joints)
+    acceleration = limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit",
+                                    robot.num_joints)
+    plan = plan_synchronized_quintic(q_initial, config.goals, velocity, acceleration,
+                                     position_lower=robot.lower_limits, position_upper=robot.upper_limits)
+    return QuinticPtpPlanner(plan, velocity, acceleration, robot=robot)

@@ -1,6 +1,6 @@
 """The trajectory-scaling coefficient c(t) shared by every planner.
 
-Seed 000 (Pająk 2024), eq. 18: after the last change at t0, where c had the value c0, the
+Pająk 2024, eq. 18: after the last change at t0, where c had the value c0, the
 coefficient relaxes exponentially back to 1:  c(t) = (c0 - 1) exp(-(t - t0)) + 1.
 We generalise the target 1 to a ``goal`` (the speed override, in [0, 1]) and keep a rate
 [1/s] (1 in the paper). The closed forms below let a planner evaluate c, dc/dt and the

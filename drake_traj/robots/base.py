@@ -1,7 +1,15 @@
-"""Shared machinery of the papers' point-placing robots (seed 001's three, seed 002's 4-DOF):
-model file lookup, joint limits, reach checks with errors naming the point and the reason, and
-the closed-form inverse kinematics wrapper. Subclasses (frozen dataclasses) give the dimensions,
-limits, ``fk``, ``jacobian``, ``bias`` and ``_ik_raw``.
+"""The robot contract, and the shared machinery of the papers' point-placing robots.
+
+:class:`Robot` is what the rest of the package knows about a robot: its model file, joints,
+limits, default PD gains, tool pose and the kinematic services the planners use (tool motion,
+inverse kinematics of tool points, joint rates along a tool motion). The UR10e
+(:mod:`drake_traj.robots.ur10e`), Boryga's three robots (:mod:`drake_traj.robots.boryga_robots`)
+and the 4-DOF robot of Li et al. 2019 (:mod:`drake_traj.robots.li_4dof`) implement it.
+
+:class:`PointRobot` adds what the papers' robots share (they place a tool point, no orientation):
+model file lookup, reach checks with errors naming the point and the reason, and the closed-form
+inverse kinematics wrapper. Subclasses (frozen dataclasses) give the dimensions, limits, ``fk``,
+``jacobian``, ``bias`` and ``_ik_raw``.
 """
 
 from __future__ import annotations
@@ -11,6 +19,9 @@ from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
+from pydrake.multibody.parsing import Parser
+
+__all__ = ["LIMIT_TOL", "PointRobot", "Robot"]
 
 LIMIT_TOL = 1e-12  # slack on joint limits [rad or m]
 
@@ -42,28 +53,159 @@ def stack_columns(columns) -> np.ndarray:
     return np.stack(np.broadcast_arrays(*columns), axis=-1)
 
 
-class PointRobot:
-    """Shared behaviour; subclasses are frozen dataclasses with the dimensions and limits."""
+class Robot:
+    """The contract of a robot (subclasses give the class attributes and the kinematics).
+
+    Joint vectors are ordered as ``joint_names``; revolute joints in rad, prismatic in m. Frames:
+    the model's ``base_frame`` is welded to the world; the tool point is ``tool_frame``.
+    """
 
     name: ClassVar[str]
-    model_file: ClassVar[str]
+    model_file: ClassVar[str]  # file name in the package's models/ folder
     joint_names: ClassVar[tuple[str, ...]]
     joint_types: ClassVar[tuple[str, ...]]  # "revolute" [rad] or "prismatic" [m]
+    base_frame: ClassVar[str] = "base"
+    tool_frame: ClassVar[str] = "tool0"
+
+    # ---- description ---------------------------------------------------------------------------
+    @property
+    def num_joints(self) -> int:
+        return len(self.joint_names)
+
+    def joint_unit(self, k: int) -> str:
+        """"rad" or "m", the position unit of joint ``k``."""
+        return "rad" if self.joint_types[k] == "revolute" else "m"
+
+    @property
+    def lower_limits(self) -> np.ndarray:  # pragma: no cover - abstract
+        """Joint position lower limits, (n,)."""
+        raise NotImplementedError
+
+    @property
+    def upper_limits(self) -> np.ndarray:  # pragma: no cover - abstract
+        """Joint position upper limits, (n,)."""
+        raise NotImplementedError
+
+    @property
+    def velocity_limits(self) -> np.ndarray:  # pragma: no cover - abstract
+        """Rated joint speeds [rad/s or m/s], (n,)."""
+        raise NotImplementedError
+
+    @property
+    def effort_limits(self) -> np.ndarray:  # pragma: no cover - abstract
+        """Joint torque or force limits [N m or N], (n,): the drives saturate there."""
+        raise NotImplementedError
+
+    @property
+    def joint_move_limits(self) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - abstract
+        """(velocity, acceleration) limits a planner keeps when the task gives none, each (n,)."""
+        raise NotImplementedError
+
+    @property
+    def default_gains(self) -> tuple[tuple[float, ...], tuple[float, ...]]:  # pragma: no cover
+        """(kp, kd) of the simulated joint PD controller [N m/rad, N m s/rad or N/m, N s/m]."""
+        raise NotImplementedError
+
+    @property
+    def home_configuration(self) -> np.ndarray:  # pragma: no cover - abstract
+        """A start configuration inside the limits, (n,), used when a scenario gives none."""
+        raise NotImplementedError
+
+    # ---- model ---------------------------------------------------------------------------------
+    def model_path(self) -> Path:
+        """Absolute path of the robot's model file shipped with the package (``models/``)."""
+        path = Path(str(resources.files("drake_traj.models").joinpath(self.model_file)))
+        if not path.is_file():
+            raise ValueError(f"{self.name} model file not found: {path}")
+        return path
+
+    def add_to_plant(self, plant):
+        """Parse the model into ``plant`` (not finalized) and weld its base to the world.
+
+        Returns the model instance; each joint J has an actuator named ``J_actuator``.
+        """
+        (instance,) = Parser(plant).AddModels(str(self.model_path()))
+        plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(self.base_frame, instance))
+        return instance
+
+    # ---- kinematics ----------------------------------------------------------------------------
+    def tcp_pose(self, q) -> np.ndarray:  # pragma: no cover - abstract
+        """[x, y, z, phi_X, phi_Y, phi_Z] of the tool in the base frame [m, rad] for one q (n,);
+        Z-Y-X Euler angles, zeros where the robot only places a point."""
+        raise NotImplementedError
+
+    def tool_position(self, q) -> np.ndarray:  # pragma: no cover - abstract
+        """Tool point in the base frame [m], (..., 3) for q of shape (..., n)."""
+        raise NotImplementedError
+
+    def tool_motion(self, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover
+        """(velocity [m/s], acceleration [m/s^2]) of the tool point, each (N, 3), for joint
+        positions, velocities and accelerations of shape (N, n)."""
+        raise NotImplementedError
+
+    def point_ik(self, points, reference) -> np.ndarray:  # pragma: no cover - abstract
+        """Joint configurations (N, n) placing the tool point at ``points`` (N, 3) [m].
+
+        A robot whose tool has an orientation keeps that of the configuration ``reference`` and
+        its inverse-kinematics branch. Raises ValueError naming the point and the reason when a
+        point is out of reach.
+        """
+        raise NotImplementedError
+
+    def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover
+        """(qd, qdd) that move the tool point with velocity ``v`` and acceleration ``a`` at q,
+        the tool orientation held where the robot has one; arrays broadcast together."""
+        raise NotImplementedError
+
+
+class PointRobot(Robot):
+    """A robot that places a tool point (no orientation); subclasses are frozen dataclasses with
+    the dimensions and limits (fields ``lower``, ``upper``, ``velocity_limit``,
+    ``effort_limit``). Default PD gains 2000 (N m/rad or N/m) and 100 (N m s/rad or N s/m) on
+    every joint: the inverse-dynamics feed-forward does most of the work."""
+
     lower: tuple[float, ...]
     upper: tuple[float, ...]
     velocity_limit: tuple[float, ...]
     effort_limit: tuple[float, ...]
 
-    base_frame: ClassVar[str] = "base"
-    tool_frame: ClassVar[str] = "tool0"
+    # ---- the Robot contract ------------------------------------------------------------------
+    @property
+    def velocity_limits(self) -> np.ndarray:
+        return np.array(self.velocity_limit, dtype=float)
 
-    # ---- model file -------------------------------------------------------------------------
-    def model_path(self) -> Path:
-        """Absolute path of the robot's URDF shipped with the package (``models/<model_file>``)."""
-        path = Path(str(resources.files("drake_traj.models").joinpath(self.model_file)))
-        if not path.is_file():
-            raise ValueError(f"{self.name} model file not found: {path}")
-        return path
+    @property
+    def effort_limits(self) -> np.ndarray:
+        return np.array(self.effort_limit, dtype=float)
+
+    @property
+    def joint_move_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """The rated speeds and no acceleration limit (the papers give none)."""
+        return self.velocity_limits, np.full(self.num_joints, np.inf)
+
+    @property
+    def default_gains(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        return (2000.0,) * self.num_joints, (100.0,) * self.num_joints
+
+    @property
+    def home_configuration(self) -> np.ndarray:
+        """Every joint at the middle of its range."""
+        return 0.5 * (self.lower_limits + self.upper_limits)
+
+    def tcp_pose(self, q) -> np.ndarray:
+        return np.concatenate([self.fk(q), np.zeros(3)])
+
+    def tool_position(self, q) -> np.ndarray:
+        return self.fk(q)
+
+    def tool_motion(self, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
+        jacobian = self.jacobian(q)
+        return (np.einsum("...ij,...j->...i", jacobian, qd),
+                np.einsum("...ij,...j->...i", jacobian, qdd) + self.bias(q, qd))
+
+    def point_ik(self, points, reference=None) -> np.ndarray:
+        """:meth:`ik` (the papers' robots have one solution branch; ``reference`` is unused)."""
+        return self.ik(points)
 
     # ---- per-robot kinematics (subclasses) --------------------------------------------------
     def fk(self, q) -> np.ndarray:  # pragma: no cover - abstract
@@ -87,10 +229,6 @@ class PointRobot:
         and a list of (index, reason) for the domain errors found."""
         raise NotImplementedError
 
-    @property
-    def num_joints(self) -> int:
-        return len(self.joint_names)
-
     # ---- limits ------------------------------------------------------------------------------
     @property
     def lower_limits(self) -> np.ndarray:
@@ -104,9 +242,6 @@ class PointRobot:
         """Whether each joint vector of ``q`` (..., n) is within the position limits."""
         q = joint_vectors(q, self.num_joints)
         return np.all((q >= self.lower_limits - tol) & (q <= self.upper_limits + tol), axis=-1)
-
-    def _unit(self, k: int) -> str:
-        return "rad" if self.joint_types[k] == "revolute" else "m"
 
     # ---- inverse kinematics -------------------------------------------------------------------
     def reach_problems(self, positions) -> list[tuple[int, str]]:
@@ -154,7 +289,7 @@ class PointRobot:
                 if index in bad:
                     continue
                 bad.add(index)
-                unit = self._unit(k)
+                unit = self.joint_unit(k)
                 problems.append(
                     (index, f"{self.joint_names[k]} = {q[index, k]:.6g} {unit} is beyond its limits "
                             f"[{lo[k]:.6g}, {hi[k]:.6g}] {unit}")

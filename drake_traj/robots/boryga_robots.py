@@ -1,4 +1,4 @@
-"""The three example manipulators of seed 001 (Boryga, "Trajectory Planning of an End-Effector for
+"""The three example manipulators of Boryga ("Trajectory Planning of an End-Effector for
 Path with Loop", section 4): kinematics, closed-form inverse kinematics and the loop placement.
 
 Robots (the paper's dimensions; everything else is chosen here and marked so):
@@ -23,15 +23,14 @@ Inverse kinematics, branch and corrections:
   upper arm is below the shoulder-to-tool line by the arcsin term of eq. 19. The arcsin of
   eq. 19 is valid on the whole workspace because l2 > l3 (the angle it stands for never exceeds
   pi / 2). Points on the joint-1 axis (s_x = s_y = 0) are rejected: theta1 is undefined there.
-* SCARA, ERRATA seed 001: eq. 24-25 as printed are inconsistent (theta2 = -arccos needs theta1 =
+* SCARA, Correction (docs/papers.md): eq. 24-25 as printed are inconsistent (theta2 = -arccos needs theta1 =
   atan2 + arcsin). Used here: theta2 = -arccos((B - D) / C) in [-pi, 0] (eq. 25 as printed) and
   theta1 = atan2(s_y, s_x) + arcsin(sqrt((C^2 - (B - D)^2) / (E^2 B))) (eq. 24 with the sign
   fixed), wrapped to (-pi, pi]. Valid for the whole annulus because l1 > l2.
 * Cartesian: eq. 30-32 as printed.
 
 Out-of-reach points raise ValueError naming the point's index and the reason (arccos argument
-beyond +-1, negative SCARA stroke, point on the joint-1 axis, joint beyond its limit). ERRATA seed
-001: the paper's example path (Table 1, z = 1 m) is out of reach of the anthropomorphic arm (0.97 to
+beyond +-1, negative SCARA stroke, point on the joint-1 axis, joint beyond its limit). Correction (docs/papers.md): the paper's example path (Table 1, z = 1 m) is out of reach of the anthropomorphic arm (0.97 to
 1.03 m from the shoulder against a reach of 0.78 m) and needs a negative SCARA stroke, so
 :func:`paper_loop_placement` moves it into each workspace (see there).
 
@@ -42,23 +41,18 @@ check FK against Drake's MultibodyPlant and IK/joint rates against FK and finite
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 
-from drake_traj.point_robot import LIMIT_TOL, PointRobot, format_point, joint_vectors, stack_columns
+from drake_traj.robots.base import LIMIT_TOL, PointRobot, format_point, joint_vectors, stack_columns
 
 __all__ = [
     "ROBOT_NAMES",
-    "PAPER_LOOP",
     "AnthropomorphicArm",
     "ScaraArm",
     "CartesianRobot",
-    "LoopPlacement",
-    "get_robot",
-    "paper_loop_placement",
-    "add_paper_robot",
 ]
 
 ROBOT_NAMES = ("anthropomorphic", "scara", "cartesian")
@@ -72,7 +66,7 @@ _SINGULAR_TOL = 1e-9
 
 
 class _PaperRobot(PointRobot):
-    """Seed 001's robots: three joints placing a point; adds the rates along a tool motion."""
+    """Boryga's robots: three joints placing a point; adds the rates along a tool motion."""
 
     # ---- rates -------------------------------------------------------------------------------
     def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
@@ -121,7 +115,7 @@ class _PaperRobot(PointRobot):
 
 @dataclass(frozen=True)
 class AnthropomorphicArm(_PaperRobot):
-    """Anthropomorphic 3-DOF arm of seed 001 (Fig. 8). Lengths [m] are the paper's."""
+    """Anthropomorphic 3-DOF arm of Boryga (Fig. 8). Lengths [m] are the paper's."""
 
     name: ClassVar[str] = "anthropomorphic"
     model_file: ClassVar[str] = "boryga_anthropomorphic.urdf"
@@ -225,13 +219,13 @@ class AnthropomorphicArm(_PaperRobot):
 
 
 # ------------------------------------------------------------------------------------------------
-# SCARA, Fig. 12, eq. 21-26 (ERRATA: eq. 24 sign).
+# SCARA, Fig. 12, eq. 21-26 (Corrected (docs/papers.md): eq. 24 sign).
 # ------------------------------------------------------------------------------------------------
 
 
 @dataclass(frozen=True)
 class ScaraArm(_PaperRobot):
-    """SCARA of seed 001 (Fig. 12). Lengths [m] are the paper's; q = (theta1, theta2, lambda3)."""
+    """SCARA of Boryga (Fig. 12). Lengths [m] are the paper's; q = (theta1, theta2, lambda3)."""
 
     name: ClassVar[str] = "scara"
     model_file: ClassVar[str] = "boryga_scara.urdf"
@@ -320,7 +314,7 @@ class ScaraArm(_PaperRobot):
         theta2 = -np.arccos(arg2)  # eq. 25 as printed
         with np.errstate(divide="ignore", invalid="ignore"):
             inner = (C**2 - (B - D) ** 2) / (E**2 * B)
-        # eq. 24 with the ERRATA sign: + arcsin goes with theta2 = -arccos.
+        # eq. 24 with the docs/papers.md sign: + arcsin goes with theta2 = -arccos.
         theta1 = np.arctan2(y, x) + np.arcsin(np.sqrt(np.clip(inner, 0.0, 1.0)))
         theta1 = np.pi - np.mod(np.pi - theta1, 2.0 * np.pi)  # wrap to (-pi, pi]
         q = np.stack((theta1, theta2, stroke), axis=-1)
@@ -337,7 +331,7 @@ _CARTESIAN_J = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
 
 @dataclass(frozen=True)
 class CartesianRobot(_PaperRobot):
-    """Cartesian robot of seed 001 (Fig. 16); q = (lambda1, lambda2, lambda3) [m]."""
+    """Cartesian robot of Boryga (Fig. 16); q = (lambda1, lambda2, lambda3) [m]."""
 
     name: ClassVar[str] = "cartesian"
     model_file: ClassVar[str] = "boryga_cartesian.urdf"
@@ -369,148 +363,3 @@ class CartesianRobot(_PaperRobot):
     def _ik_raw(self, p):
         # eq. 30-32; only the joint ranges can put a point out of reach.
         return np.stack((p[:, 2] - self.l2, p[:, 1], -p[:, 0]), axis=-1), []
-
-
-_ROBOTS = {
-    "anthropomorphic": AnthropomorphicArm(),
-    "scara": ScaraArm(),
-    "cartesian": CartesianRobot(),
-}
-
-
-def get_robot(name: str):
-    """The robot ``name`` (one of ROBOT_NAMES) with the paper's dimensions and this project's limits."""
-    try:
-        return _ROBOTS[name]
-    except KeyError:
-        raise ValueError(f"unknown robot {name!r}; expected one of {ROBOT_NAMES}") from None
-
-
-def add_paper_robot(plant, name: str):
-    """Parse the robot's URDF into a MultibodyPlant and weld its ``base`` to the world.
-
-    Returns the model instance (``plant`` is not finalized).
-    """
-    from pydrake.multibody.parsing import Parser
-
-    robot = get_robot(name)
-    (instance,) = Parser(plant).AddModels(str(robot.model_path()))
-    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(robot.base_frame, instance))
-    return instance
-
-
-# ------------------------------------------------------------------------------------------------
-# The paper's example loop and its placement in each workspace.
-# ------------------------------------------------------------------------------------------------
-
-# Seed 001, section 3 / Table 1: B, M, E [m], Delta [m], v_max [m/s]. Horizontal plane z = 1 m.
-PAPER_LOOP = {
-    "B": (0.5, 0.5, 1.0),
-    "M": (0.54, 0.53, 1.0),
-    "E": (0.54, 0.5, 1.0),
-    "delta": 0.02,
-    "v_max": 0.25,
-}
-
-
-@dataclass(frozen=True, eq=False)
-class LoopPlacement:
-    """The paper's loop (same shape, Delta and v_max) moved into one robot's workspace.
-
-    Attributes:
-        robot: robot name.
-        B, M, E: placed points [m], read-only arrays (3,).
-        delta: Delta [m]; v_max: loop speed [m/s] (the paper's).
-        offset: translation applied to the paper's Table 1 points [m] (no rotation is needed).
-        reason: where the loop was put and why.
-    """
-
-    robot: str
-    B: np.ndarray
-    M: np.ndarray
-    E: np.ndarray
-    delta: float
-    v_max: float
-    offset: np.ndarray
-    reason: str = field(default="")
-
-    def plan(self):
-        """The placed loop as a time law, :func:`drake_traj.planners.boryga.plan_loop_path`."""
-        from drake_traj.planners.boryga import plan_loop_path
-
-        return plan_loop_path(self.B, self.M, self.E, self.v_max, delta=self.delta)
-
-
-_PLACEMENT = {
-    # Pure translation, so the loop keeps its shape, plane (horizontal), Delta and v_max.
-    "anthropomorphic": (
-        (-0.2, -0.2, -0.5),
-        "translated by (-0.2, -0.2, -0.5) m: B = (0.3, 0.3, 0.5), M = (0.34, 0.33, 0.5), "
-        "E = (0.34, 0.3, 0.5). The paper's path is 0.97-1.03 m from the shoulder against a 0.78 m "
-        "reach (ERRATA); here the whole loop is 0.46-0.53 m from the shoulder (59-68 % of the "
-        "reach), 0.17 m above it, in front of the arm near the diagonal x = y as in the paper: the "
-        "elbow stays bent at 95-109 deg, far from the stretched/folded singularities, the joint-1 "
-        "axis and every joint limit.",
-    ),
-    "scara": (
-        (0.0, 0.0, -0.735),
-        "translated down by 0.735 m to z = 0.265 m (mid-stroke lambda3 = 0.1 m); x and y are the "
-        "paper's, so theta1 and theta2 follow the paper's plan. At the paper's z = 1 m the stroke "
-        "would be -0.635 m (ERRATA); the horizontal distances 0.71-0.78 m are inside the annulus "
-        "0.12-0.96 m, with theta2 between about -86 and -71 deg (arm well bent, far from its limits).",
-    ),
-    "cartesian": (
-        (0.0, 0.0, 0.0),
-        "not moved: the paper's points are inside the chosen joint ranges (lambda1 = 0.76 m, "
-        "lambda2 = 0.5-0.55 m, lambda3 = -s_x = -0.5 to -0.56 m).",
-    ),
-}
-
-
-def paper_loop_placement(robot_name: str) -> LoopPlacement:
-    """The paper's example loop (Table 1, Delta = 0.02 m, v_max = 0.25 m/s) placed for a robot.
-
-    Returns:
-        LoopPlacement with B, M, E, delta, v_max, the offset from Table 1 and the reason.
-    """
-    get_robot(robot_name)  # validates the name
-    offset, reason = _PLACEMENT[robot_name]
-    offset = np.array(offset, dtype=float)
-    points = []
-    for key in ("B", "M", "E"):
-        point = np.array(PAPER_LOOP[key], dtype=float) + offset
-        point.setflags(write=False)
-        points.append(point)
-    offset.setflags(write=False)
-    return LoopPlacement(
-        robot=robot_name,
-        B=points[0],
-        M=points[1],
-        E=points[2],
-        delta=PAPER_LOOP["delta"],
-        v_max=PAPER_LOOP["v_max"],
-        offset=offset,
-        reason=reason,
-    )
-
-
-def closed_loop_model(name: str):
-    """The closed-loop description (:class:`drake_traj.diagram.RobotModel`) of robot ``name``.
-
-    The tool point has no orientation here (the paper's robots place a point): its pose is
-    [fk(q), 0, 0, 0]. Default PD gains 2000 (N m/rad or N/m) and 100 (N m s/rad or N s/m) on every
-    joint; the inverse-dynamics feed-forward does most of the work.
-    """
-    from drake_traj.diagram import RobotModel
-
-    arm = get_robot(name)
-    count = len(arm.joint_names)
-    return RobotModel(
-        name=name,
-        model_path=arm.model_path,
-        joint_names=tuple(arm.joint_names),
-        effort_limit=np.array(arm.effort_limit, dtype=float),
-        tcp_pose=lambda q: np.concatenate([arm.fk(q), np.zeros(3)]),
-        kp=(2000.0,) * count,
-        kd=(100.0,) * count,
-    )

@@ -1,9 +1,9 @@
-"""The 4-DOF serial collaborative robot of seed 002 (Li, Zhang, Zhou 2019, "Trajectory Planning of
+"""The 4-DOF serial collaborative robot of Li et al. 2019 (Li, Zhang, Zhou, "Trajectory Planning of
 High Precision Collaborative Robots", section 4, Fig. 5, Tables 3-5, Fig. 6): kinematics, inverse
 kinematics for the paper's planar task, joint limits and the closed test path.
 
 Standard DH table (Table 3), T_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i), lengths in metres
-(the paper's mm / 1000). OCR corrections (ERRATA seed 002): "057" is 0.5 pi.
+(the paper's mm / 1000). OCR corrections (docs/papers.md): "057" is 0.5 pi.
 
     i   d_i     a_i     alpha_i   theta_i
     1   0.255   0       pi/2      q1
@@ -11,7 +11,7 @@ Standard DH table (Table 3), T_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i), leng
     3   0       0.250   0         q3 - pi/2
     4   0       0.140   0         q4 - pi/2
 
-Joint limits (Table 5; the text calls it "Tab. 4", ERRATA). OCR corrections: "0.757" is 0.75 pi,
+Joint limits (Table 5; the text calls it "Tab. 4", docs/papers.md). OCR corrections: "0.757" is 0.75 pi,
 "0.257" is 0.25 pi, "1.257" is 1.25 pi, "25" is 2.5, "15" is 1.5:
 
     joint   range [rad]              max velocity [rad/s]   max acceleration [rad/s^2]
@@ -20,8 +20,8 @@ Joint limits (Table 5; the text calls it "Tab. 4", ERRATA). OCR corrections: "0.
     3       [-0.25 pi, 1.25 pi]      3.0                    1.5
     4       [-0.25 pi, 1.25 pi]      3.0                    1.8
 
-Cartesian limits (Table 4): |V| <= 200 mm/s, |a| <= 100 mm/s^2 (``CARTESIAN_VELOCITY_LIMIT``,
-``CARTESIAN_ACCELERATION_LIMIT`` in m/s, m/s^2).
+The tool limits of Table 4 (200 mm/s, 100 mm/s^2) belong to the paper's task and live with the
+planner (:mod:`drake_traj.planners.li`).
 
 Geometry. Joint 1 turns about the vertical base z axis; joints 2, 3, 4 are parallel horizontal
 axes, so the arm is a planar 3R chain (257, 250, 140 mm) in the vertical plane at azimuth q1, with
@@ -66,20 +66,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from drake_traj.point_robot import PointRobot, format_point, joint_vectors, point_array, stack_columns
+from drake_traj.robots.base import PointRobot, format_point, joint_vectors, point_array, stack_columns
 
-__all__ = [
-    "CARTESIAN_VELOCITY_LIMIT",
-    "CARTESIAN_ACCELERATION_LIMIT",
-    "Li4Dof",
-    "LI_4DOF",
-    "li_closed_path",
-    "closed_loop_model",
-]
-
-# Table 4: Sup |V_m| = 200 mm/s, Sup |a_m| = 100 mm/s^2.
-CARTESIAN_VELOCITY_LIMIT = 0.2  # [m/s]
-CARTESIAN_ACCELERATION_LIMIT = 0.1  # [m/s^2]
+__all__ = ["Li4Dof", "LI_4DOF"]
 
 _HALF_PI = 0.5 * math.pi
 _DOMAIN_TOL = 1e-12  # slack on the arccos argument (points exactly on the workspace boundary)
@@ -96,7 +85,7 @@ def _wrap(angle):
 
 @dataclass(frozen=True)
 class Li4Dof(PointRobot):
-    """The 4-DOF collaborative robot of seed 002 (Fig. 5). DH values (Table 3) in m and rad.
+    """The 4-DOF collaborative robot of Li et al. 2019 (Fig. 5). DH values (Table 3) in m and rad.
 
     Attributes:
         d, a, alpha, theta_offset: the standard DH table; theta_i = q_i + theta_offset_i.
@@ -146,16 +135,18 @@ class Li4Dof(PointRobot):
 
     # ---- limits --------------------------------------------------------------------------------
     @property
-    def velocity_limits(self) -> np.ndarray:
-        return np.array(self.velocity_limit, dtype=float)
-
-    @property
     def acceleration_limits(self) -> np.ndarray:
         return np.array(self.acceleration_limit, dtype=float)
 
     @property
-    def effort_limits(self) -> np.ndarray:
-        return np.array(self.effort_limit, dtype=float)
+    def joint_move_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Table 5's joint velocity and acceleration limits."""
+        return self.velocity_limits, self.acceleration_limits
+
+    @property
+    def home_configuration(self) -> np.ndarray:
+        """q = 0, the paper's initial pose."""
+        return np.zeros(NUM_JOINTS)
 
     def fk_pose(self, q) -> np.ndarray:
         """Homogeneous transform of DH frame 4 (= URDF ``tool0``) in the base, shape (..., 4, 4).
@@ -331,96 +322,3 @@ class Li4Dof(PointRobot):
 
 
 LI_4DOF = Li4Dof()
-
-
-# ------------------------------------------------------------------------------------------------
-# The closed test path of Fig. 6.
-# ------------------------------------------------------------------------------------------------
-
-# Segments in mm, in the plane Z = 0, anticlockwise from S = (200, -74):
-#   ("line", end) or ("arc", center, radius, start angle, end angle) [deg; end < start: clockwise].
-_PATH_START = (200.0, -74.0)
-_PATH_SEGMENTS = (
-    ("line", (360.0, -74.0)),  # S -> bottom right: a long straight start, as S -> P_b in Fig. 6
-    ("arc", (360.0, -34.0), 40.0, -90.0, 0.0),  # R 40 quarter
-    ("line", (400.0, 30.0)),
-    ("arc", (380.0, 30.0), 20.0, 0.0, 90.0),  # R 20 quarter
-    ("line", (300.0, 50.0)),
-    ("line", (300.0, 20.0)),  # 90-degree corner, short line into the notch
-    ("arc", (285.0, 20.0), 15.0, 0.0, -180.0),  # R 15 half circle, clockwise (concave notch)
-    ("line", (270.0, 50.0)),
-    ("line", (230.0, 50.0)),  # 90-degree corner
-    ("arc", (230.0, 20.0), 30.0, 90.0, 180.0),  # R 30 quarter
-    ("line", _PATH_START),  # back down to S (90-degree corner at S)
-)
-
-
-def li_closed_path(points_per_mm: float = 1.0) -> np.ndarray:
-    """A closed path like the paper's Fig. 6, in the XY plane at Z = 0, in the robot's base [m].
-
-    Straight lines, quarter arcs of radii 40, 20 and 30 mm, a clockwise half circle of 15 mm (a
-    notch) and three 90-degree corners; 686.5 mm long, anticlockwise (seen from +Z) from
-    S = (0.200, -0.074, 0). Every segment is sampled at equal steps of about 1 / points_per_mm mm
-    with its end points (break points and arc ends) included exactly. The last row repeats S, so
-    the path is closed; at the default density there are 686 distinct points (the paper's count),
-    687 rows.
-
-    Placement (the paper's Fig. 6 is not readable beyond its X axis 150-350 mm): x in
-    [200, 400] mm, y in [-74, 50] mm, i.e. the figure's 200 mm width moved +50 mm in X. With the
-    pen (last link) vertical, q3 >= -0.25 pi keeps the point at least 156.4 mm from the joint-1
-    axis, so X = 150 mm near Y = 0 is out of reach; here the path is 200-402 mm from the axis:
-    q3 keeps >= 0.15 rad from its lower limit, the elbow is never stretched (arccos argument
-    <= 0.36), |q1| <= 0.36 rad, and the tool speed of 200 mm/s needs |qd1| <= 1 rad/s.
-
-    Args:
-        points_per_mm: sampling density along the path [1/mm], > 0.
-
-    Returns:
-        (N, 3) positions [m].
-    """
-    density = float(points_per_mm)
-    if not math.isfinite(density) or density <= 0.0:
-        raise ValueError(f"points_per_mm must be positive and finite, got {points_per_mm!r}")
-    pieces = []
-    start = np.array(_PATH_START)
-    for segment in _PATH_SEGMENTS:
-        if segment[0] == "line":
-            end = np.array(segment[1])
-            length = float(np.linalg.norm(end - start))
-            n = max(1, int(round(length * density)))
-            pieces.append(start + np.linspace(0.0, 1.0, n + 1)[:-1, None] * (end - start))
-        else:
-            _, center, radius, a0, a1 = segment
-            a0, a1 = math.radians(a0), math.radians(a1)
-            n = max(1, int(round(abs(a1 - a0) * radius * density)))
-            theta = np.linspace(a0, a1, n + 1)[:-1]
-            arc = np.stack([center[0] + radius * np.cos(theta), center[1] + radius * np.sin(theta)], 1)
-            arc[0] = start  # exactly the previous segment's end
-            pieces.append(arc)
-            end = np.array([center[0] + radius * math.cos(a1), center[1] + radius * math.sin(a1)])
-            end = np.round(end, 9)  # cos(90 deg) etc.: the end is a grid point
-        start = end
-    pieces.append(np.array([_PATH_START]))
-    xy = np.concatenate(pieces) / 1000.0
-    return np.column_stack([xy, np.zeros(len(xy))])
-
-
-def closed_loop_model():
-    """The closed-loop description (:class:`drake_traj.diagram.RobotModel`) of the robot.
-
-    Name "li_4dof"; the tool point has no orientation here: tcp_pose = [fk(q), 0, 0, 0].
-    Default PD gains 2000 N m/rad and 100 N m s/rad on every joint (as for seed 001's robots); the
-    inverse-dynamics feed-forward does most of the work.
-    """
-    from drake_traj.diagram import RobotModel
-
-    arm = LI_4DOF
-    return RobotModel(
-        name=arm.name,
-        model_path=arm.model_path,
-        joint_names=tuple(arm.joint_names),
-        effort_limit=arm.effort_limits,
-        tcp_pose=lambda q: np.concatenate([arm.fk(q), np.zeros(3)]),
-        kp=(2000.0,) * NUM_JOINTS,
-        kd=(100.0,) * NUM_JOINTS,
-    )

@@ -1,9 +1,9 @@
 """UR10e: model file, published limits and analytic kinematics.
 
-Frames follow ``ur10e_facts.md`` and seed 000 (Pająk 2024): the base frame is standard-DH frame 0
+Frames follow ``docs/ur10e.md`` and Pająk 2024: the base frame is standard-DH frame 0
 (UR's controller "Base" frame), the flange ``tool0`` is DH frame 6. The task-space pose is
 p = k(q) = [x, y, z, phi_X, phi_Y, phi_Z]: flange position in metres and Z-Y-X Euler angles in
-radians (R = Rz(phi_Z) Ry(phi_Y) Rx(phi_X)), as used by UR's software and by seed 000.
+radians (R = Rz(phi_Z) Ry(phi_Y) Rx(phi_X)), as used by UR's software and by Pająk 2024.
 
 Everything here is plain numpy so tests and planners can call it without building a plant; the
 tests check it against Drake's MultibodyPlant.
@@ -11,16 +11,20 @@ tests check it against Drake's MultibodyPlant.
 
 from __future__ import annotations
 
-from importlib import resources
-from pathlib import Path
-
 import math
+from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
+from drake_traj.errors import SingularConfigurationError
+from drake_traj.robots.base import Robot
+
+__all__ = ["UR10E", "UR10e"]
+
 NUM_JOINTS = 6
 
-# Standard DH parameters (ur10e_facts.md; seed 000 Table 1 is the same chain in modified DH).
+# Standard DH parameters (docs/ur10e.md; Pająk 2024 Table 1 is the same chain in modified DH).
 DH_D = np.array([0.1807, 0.0, 0.0, 0.17415, 0.11985, 0.11655])  # [m]
 DH_A = np.array([0.0, -0.6127, -0.57155, 0.0, 0.0, 0.0])  # [m]
 DH_ALPHA = np.array([np.pi / 2, 0.0, 0.0, np.pi / 2, -np.pi / 2, 0.0])  # [rad]
@@ -36,9 +40,15 @@ JOINT_NAMES = (
 POSITION_LIMIT = np.full(NUM_JOINTS, 2 * np.pi)  # [rad], symmetric
 VELOCITY_LIMIT = np.array([2.094, 2.094, 3.1416, 3.1416, 3.1416, 3.1416])  # [rad/s]
 EFFORT_LIMIT = np.array([330.0, 330.0, 150.0, 56.0, 56.0, 56.0])  # [N m]
-# UR controller defaults for joint moves, used by seed 000 for every joint.
+# UR controller defaults for joint moves, used by Pająk 2024 for every joint.
 DEFAULT_JOINT_MOVE_VELOCITY = 1.05  # [rad/s] (60 deg/s)
 DEFAULT_JOINT_MOVE_ACCELERATION = 1.40  # [rad/s^2] (80 deg/s^2)
+# Default PD gains per joint [N m/rad], [N m s/rad]: see README "Controller" for how they were chosen.
+DEFAULT_KP = (4000.0, 4000.0, 2000.0, 500.0, 500.0, 300.0)
+DEFAULT_KD = (200.0, 200.0, 100.0, 20.0, 20.0, 10.0)
+# The start configuration of Pająk 2024's task, q(0) [rad]: the flange at
+# p0 = [-0.174, -0.524, 0.273, pi, 0, 3pi/4]; our home configuration.
+HOME = (-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4)
 
 LINK_MASSES = np.array([7.369, 13.051, 3.989, 2.1, 1.98, 0.615])  # [kg], links 1..6
 BASE_MASS = 4.0  # [kg], approximate; the base is welded to the world.
@@ -50,10 +60,7 @@ BASE_FRAME = "base"
 
 def model_path() -> Path:
     """Absolute path of the UR10e URDF shipped with the package (``models/ur10e.urdf``)."""
-    path = Path(str(resources.files("drake_traj.models").joinpath("ur10e.urdf")))
-    if not path.is_file():
-        raise ValueError(f"UR10e model file not found: {path}")
-    return path
+    return UR10E.model_path()
 
 
 def _as_joint_vector(q, name: str = "q") -> np.ndarray:
@@ -93,19 +100,15 @@ def flange_pose(q) -> np.ndarray:
     return dh_frames(q)[-1]
 
 
-class SingularConfigurationError(ValueError):
-    """Raised where the analytic Jacobian cannot be formed (Euler-angle gimbal lock)."""
-
-
 def wrap_angle(angle):
-    """Wrap angles [rad] to (-pi, pi] (ERRATA: the orientation error of seed 000 must be wrapped)."""
+    """Wrap angles [rad] to (-pi, pi] (Corrected (docs/papers.md): the orientation error of Pająk 2024 must be wrapped)."""
     return np.pi - np.mod(np.pi - np.asarray(angle, dtype=float), 2 * np.pi)
 
 
 def zyx_euler_from_rotation(rotation: np.ndarray) -> np.ndarray:
     """Z-Y-X Euler angles (phi_X, phi_Y, phi_Z) [rad] of R = Rz(phi_Z) Ry(phi_Y) Rx(phi_X).
 
-    Seed 000, k(q) rows 4-6: phi_X = atan2(r32, r33), phi_Y = atan2(-r31, sqrt(r32^2 + r33^2)),
+    Pająk 2024, k(q) rows 4-6: phi_X = atan2(r32, r33), phi_Y = atan2(-r31, sqrt(r32^2 + r33^2)),
     phi_Z = atan2(r21, r11).
     """
     r = rotation
@@ -131,13 +134,13 @@ def rotation_from_zyx_euler(phi) -> np.ndarray:
 
 
 def task_pose(q) -> np.ndarray:
-    """k(q) of seed 000: [x, y, z, phi_X, phi_Y, phi_Z] of the flange in the base frame [m, rad]."""
+    """k(q) of Pająk 2024: [x, y, z, phi_X, phi_Y, phi_Z] of the flange in the base frame [m, rad]."""
     pose = flange_pose(q)
     return np.concatenate([pose[:3, 3], zyx_euler_from_rotation(pose[:3, :3])])
 
 
 def task_pose_error(pose, goal) -> np.ndarray:
-    """e = pose - goal (eq. 6) with the orientation part wrapped to (-pi, pi] (ERRATA)."""
+    """e = pose - goal (eq. 6) with the orientation part wrapped to (-pi, pi] (docs/papers.md)."""
     error = np.asarray(pose, dtype=float) - np.asarray(goal, dtype=float)
     error[3:] = wrap_angle(error[3:])
     return error
@@ -146,7 +149,7 @@ def task_pose_error(pose, goal) -> np.ndarray:
 def euler_rate_matrix(phi) -> np.ndarray:
     """B(phi) with omega = B(phi) d(phi)/dt, columns ordered (phi_X, phi_Y, phi_Z) like k(q).
 
-    Seed 000 prints B with its columns in Z, Y, X order; ERRATA: they must follow k(q)'s order.
+    Pająk 2024 prints B with its columns in Z, Y, X order; Corrected (docs/papers.md): they must follow k(q)'s order.
     """
     _, phi_y, phi_z = phi
     cy, sy, cz, sz = np.cos(phi_y), np.sin(phi_y), np.cos(phi_z), np.sin(phi_z)
@@ -166,7 +169,7 @@ def _geometric_jacobian(frames: np.ndarray) -> np.ndarray:
 
 
 def analytic_jacobian(q, *, min_cos_pitch: float = 1e-6) -> np.ndarray:
-    """J(q) = diag(I, B^-1(phi)) J_g(q) (seed 000): d k(q)/dt = J(q) qd.
+    """J(q) = diag(I, B^-1(phi)) J_g(q) (Pająk 2024): d k(q)/dt = J(q) qd.
 
     Raises SingularConfigurationError where cos(phi_Y) < ``min_cos_pitch`` (Euler gimbal lock).
     """
@@ -174,7 +177,7 @@ def analytic_jacobian(q, *, min_cos_pitch: float = 1e-6) -> np.ndarray:
 
 
 def analytic_jacobian_and_bias(q, qd, *, min_cos_pitch: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
-    """(J(q), dJ/dt(q, qd) qd) of the analytic Jacobian (seed 000), from :func:`ur10e_kinematics`.
+    """(J(q), dJ/dt(q, qd) qd) of the analytic Jacobian (Pająk 2024), from :func:`ur10e_kinematics`.
 
     The bias term is the second derivative of k(q(t)) when qdd = 0.
     Raises SingularConfigurationError where cos(phi_Y) < ``min_cos_pitch`` (Euler gimbal lock).
@@ -202,10 +205,10 @@ def _cross(a, b):
 def _chain(q, qd, m):
     """k(q), analytic J and J̇q̇ as nested tuples of components (floats, or arrays of tasks).
 
-    ``m`` is ``math`` for floats or ``numpy`` for arrays. Standard DH frames of robot.py written
+    ``m`` is ``math`` for floats or ``numpy`` for arrays. Standard DH frames of :func:`dh_frames` written
     out: joint axes z_j at origins o_j, flange o_6; J_g columns z_j x (o_6 - o_j) and z_j; the
     bias by the usual velocity/acceleration recursion with q̈ = 0; then J = diag(I, B⁻¹) J_g and
-    the Euler part of the bias B⁻¹ (α - Ḃ φ̇) (seed 000, with B's columns in k(q)'s order).
+    the Euler part of the bias B⁻¹ (α - Ḃ φ̇) (Pająk 2024, with B's columns in k(q)'s order).
     """
     q1, q2, q3, q4, q5, q6 = q
     c1, s1 = m.cos(q1), m.sin(q1)
@@ -638,3 +641,82 @@ def inverse_kinematics_path(
         path[i] = q
         q_prev = q
     return path
+
+
+# --------------------------------------------------------------------------------------------
+# The Robot contract.
+# --------------------------------------------------------------------------------------------
+
+
+class UR10e(Robot):
+    """The UR10e under the :class:`~drake_traj.robots.base.Robot` contract (the functions of this
+    module do the work). The tool point is the flange ``tool0`` (no tool offset)."""
+
+    name: ClassVar[str] = "ur10e"
+    model_file: ClassVar[str] = "ur10e.urdf"
+    joint_names: ClassVar[tuple[str, ...]] = JOINT_NAMES
+    joint_types: ClassVar[tuple[str, ...]] = ("revolute",) * NUM_JOINTS
+    tool_frame: ClassVar[str] = FLANGE_FRAME
+
+    @property
+    def lower_limits(self) -> np.ndarray:
+        return -POSITION_LIMIT
+
+    @property
+    def upper_limits(self) -> np.ndarray:
+        return POSITION_LIMIT.copy()
+
+    @property
+    def velocity_limits(self) -> np.ndarray:
+        return VELOCITY_LIMIT.copy()
+
+    @property
+    def effort_limits(self) -> np.ndarray:
+        return EFFORT_LIMIT.copy()
+
+    @property
+    def joint_move_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """The UR controller's joint-move defaults, 1.05 rad/s and 1.40 rad/s^2 on every joint."""
+        return np.full(NUM_JOINTS, DEFAULT_JOINT_MOVE_VELOCITY), np.full(NUM_JOINTS, DEFAULT_JOINT_MOVE_ACCELERATION)
+
+    @property
+    def default_gains(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        return DEFAULT_KP, DEFAULT_KD
+
+    @property
+    def home_configuration(self) -> np.ndarray:
+        """:data:`HOME`, the start of Pająk 2024's task."""
+        return np.array(HOME)
+
+    def tcp_pose(self, q) -> np.ndarray:
+        return task_pose(q)
+
+    def tool_position(self, q) -> np.ndarray:
+        q = np.asarray(q, dtype=float)
+        return ur10e_kinematics(q, np.zeros_like(q))[0][..., :3]
+
+    def tool_motion(self, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
+        _, jacobian, bias, _, _ = ur10e_kinematics(q, qd)
+        return (np.einsum("...ij,...j->...i", jacobian[..., :3, :], qd),
+                np.einsum("...ij,...j->...i", jacobian[..., :3, :], qdd) + bias[..., :3])
+
+    def point_ik(self, points, reference) -> np.ndarray:
+        """IK of flange positions at the flange orientation of ``reference``, on its IK branch,
+        each joint within 2 pi of ``reference`` (:func:`inverse_kinematics`)."""
+        reference = _as_joint_vector(reference, "reference")
+        orientation = task_pose(reference)[3:]
+        branch = ik_branch(reference)
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        return np.array([inverse_kinematics(np.concatenate([point, orientation]), branch=branch, near=reference)
+                         for point in points]).reshape(-1, NUM_JOINTS)
+
+    def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
+        """qd = J^-1 [v; 0], qdd = J^-1 ([a; 0] - dJ/dt qd) with the analytic Jacobian (one q)."""
+        jacobian = analytic_jacobian(q)
+        qd = np.linalg.solve(jacobian, np.concatenate([v, np.zeros(3)]))
+        _, bias = analytic_jacobian_and_bias(q, qd)
+        qdd = np.linalg.solve(jacobian, np.concatenate([a, np.zeros(3)]) - bias)
+        return qd, qdd
+
+
+UR10E = UR10e()

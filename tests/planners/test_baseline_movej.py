@@ -1,26 +1,26 @@
-"""UR-style MoveJ baseline with radius blending (seed 000, experiment 1)."""
+"""UR-style MoveJ baseline with radius blending (Pająk 2024, experiment 1)."""
 
 import numpy as np
 import pytest
 from pydrake.systems.analysis import Simulator
 
-from drake_traj import robot
-from drake_traj.planners.baseline_movej import (
+from drake_traj.robots import ur10e as robot
+from drake_traj.bench import joint_waypoints, paper_task
+from drake_traj.planners.baselines.movej import (
     MovejBlendLaw,
     MovejPlanner,
-    paper_task_joint_waypoints,
     trapezoid_profile,
 )
 
 V_LIMIT = robot.DEFAULT_JOINT_MOVE_VELOCITY  # 1.05 rad/s
 A_LIMIT = robot.DEFAULT_JOINT_MOVE_ACCELERATION  # 1.40 rad/s^2
 PAPER_BLEND_RADIUS = 0.05  # [m]
-PAPER_BLEND_ACCELERATION = 2.48  # [rad/s^2], seed 000 Table 3 (measured on the robot)
+PAPER_BLEND_ACCELERATION = 2.48  # [rad/s^2], Pająk 2024 Table 3 (measured on the robot)
 
 
 @pytest.fixture(scope="module")
 def waypoints():
-    return paper_task_joint_waypoints()
+    return joint_waypoints(*paper_task())
 
 
 @pytest.fixture(scope="module")

@@ -1,5 +1,5 @@
 """Ruckig baseline (drake_traj.planners.baseline_ruckig) on the stop-at-each-waypoint version of
-seed 000's task."""
+Pająk 2024's task."""
 
 from __future__ import annotations
 
@@ -7,16 +7,16 @@ import numpy as np
 import pytest
 import ruckig
 
-from drake_traj import robot
-from drake_traj.planners import baseline_ruckig
-from drake_traj.planners.baseline_ruckig import RuckigPlanner, RuckigStopLaw, default_jerk_limit
+from drake_traj.robots import ur10e as robot
+from drake_traj.planners.baselines import ruckig as baseline_ruckig
+from drake_traj.planners.baselines.ruckig import RuckigPlanner, RuckigStopLaw, default_jerk_limit
 from drake_traj.planners.quintic import plan_synchronized_quintic
 
-VELOCITY_LIMIT = 1.05  # rad/s (seed 000)
-ACCELERATION_LIMIT = 1.40  # rad/s^2 (seed 000)
+VELOCITY_LIMIT = 1.05  # rad/s (Pająk 2024)
+ACCELERATION_LIMIT = 1.40  # rad/s^2 (Pająk 2024)
 JERK_LIMIT = 14.0  # rad/s^3: the default, 10/s times the acceleration limit
 
-# Seed 000 (/work/shared/seeds/000_d06a732d18392c9a.txt): q(0) and p1, p2, p3, pf; orientation
+# Pająk 2024 (docs/papers.md): q(0) and p1, p2, p3, pf; orientation
 # (pi, 0, 3 pi/4) on every pose.
 Q_INITIAL = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
 ORIENTATION = [np.pi, 0.0, 3 * np.pi / 4]

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from drake_traj.planners.baseline_toppra import (
+from drake_traj.planners.baselines.toppra import (
     ToppraLaw,
     ToppraPlanner,
     geometric_path_from_samples,
@@ -11,7 +11,7 @@ from drake_traj.planners.baseline_toppra import (
 )
 from drake_traj.planners.quintic import plan_synchronized_quintic, quintic_profile
 
-KV, KA = 1.05, 1.40  # seed 000's joint-move limits [rad/s, rad/s^2]
+KV, KA = 1.05, 1.40  # Pająk 2024's joint-move limits [rad/s, rad/s^2]
 Q0 = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
 Q1 = Q0 + np.array([1.6, -0.7, 0.9, 0.4, -0.2, 0.1])
 
@@ -77,7 +77,7 @@ def test_curved_path_respects_limits_and_beats_other_timings():
     assert acceleration_ratio <= 1.05  # Toppra constrains its discrete grid only
     assert max(velocity_ratio, acceleration_ratio) > 0.95  # and it is tight somewhere
 
-    # Another feasible timing of the same path: the quintic law s(t) = L r(t / T) (seed 004's
+    # Another feasible timing of the same path: the quintic law s(t) = L r(t / T) (Benotsmane et al.'s
     # time law), with T the smallest value meeting both limits (qd ~ 1/T, qdd ~ 1/T^2).
     length = path.end_time()
     dq = path.MakeDerivative(1)
@@ -132,7 +132,7 @@ def test_errors_are_clear():
 
 
 def test_toppra_failure_is_reported(monkeypatch):
-    from drake_traj.planners import baseline_toppra
+    from drake_traj.planners.baselines import toppra as baseline_toppra
 
     class NoSolution:
         def __init__(self, *args):
@@ -159,8 +159,8 @@ def test_planner_runs_in_the_closed_loop():
     assert result.succeeded, result.failure
     assert result.duration == pytest.approx(duration, abs=0.02)
     metrics = result.metrics()
-    assert metrics["max_velocity_over_limit"] <= 1.01
-    assert metrics["max_acceleration_over_limit"] <= 1.05
+    assert metrics.max_velocity_over_limit <= 1.01
+    assert metrics.max_acceleration_over_limit <= 1.05
     np.testing.assert_allclose(result.q_ref[-1], trajectory.value(trajectory.end_time()).ravel(), atol=1e-5)
 
 
@@ -168,7 +168,7 @@ def test_faster_than_the_pajak_run_on_its_own_path():
     from drake_traj.diagram import simulate
     from drake_traj.scenario import load_scenario, make_planner
 
-    result = simulate(make_planner(load_scenario("diagrams/pajak_sim3.yaml")))
+    result = simulate(make_planner(load_scenario("diagrams/pajak.yaml", "sim3")))
     assert result.succeeded, result.failure
     samples = result.q_ref[result.t <= result.duration]
     duration, trajectory = time_optimal_along_path(geometric_path_from_samples(samples), KV, KA)

@@ -1,22 +1,24 @@
-"""Seed 001's loop on the UR10e and on the paper's three robots, in the closed loop."""
+"""Boryga's loop on the UR10e and on the paper's three robots, in the closed loop."""
 
 import numpy as np
 import pytest
 
-from drake_traj import paper_robots, robot
-from drake_traj.diagram import robot_model, simulate
-from drake_traj.planners.boryga import Ur10eLoopLaw, joint_speed_cap, plan_loop_path
-from drake_traj.scenario import PAJAK_Q0, load_scenario, make_planner
+from drake_traj.robots import UR10E, boryga_robots
+from drake_traj.robots import ur10e as robot
+from drake_traj.diagram import simulate
+from drake_traj.robots import get_robot
+from drake_traj.planners.boryga import RobotLoopLaw, joint_speed_cap, paper_loop_placement, plan_loop_path
+from drake_traj.scenario import load_scenario, make_planner
 
 from conftest import DIAGRAMS
 
-NOMINAL_DURATION = 0.81368  # t_e of the paper's example (ERRATA)
+NOMINAL_DURATION = 0.81368  # t_e of the paper's example (docs/papers.md)
 
 
 def run(name):
-    scenario = load_scenario(DIAGRAMS / f"boryga_loop_{name}.yaml")
+    scenario = load_scenario(DIAGRAMS / "boryga_loop.yaml", name)
     planner = make_planner(scenario)
-    result = simulate(planner, name=scenario.name, robot_model=robot_model(scenario.robot), settle_time=0.1)
+    result = simulate(planner, name=scenario.name, robot=get_robot(scenario.robot), settle_time=0.1)
     return planner, result
 
 
@@ -36,7 +38,7 @@ def test_ur10e_traces_the_loop_in_a_plane_at_fixed_orientation(ur10e_run):
     np.testing.assert_allclose(result.tcp_ref[:, :3], position, atol=1e-6)
     np.testing.assert_allclose(robot.wrap_angle(result.tcp_ref[:, 3:] - result.tcp_ref[0, 3:]), 0, atol=1e-9)  # fixed
     np.testing.assert_allclose(result.tcp_ref[:, 2], result.tcp_ref[0, 2], atol=1e-9)  # a horizontal plane
-    np.testing.assert_allclose(result.q_ref[0], PAJAK_Q0, atol=1e-9)  # B is the flange at q_initial
+    np.testing.assert_allclose(result.q_ref[0], robot.HOME, atol=1e-9)  # B is the flange at q_initial
 
 
 def test_ur10e_loop_is_slowed_into_its_joint_limits(ur10e_run):
@@ -49,38 +51,39 @@ def test_ur10e_loop_is_slowed_into_its_joint_limits(ur10e_run):
     assert np.abs(result.qdd_ref).max() <= 1.40 * (1 + 1e-6)
     assert np.abs(result.qd_ref).max() <= 1.05
     assert np.abs(result.qdd_ref).max() == pytest.approx(1.40, rel=1e-3)  # the cap is tight
-    assert result.metrics()["tracking_error_tcp_max_m"] < 1e-4
+    assert result.metrics().tracking_error_tcp_max_m < 1e-4
 
 
-@pytest.mark.parametrize("name", paper_robots.ROBOT_NAMES)
+@pytest.mark.parametrize("name", boryga_robots.ROBOT_NAMES)
 def test_paper_robots_trace_the_placed_loop(name):
     planner, result = run(name)
     assert result.succeeded
     assert planner.speed_cap == 1.0  # within the robots' velocity limits, no acceleration limit set
     assert result.duration == pytest.approx(NOMINAL_DURATION, abs=2e-3)
-    placement = paper_robots.paper_loop_placement(name)
+    placement = paper_loop_placement(name)
     position = placement.plan().sample(np.minimum(result.t, NOMINAL_DURATION))[0]
     np.testing.assert_allclose(result.tcp_ref[:, :3], position, atol=1e-6)
     np.testing.assert_allclose(result.tcp[-1, :3], placement.E, atol=1e-4)  # measured, at rest at E
-    assert np.all(np.abs(result.qd_ref) <= np.asarray(paper_robots.get_robot(name).velocity_limit))
+    assert np.all(np.abs(result.qd_ref) <= np.asarray(get_robot(name).velocity_limit))
 
 
 def test_speed_cap_is_one_when_the_law_is_within_limits():
-    q0 = np.asarray(PAJAK_Q0)
+    q0 = np.asarray(robot.HOME)
     start = robot.task_pose(q0)
     plan = plan_loop_path(start[:3], start[:3] + [0.04, 0.03, 0], start[:3] + [0.04, 0, 0], 0.01, delta=0.02)
-    law = Ur10eLoopLaw(plan, start[3:], robot.ik_branch(q0))
+    law = RobotLoopLaw(plan, UR10E, q0)
     cap, peaks = joint_speed_cap(law, [3.0] * 6, [50.0] * 6)
     assert cap == 1.0 and peaks["qd"].max() < 3.0
 
 
 def test_bad_loop_scenarios_name_the_reason(tmp_path):
-    text = (DIAGRAMS / "boryga_loop_scara.yaml").read_text()
+    text = (DIAGRAMS / "boryga_loop.yaml").read_text()
+    text = "scara:" + text.split("\nscara:")[1].split("\ncartesian:")[0]  # the scara variant alone
     path = tmp_path / "bad.yaml"
-    path.write_text(text.replace("  delta: 0.02", "  delta: 0.02\n  B: [0.5, 0.5, 1.0]\n  M: [0.54, 0.53, 1.0]\n  E: [0.54, 0.5, 1.0]"))
-    with pytest.raises(ValueError, match="out of reach of the scara"):  # the paper's own placement (ERRATA)
+    path.write_text(text.replace("    delta: 0.02", "    delta: 0.02\n    B: [0.5, 0.5, 1.0]\n    M: [0.54, 0.53, 1.0]\n    E: [0.54, 0.5, 1.0]"))
+    with pytest.raises(ValueError, match="out of reach of the scara"):  # the paper's own placement (docs/papers.md)
         make_planner(load_scenario(path))
-    path.write_text(text.replace("  v_max: 0.25", "  v_max: -0.25"))
+    path.write_text(text.replace("    v_max: 0.25", "    v_max: -0.25"))
     with pytest.raises(ValueError, match="v_max"):
         make_planner(load_scenario(path))
     path.write_text(text.replace("robot: scara", "robot: puma"))
@@ -91,6 +94,6 @@ def test_bad_loop_scenarios_name_the_reason(tmp_path):
 def test_cli_writes_the_loop_path_figure(tmp_path):
     from drake_traj import cli
 
-    assert cli.main(["run", str(DIAGRAMS / "boryga_loop_cartesian.yaml"), "--out", str(tmp_path)]) == 0
+    assert cli.main(["run", str(DIAGRAMS / "boryga_loop.yaml"), "--variant", "cartesian", "--out", str(tmp_path)]) == 0
     for stem in ("loop_path", "joints", "tcp_path"):
         assert (tmp_path / f"{stem}.png").stat().st_size > 10_000

@@ -1,7 +1,7 @@
-"""Tests for the loop path geometry and time law (seed 001, Boryga, section 2, eq. 1-14).
+"""Tests for the loop path geometry and time law (Boryga, Boryga, section 2, eq. 1-14).
 
 Numbers from the paper's numerical example (section 3, Table 1) are checked against the corrected
-values of ``/work/shared/ERRATA.md``; where the paper printed something else, the comment says
+values of ``docs/papers.md``; where the paper printed something else, the comment says
 what it printed. Printed values rounded to three decimals are checked to 5e-4.
 """
 
@@ -132,7 +132,7 @@ def test_example_geometry_numbers(plan):
     assert g.ds_MT1 == pytest.approx(0.0179, abs=PRINTED_TOL)
     assert g.ds_T2M == pytest.approx(0.0179, abs=PRINTED_TOL)
     assert g.ds_ME == pytest.approx(0.03, abs=1e-15)
-    # ERRATA: total path 0.15217 m (paper: 0.152); 0.036 m is the arc alone (paper: "on the loop"),
+    # Corrected (docs/papers.md): total path 0.15217 m (paper: 0.152); 0.036 m is the arc alone (paper: "on the loop"),
     # the whole M -> T1 -> T2 -> M loop is 0.07217 m.
     assert g.path_length == pytest.approx(0.15217, abs=5e-6)
     assert plan.path_length == g.path_length
@@ -149,10 +149,10 @@ def test_example_time_law_numbers(plan):
     assert tl.t_T2M == pytest.approx(0.072, abs=PRINTED_TOL)
     assert tl.t_ME == pytest.approx(0.197, abs=PRINTED_TOL)
     assert tl.tau == pytest.approx(0.42, abs=PRINTED_TOL)
-    # ERRATA: p_BM = 4.46516e4 m/s^9 (the paper prints 4.46156e4, digits transposed).
+    # Corrected (docs/papers.md): p_BM = 4.46516e4 m/s^9 (the paper prints 4.46156e4, digits transposed).
     assert tl.p_BM == pytest.approx(4.46516e4, rel=1e-5)
     assert tl.p_ME == pytest.approx(2.65844e6, rel=1e-5)
-    # ERRATA: t_e = 0.81368 s (the paper prints 0.815, the sum of its rounded parts).
+    # Corrected (docs/papers.md): t_e = 0.81368 s (the paper prints 0.815, the sum of its rounded parts).
     assert tl.t_e == pytest.approx(0.81368, abs=5e-6)
     assert plan.duration == tl.t_e
     # Eq. 13 and 14 as sums, and the second pass through M at tau + t_ME.
@@ -162,7 +162,7 @@ def test_example_time_law_numbers(plan):
 
 
 def test_acceleration_jump_at_t1_and_t2(plan):
-    # ERRATA: v_max^2 / R = 6.99 m/s^2 in the example.
+    # Corrected (docs/papers.md): v_max^2 / R = 6.99 m/s^2 in the example.
     jump = V_MAX**2 / plan.geometry.R
     assert jump == pytest.approx(6.99, abs=5e-3)
     for name in ("T1", "T2"):

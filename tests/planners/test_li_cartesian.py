@@ -1,7 +1,7 @@
-"""Tests for the Cartesian stage of seed 002 (Li, Zhang, Zhou 2019): break-point limits, the
+"""Tests for the Cartesian stage of Li et al. 2019 (Li, Zhang, Zhou): break-point limits, the
 velocity look-ahead and the cubic ACC/DEC profile.
 
-The paper's OCR text is checked against the corrected forms of ``/work/shared/ERRATA.md`` (seed
+The paper's OCR text is checked against the corrected forms of ``docs/papers.md`` (seed
 002); where the paper printed something else, the comment says what it printed.
 """
 
@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from drake_traj.planners.li_lookahead import (
+from drake_traj.planners.li.cartesian import (
     AccDecCase,
     acc_dec_profile,
     average_acceleration,
@@ -118,9 +118,9 @@ def test_straight_line_and_corner_limits():
     geometry = break_point_geometry(corner)
     np.testing.assert_allclose(geometry.direction_change, [0.0, math.sqrt(2.0), 0.0, 0.0], atol=1e-15)
     limits = break_point_limits(corner, V_M, A_M)
-    # dl_1 = l_1 = 0.01 m: the incoming segment (ERRATA: dl_i = min{l_step, l_i}).
+    # dl_1 = l_1 = 0.01 m: the incoming segment (Corrected (docs/papers.md): dl_i = min{l_step, l_i}).
     np.testing.assert_allclose(limits, [0.0, math.sqrt(A_M * 0.01 / math.sqrt(2.0)), V_M, 0.0])
-    # The ERRATA's index fix: the turn is charged to P_1 (from P_0P_1 to P_1P_2), not P_2.
+    # The index fix (docs/papers.md): the turn is charged to P_1 (from P_0P_1 to P_1P_2), not P_2.
     assert limits[2] == V_M
 
 
@@ -191,7 +191,7 @@ def test_look_ahead_steps_back_where_one_forward_pass_is_not_enough():
 
 
 def errata_time(case, length, v_s, v_e, v_m, acc) -> float:
-    """Table 2 per ERRATA (A = (2/3) a_m). The paper's Table 2 uses a_m; see the ERRATA."""
+    """Table 2 as corrected in docs/papers.md (A = (2/3) a_m). The paper's Table 2 uses a_m; see docs/papers.md."""
     v_a = math.sqrt((2 * acc * length + v_s**2 + v_e**2) / 2)  # eq. 13 (corrected)
     return {
         AccDecCase.I: length / v_m,
@@ -253,7 +253,7 @@ def test_acc_dec_random_segments_cover_all_seven_cases():
         counts[case] += 1
         assert case == expected_case(length, v_s, v_e, v_m, acc)
         assert classify_acc_dec(length, v_s, v_e, v_m, a_max) == case
-        # Table 2 (ERRATA) times.
+        # Table 2 (docs/papers.md) times.
         assert profile.duration == pytest.approx(errata_time(case, length, v_s, v_e, v_m, acc), rel=1e-9)
         # Dense samples plus both ramp midpoints (where the bell peaks).
         t = np.concatenate([tau * profile.duration, [0.5 * profile.t_acc],
@@ -282,7 +282,7 @@ def test_acc_dec_random_segments_cover_all_seven_cases():
             assert np.all(a == 0.0) and np.all(v == v_m)
         else:
             # Every ramp peaks at exactly a_m (mean A = 2/3 a_m); the paper's eq. 8-13 with a_m
-            # would peak at 1.5 a_m (ERRATA).
+            # would peak at 1.5 a_m (docs/papers.md).
             assert np.max(np.abs(a)) == pytest.approx(a_max, rel=1e-9)
             assert profile.peak_acceleration == pytest.approx(a_max, rel=1e-9)
     # All seven cases are hit; all but I (uniform) reach a_m.

@@ -1,9 +1,10 @@
-"""Seed 002's planner end to end: the closed path on the 4-DOF robot and on the UR10e."""
+"""Li et al. 2019's planner end to end: the closed path on the 4-DOF robot and on the UR10e."""
 
 import numpy as np
 import pytest
 
-from drake_traj.diagram import robot_model, simulate
+from drake_traj.diagram import simulate
+from drake_traj.robots import get_robot
 from drake_traj.scenario import load_scenario, make_planner
 
 from conftest import DIAGRAMS
@@ -22,9 +23,9 @@ def distance_to_polyline(points, polyline):
 
 @pytest.fixture(scope="module", params=["4dof", "ur10e"])
 def li_run(request):
-    scenario = load_scenario(DIAGRAMS / f"li_closed_path_{request.param}.yaml")
+    scenario = load_scenario(DIAGRAMS / "li_closed_path.yaml", request.param)
     planner = make_planner(scenario)
-    result = simulate(planner, name=scenario.name, robot_model=robot_model(scenario.robot), settle_time=0.1,
+    result = simulate(planner, name=scenario.name, robot=get_robot(scenario.robot), settle_time=0.1,
                       max_duration=scenario.max_duration)
     return planner, result
 
@@ -50,7 +51,7 @@ def test_tool_stays_on_the_path_and_closes_it(li_run):
     # Measured: 0.09 mm (4-DOF) and 0.07 mm (UR10e) between the 1 mm spaced path points.
     assert deviation.max() < 2e-4
     np.testing.assert_allclose(result.tcp[-1, :3], path[-1], atol=1e-5)  # back at the start, at rest
-    assert result.metrics()["tracking_error_tcp_max_m"] < 1e-4
+    assert result.metrics().tracking_error_tcp_max_m < 1e-4
 
 
 def test_the_repairs_only_lengthen_the_motion(li_run):
@@ -62,17 +63,23 @@ def test_the_repairs_only_lengthen_the_motion(li_run):
 
 
 def test_li_planner_rejects_bad_input(tmp_path):
-    text = (DIAGRAMS / "li_closed_path_4dof.yaml").read_text()
+    text = (DIAGRAMS / "li_closed_path.yaml").read_text()
+    text = "4dof:" + text.split("\n4dof:")[1].split("\nur10e:")[0]  # the 4-DOF variant alone
     path = tmp_path / "bad.yaml"
-    path.write_text(text.replace("  tool_velocity_limit: 0.2", "  tool_velocity_limit: 0.2\n  points: [[0.3, 0, 0], [0.9, 0, 0]]"))
+    path.write_text(text.replace("    tool_velocity_limit: 0.2", "    tool_velocity_limit: 0.2\n    points: [[0.3, 0, 0], [0.9, 0, 0]]"))
     with pytest.raises(ValueError, match="out of reach|too far"):
         make_planner(load_scenario(path))
-    path.write_text(text.replace("  tool_velocity_limit: 0.2", "  tool_velocity_limit: 0.2\n  points: [[0.3, 0, 0], [0.3, 0, 0], [0.35, 0, 0]]"))
+    path.write_text(text.replace("    tool_velocity_limit: 0.2", "    tool_velocity_limit: 0.2\n    points: [[0.3, 0, 0], [0.3, 0, 0], [0.35, 0, 0]]"))
     with pytest.raises(ValueError, match="repeats"):
         make_planner(load_scenario(path))
-    path.write_text(text.replace("  tool_acceleration_limit: 0.1", "  tool_acceleration_limit: 0.0"))
+    path.write_text(text.replace("    tool_acceleration_limit: 0.1", "    tool_acceleration_limit: 0.0"))
     with pytest.raises(ValueError, match="a_max"):
         make_planner(load_scenario(path))
-    path.write_text(text.replace("robot: li_4dof", "robot: scara"))
-    with pytest.raises(ValueError, match="LiClosedPath runs on robot ur10e or li_4dof"):
+    text = text.replace("robot: li_4dof", "robot: scara")
+    path.write_text(text)
+    with pytest.raises(ValueError, match="acceleration_limit must be given: the robot has no default"):
+        make_planner(load_scenario(path))
+    # the path placed at the tool of the SCARA's home configuration, where its arm is stretched
+    path.write_text(text.replace("    tool_velocity_limit: 0.2", "    tool_velocity_limit: 0.2\n    acceleration_limit: [1, 1, 1]"))
+    with pytest.raises(ValueError, match="out of reach of the scara"):
         make_planner(load_scenario(path))

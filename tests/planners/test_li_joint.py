@@ -1,7 +1,7 @@
-"""Tests for the joint stage of seed 002 (Li, Zhang, Zhou 2019): re-timing (eq. 14), the quintic
-B-spline fit (eq. 15-22) and the post-check / time-stretch repair the ERRATA (seed 002) asks for.
+"""Tests for the joint stage of Li et al. 2019 (Li, Zhang, Zhou): re-timing (eq. 14), the quintic
+B-spline fit (eq. 15-22) and the post-check / time-stretch repair docs/papers.md asks for.
 
-The paper claims its joint trajectories satisfy the limits (Fig. 8); the ERRATA recomputed that
+The paper claims its joint trajectories satisfy the limits (Fig. 8); docs/papers.md recomputes that
 they do not (joint-1 acceleration 2.0 vs 1.0 near arcs). The UR10e test below shows the same on a
 path of straight lines and 10 mm arcs, and that the repaired law holds every limit.
 """
@@ -13,8 +13,8 @@ import math
 import numpy as np
 import pytest
 
-from drake_traj import robot
-from drake_traj.planners.li_joint import (
+from drake_traj.robots import ur10e as robot
+from drake_traj.planners.li.joint import (
     JointSplineLaw,
     check_limits,
     fit_quintic_spline,
@@ -22,7 +22,7 @@ from drake_traj.planners.li_joint import (
     repair_time_stretch,
     retime_joint_samples,
 )
-from drake_traj.planners.li_lookahead import plan_cartesian_path
+from drake_traj.planners.li.cartesian import plan_cartesian_path
 from drake_traj.planners.quintic import quintic_profile
 
 Q0 = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
@@ -160,7 +160,7 @@ def test_rates_at_matches_sample(ur10e_repaired):
 
 
 def rest_to_rest_time(length, omega, alpha):
-    """Table 2 time (ERRATA) from rest to rest over ``length`` with A = (2/3) alpha: case VII
+    """Table 2 time (docs/papers.md) from rest to rest over ``length`` with A = (2/3) alpha: case VII
     L / omega + omega / A when the joint reaches omega (L >= L_e = omega^2 / A), else case VI
     2 sqrt(L / A)."""
     acc = 2.0 / 3.0 * alpha

@@ -1,4 +1,4 @@
-"""Seed 000's planner as a Drake system: the paper's sim 3 in the closed loop, and failures.
+"""Pająk 2024's planner as a Drake system: the paper's sim 3 in the closed loop, and failures.
 
 The law itself (Table 2, the improvements, the property test) is tested in test_pajak_law.py
 with its own fixed-step integrator; here the same law runs under the Simulator in the
@@ -8,9 +8,10 @@ PD-controlled diagram, and the two must agree.
 import numpy as np
 import pytest
 
-from drake_traj import robot
+from drake_traj.robots import ur10e as robot
 from drake_traj.diagram import simulate
 from drake_traj.planners import pajak as P
+from drake_traj.planners.pajak import parameters as pajak_parameters
 from drake_traj.result import SimulationResult
 from drake_traj.scenario import load_scenario, make_planner
 
@@ -57,9 +58,9 @@ def test_sim3_reaches_the_goal_through_every_neighbourhood(sim3):
 def test_sim3_closed_loop_tracking_and_torques(sim3):
     metrics = sim3.metrics()
     # Measured: 3.6e-5 rad and 2.8e-5 m; peak torque 0.28 of the effort limit (elbow).
-    assert metrics["tracking_error_joint_max_rad"] < 1e-4
-    assert metrics["tracking_error_tcp_max_m"] < 1e-4
-    assert max(metrics["peak_torque_over_limit"]) < 1.0
+    assert metrics.tracking_error_joint_max_rad < 1e-4
+    assert metrics.tracking_error_tcp_max_m < 1e-4
+    assert max(metrics.peak_torque_over_limit) < 1.0
 
 
 def test_sim3_acceleration_is_continuous_in_the_diagram():
@@ -67,7 +68,7 @@ def test_sim3_acceleration_is_continuous_in_the_diagram():
     # largest step-to-step change.
     steps = {}
     for period in (1e-3, 5e-4):
-        planner = make_planner(load_scenario(DIAGRAMS / "pajak_sim3.yaml"))
+        planner = make_planner(load_scenario(DIAGRAMS / "pajak.yaml", "sim3"))
         result = simulate(planner, log_period=period, settle_time=0.0)
         after_start = result.t > 0.01
         steps[period] = np.abs(np.diff(result.qdd_ref[after_start], axis=0)).max()
@@ -77,12 +78,14 @@ def test_sim3_acceleration_is_continuous_in_the_diagram():
 def test_unreachable_goal_stops_with_the_reason_and_keeps_the_log(tmp_path):
     pose = robot.task_pose(Q0)
     goal = pose.copy()
-    direction = (pose[:3] - P.SHOULDER) / np.linalg.norm(pose[:3] - P.SHOULDER)
-    goal[:3] = P.SHOULDER + 1.29 * direction  # inside 1.3 m, but not reachable with this orientation
-    planner = P.PajakPlanner(P.PajakParameters(waypoints=goal[None], limit_velocity=True, stall_time=1.0), Q0)
+    direction = (pose[:3] - pajak_parameters.SHOULDER) / np.linalg.norm(pose[:3] - pajak_parameters.SHOULDER)
+    goal[:3] = pajak_parameters.SHOULDER + 1.29 * direction  # inside 1.3 m, but not reachable with this orientation
+    planner = P.PajakPlanner(P.PajakConfig(waypoints=goal[None], limit_velocity=True, limit_acceleration=False, stall_time=1.0), Q0)
     result = simulate(planner, max_duration=20.0)
     assert not result.succeeded
-    assert "PlanningError" in result.failure and "no progress" in result.failure and "q = " in result.failure
+    message = result.failure.message
+    assert "PlanningError" in message and "no progress" in message and "q = " in message
+    assert result.failure.cause == "stall" and result.failure.configuration is not None
     assert len(result.t) > 1000 and np.all(np.isfinite(result.qdd_ref))
     assert np.abs(result.qd_ref).max() <= 1.05 + TOL
     saved = SimulationResult.load(result.save(tmp_path))
@@ -93,6 +96,6 @@ def test_bad_task_names_the_field():
     with pytest.raises(ValueError, match="vartheta"):
         P.PajakPlanner(P.paper_parameters(3, vartheta=0.7), Q0)
     with pytest.raises(ValueError, match="beyond the UR10e reach"):
-        P.PajakPlanner(P.PajakParameters(waypoints=[[1.5, 0, 0.2, np.pi, 0, 0]]), Q0)
+        P.PajakPlanner(P.PajakConfig(waypoints=[[1.5, 0, 0.2, np.pi, 0, 0]]), Q0)
     with pytest.raises(ValueError, match="q_initial"):
         P.PajakPlanner(P.paper_parameters(3), Q0[:5])

@@ -1,6 +1,6 @@
-"""Tests for the planning law of seed 000 (Pająk 2024), drake_traj.planners.pajak.
+"""Tests for the planning law of Pająk 2024, drake_traj.planners.pajak.
 
-Paper numbers are checked against the recomputed values of ``/work/shared/ERRATA.md`` (seed 000);
+Paper numbers are checked against the recomputed values of ``docs/papers.md`` (Pająk 2024);
 where the paper printed something else, the comment says what it printed. The trajectories come
 from the module's own fixed-step RK4 integrator (``integrate``, dt = 1 ms, the discrete state
 updated every step), so no Drake system is involved here.
@@ -14,11 +14,13 @@ import time
 import numpy as np
 import pytest
 
-from drake_traj import robot
+from drake_traj.robots import ur10e as robot
 from drake_traj.planners import pajak as P
+from drake_traj.planners.pajak import law as law_state
+from drake_traj.planners.pajak import parameters as pajak_parameters
 
 Q0 = P.paper_initial_configuration()
-# Every improvement off: the paper's method as printed (with the ERRATA corrections).
+# Every improvement off: the paper's method as printed (with the corrections of docs/papers.md).
 LITERAL = P.PAPER_METHOD
 VMAX, AMAX = 1.05, 1.40  # [rad/s], [rad/s^2]: the paper's limits
 TOL = 1e-9  # floating-point slack on "limit held"
@@ -45,7 +47,7 @@ def until_finish(result: dict, name: str) -> np.ndarray:
     return result[name][: k + 1]
 
 
-def overshoot_past_goal(result: dict, law_params: P.PajakParameters) -> float:
+def overshoot_past_goal(result: dict, law_params: P.PajakConfig) -> float:
     """Largest distance [m] the TCP gets past p_w along the approach direction (negative: never).
 
     The approach direction is p_{w-1} -> p_w, or start -> p_w for a single waypoint; only samples
@@ -243,7 +245,7 @@ def test_start_of_the_motion_eq_18():
     # sim 3: c(0) = 0 with the anchor (t0, c0) = (0, 0), so q̈(0) = 0 and c then follows eq. 18
     law = P.PajakLaw(P.paper_parameters(3))
     d = law.initial_discrete()
-    assert d[P.C] == 0.0 and d[P.T0] == 0.0 and d[P.C0] == 0.0
+    assert d[law_state.C] == 0.0 and d[law_state.T0] == 0.0 and d[law_state.C0] == 0.0
     qdd, c = law.acceleration(0.0, Q0, np.zeros(6), d)
     assert c == 0.0 and np.all(qdd == 0.0)
     _, c = law.acceleration(0.01, Q0, np.zeros(6), d)
@@ -265,13 +267,13 @@ def test_table_2(sim, method):
     result = run(sim, **overrides)
     t_paper, qd_max_paper, qd_min_paper = TABLE2[sim]
     qd, qdd = until_finish(result, "qd"), until_finish(result, "qdd")
-    # paper: 4.98 / 5.22 / 5.32 s; ERRATA recomputed 4.95-5.17 / 5.20-5.42 / 5.26-5.43. Sim 3
+    # paper: 4.98 / 5.22 / 5.32 s; docs/papers.md recomputed 4.95-5.17 / 5.20-5.42 / 5.26-5.43. Sim 3
     # improved: 5.28 s without the overshoot (literal: 5.35 s, finishing while passing p_f)
     assert result["T"] == pytest.approx(t_paper, rel=0.05)
     assert qd.max() == pytest.approx(qd_max_paper, abs=0.06)
     assert qd.min() == pytest.approx(qd_min_paper, abs=0.06)
     if sim in (1, 2):
-        # Table 2 prints max q̈ = 19.77 for sims 1-2; ERRATA: not reproducible, the equations
+        # Table 2 prints max q̈ = 19.77 for sims 1-2; Corrected (docs/papers.md): not reproducible, the equations
         # give 14.89 (at t = 0, where joints 2-4 sum to zero). -22.63 (joint 4 at t = 0) is.
         assert qdd.max() == pytest.approx(14.89, abs=0.05)
         assert qdd.min() == pytest.approx(-22.63, abs=0.05)
@@ -281,7 +283,7 @@ def test_table_2(sim, method):
         assert qdd.max() == pytest.approx(AMAX, abs=0.01) and qdd.min() == pytest.approx(-AMAX, abs=0.01)
     if sim in (2, 3):
         assert np.all(np.abs(qd) <= VMAX)
-    # Table 2: 5.81e-4 / 5.68e-4 / 6.26e-4 m; ERRATA: below the 1 mm stop threshold checked
+    # Table 2: 5.81e-4 / 5.68e-4 / 6.26e-4 m; Corrected (docs/papers.md): below the 1 mm stop threshold checked
     # every step, reproductions land just under 1 mm
     assert result["error"] < 1e-3
     # the TCP passes through every waypoint's 5 cm neighbourhood
@@ -299,9 +301,9 @@ def test_c_stays_in_unit_interval_and_anchor_is_recorded():
     assert not result["saturated"].any()
     # while the limits set c the anchor is (t, c) of the last update
     d = result["discrete"]
-    active = np.flatnonzero(d[1:, P.T0] == result["t"][1:]) + 1
+    active = np.flatnonzero(d[1:, law_state.T0] == result["t"][1:]) + 1
     assert active.size > 100
-    np.testing.assert_allclose(d[active, P.C0], d[active, P.C])
+    np.testing.assert_allclose(d[active, law_state.C0], d[active, law_state.C])
 
 
 def test_acceleration_limit_holds_between_samples():
@@ -425,7 +427,7 @@ def random_tasks(count: int, seed: int = 0):
                 break
         if len(poses) == 0 or len(poses) < len(configurations) - 1:
             continue
-        task = P.PajakParameters(
+        task = P.PajakConfig(
             waypoints=np.array(poses),
             velocity_limit=rng.uniform(0.5, 2.0),
             acceleration_limit=rng.uniform(0.7, 3.0),
@@ -510,7 +512,7 @@ def test_damped_inverse_keeps_motion_bounded_through_a_wrist_singularity():
     goal = robot.task_pose(q_goal)
     peaks = {}
     for damped in (True, False):
-        law = P.PajakLaw(P.PajakParameters(waypoints=goal[None], damped_inverse=damped))
+        law = P.PajakLaw(P.PajakConfig(waypoints=goal[None], damped_inverse=damped, limit_velocity=False, limit_acceleration=False))
         try:
             result = P.integrate(law, q_start, t_max=10.0)
         except P.PlanningError as exc:
@@ -526,9 +528,9 @@ def test_damped_inverse_keeps_motion_bounded_through_a_wrist_singularity():
 def test_unreachable_goal_fails_cleanly():
     pose = robot.task_pose(Q0)
     goal = pose.copy()
-    direction = (pose[:3] - P.SHOULDER) / np.linalg.norm(pose[:3] - P.SHOULDER)
-    goal[:3] = P.SHOULDER + 1.29 * direction  # inside 1.3 m, but not with this orientation
-    law = P.PajakLaw(P.PajakParameters(waypoints=goal[None], limit_velocity=True, stall_time=1.0))
+    direction = (pose[:3] - pajak_parameters.SHOULDER) / np.linalg.norm(pose[:3] - pajak_parameters.SHOULDER)
+    goal[:3] = pajak_parameters.SHOULDER + 1.29 * direction  # inside 1.3 m, but not with this orientation
+    law = P.PajakLaw(P.PajakConfig(waypoints=goal[None], limit_velocity=True, limit_acceleration=False, stall_time=1.0))
     with pytest.raises(P.PlanningError) as info:
         P.integrate(law, Q0, t_max=20.0)
     error = info.value
@@ -541,9 +543,9 @@ def test_unreachable_goal_fails_cleanly():
     assert len(partial["t"]) > 1000 and np.all(np.isfinite(partial["qdd"]))
     assert np.all(np.abs(partial["qd"]) <= VMAX)
     # goals beyond the reach are refused up front
-    goal[:3] = P.SHOULDER + 1.4 * direction
+    goal[:3] = pajak_parameters.SHOULDER + 1.4 * direction
     with pytest.raises(ValueError, match="beyond the UR10e reach"):
-        P.PajakLaw(P.PajakParameters(waypoints=goal[None]))
+        P.PajakLaw(P.PajakConfig(waypoints=goal[None], limit_velocity=False, limit_acceleration=False))
 
 
 def test_gimbal_lock_and_timeout_raise_planning_error():

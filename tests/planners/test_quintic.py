@@ -1,6 +1,6 @@
-"""Tests for the synchronised quintic point-to-point planner (seed 004, Benotsmane).
+"""Tests for the synchronised quintic point-to-point planner (Benotsmane et al., Benotsmane).
 
-Numbers from the paper are checked against the corrected values of ``/work/shared/ERRATA.md``;
+Numbers from the paper are checked against the corrected values of ``docs/papers.md``;
 where the paper printed something else, the comment says what it printed.
 """
 
@@ -86,7 +86,7 @@ def test_profile_derivatives_match_finite_differences_and_symmetry():
 def test_table6_theoretical_peaks():
     d, t_f = np.pi / 2, 230.0  # Table 5: joint 1, q^i = 0, q^f = pi/2, T = 230 s
     # Paper printed 0,012 rad/s (truncated) and 1,7e-4 rad/s^2; the experiment gave
-    # BCV = 0.0129 rad/s and BCA = 1.8e-4 rad/s^2. Recomputed (ERRATA): 0.012805 rad/s and
+    # BCV = 0.0129 rad/s and BCA = 1.8e-4 rad/s^2. Recomputed (docs/papers.md): 0.012805 rad/s and
     # 1.7144e-4 rad/s^2.
     assert peak_velocity(d, t_f) == pytest.approx(0.012805, rel=1e-4)
     assert peak_acceleration(d, t_f) == pytest.approx(1.7144e-4, rel=1e-4)
@@ -123,7 +123,7 @@ def test_table6_peaks_reproduced_by_dense_sampling():
 
 def test_table3_velocity_gains_from_table2():
     k_v = TABLE2_OMEGA * TABLE2_RATIO  # eq. 10: K_vj = omega_motor * n
-    # Corrected Table 3 (ERRATA).
+    # Corrected Table 3 (docs/papers.md).
     np.testing.assert_allclose(
         k_v, [142.857, 87.558, 115.208, 92.166, 148.148, 96.296], rtol=1e-5
     )
@@ -231,7 +231,7 @@ def test_random_moves_limits_synchronisation_and_ends(seed):
     np.testing.assert_array_equal(qd_out, 0.0)
     np.testing.assert_array_equal(qdd_out, 0.0)
 
-    # Non-zero end jerk 60 D / t_f^3 (ERRATA note); 0 outside the move.
+    # Non-zero end jerk 60 D / t_f^3 (docs/papers.md); 0 outside the move.
     np.testing.assert_allclose(plan.jerk(t_f), 60 * d / t_f**3, rtol=1e-12)
     np.testing.assert_allclose(plan.jerk(0.0), 60 * d / t_f**3, rtol=1e-12)
     np.testing.assert_array_equal(plan.jerk(t_f + 1e-3), 0.0)

@@ -1,8 +1,8 @@
-"""drake_traj.paper_robots: the three manipulators of seed 001 (Boryga, section 4).
+"""drake_traj.robots.boryga_robots: the three manipulators of Boryga (section 4).
 
 FK against Drake's MultibodyPlant (URDF ``tool0``), closed-form IK (eq. 18-20, 24-26 with the
-ERRATA sign fix, 30-32) against FK, joint rates against finite differences of IK along the placed
-loop path, and rejection of out-of-reach points (ERRATA: the paper's own example path is out of
+docs/papers.md sign fix, 30-32) against FK, joint rates against finite differences of IK along the placed
+loop path, and rejection of out-of-reach points (Corrected (docs/papers.md): the paper's own example path is out of
 reach of the anthropomorphic arm and needs a negative SCARA stroke).
 """
 
@@ -15,8 +15,9 @@ import pytest
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable
 
-from drake_traj import paper_robots as pr
-from drake_traj.planners.boryga import plan_loop_path
+from drake_traj.planners.boryga import PAPER_LOOP, paper_loop_placement, plan_loop_path
+from drake_traj.robots import boryga_robots as pr
+from drake_traj.robots import get_robot
 
 NAMES = pr.ROBOT_NAMES
 
@@ -25,7 +26,7 @@ NAMES = pr.ROBOT_NAMES
 def plant_setup(request):
     name = request.param
     plant = MultibodyPlant(0.0)
-    instance = pr.add_paper_robot(plant, name)
+    instance = get_robot(name).add_to_plant(plant)
     plant.Finalize()
     return name, plant, instance, plant.CreateDefaultContext()
 
@@ -47,8 +48,8 @@ def placed():
     """Per robot: (robot, plan, dense times, q, qd, qdd) along the placed loop."""
     out = {}
     for name in NAMES:
-        robot = pr.get_robot(name)
-        plan = pr.paper_loop_placement(name).plan()
+        robot = get_robot(name)
+        plan = paper_loop_placement(name).plan()
         times = np.linspace(0.0, plan.duration, 8001)
         out[name] = (robot, plan, times) + robot.joint_trajectory(plan, times)
     return out
@@ -61,7 +62,7 @@ def placed():
 
 def test_urdf_joints_limits_and_actuators_match_module(plant_setup):
     name, plant, instance, _ = plant_setup
-    robot = pr.get_robot(name)
+    robot = get_robot(name)
     assert robot.model_path().name == f"boryga_{name}.urdf"
     assert plant.num_positions() == 3 and plant.num_actuators() == 3
     plant.GetFrameByName("tool0", instance)
@@ -81,12 +82,12 @@ def test_urdf_joints_limits_and_actuators_match_module(plant_setup):
 
 
 def test_paper_dimensions():
-    a, s, c = (pr.get_robot(n) for n in NAMES)
+    a, s, c = (get_robot(n) for n in NAMES)
     assert (a.lambda1, a.l2, a.l3) == (0.33, 0.42, 0.36)
     assert (s.lambda1, s.lambda2, s.l1, s.l2) == (0.3, 0.065, 0.54, 0.42)
     assert c.l2 == 0.24
-    with pytest.raises(ValueError, match="unknown robot"):
-        pr.get_robot("delta")
+    with pytest.raises(ValueError, match="robot must be one of"):
+        get_robot("delta")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -96,7 +97,7 @@ def test_paper_dimensions():
 
 def test_fk_jacobian_and_bias_match_multibody_plant(plant_setup):
     name, plant, instance, context = plant_setup
-    robot = pr.get_robot(name)
+    robot = get_robot(name)
     tool = plant.GetFrameByName("tool0", instance)
     world = plant.world_frame()
     rng = np.random.default_rng(7)
@@ -142,7 +143,7 @@ def _branch_q(robot, count, seed):
 
 @pytest.mark.parametrize("name", NAMES)
 def test_ik_recovers_branch_configurations(name):
-    robot = pr.get_robot(name)
+    robot = get_robot(name)
     q = _branch_q(robot, 2000, seed=3)
     assert len(q) > 500
     x = robot.fk(q)
@@ -155,7 +156,7 @@ def test_ik_recovers_branch_configurations(name):
 
 @pytest.mark.parametrize("name", NAMES)
 def test_fk_of_ik_over_random_reachable_points(name):
-    robot = pr.get_robot(name)
+    robot = get_robot(name)
     rng = np.random.default_rng(11)
     box = {  # (xy low, xy high, z low, z high) [m], larger than each workspace
         "anthropomorphic": (-0.8, 0.8, -0.5, 1.2),
@@ -177,9 +178,9 @@ def test_fk_of_ik_over_random_reachable_points(name):
 
 
 def test_scara_eq_24_printed_sign_is_wrong_and_fix_is_consistent():
-    # ERRATA seed 001: with theta2 = -arccos (eq. 25), eq. 24's "- arcsin" does not reproduce the
+    # Correction (docs/papers.md): with theta2 = -arccos (eq. 25), eq. 24's "- arcsin" does not reproduce the
     # point; "+ arcsin" does, and so does the other consistent pair (theta2 = +arccos, - arcsin).
-    robot = pr.get_robot("scara")
+    robot = get_robot("scara")
     x = np.array([0.52, 0.51, 0.265])
     B = x[0] ** 2 + x[1] ** 2
     C, D, E = 2 * robot.l1 * robot.l2, robot.l1**2 + robot.l2**2, 2 * robot.l1
@@ -223,8 +224,8 @@ UNREACHABLE = {
 
 @pytest.mark.parametrize("name", NAMES)
 def test_unreachable_points_raise_naming_index_and_reason(name):
-    robot = pr.get_robot(name)
-    good = pr.paper_loop_placement(name).M
+    robot = get_robot(name)
+    good = paper_loop_placement(name).M
     for bad, reason in UNREACHABLE[name]:
         points = np.array([good] * 6)
         points[3] = bad
@@ -240,27 +241,27 @@ def test_unreachable_points_raise_naming_index_and_reason(name):
 
 @pytest.mark.parametrize("name", ["anthropomorphic", "scara"])
 def test_paper_example_path_is_rejected(name):
-    # ERRATA seed 001: Table 1's path (z = 1 m) is 0.97-1.03 m from the anthropomorphic shoulder
+    # Correction (docs/papers.md): Table 1's path (z = 1 m) is 0.97-1.03 m from the anthropomorphic shoulder
     # (reach 0.78 m) and needs a SCARA stroke of -0.635 m.
-    p = pr.PAPER_LOOP
+    p = PAPER_LOOP
     plan = plan_loop_path(p["B"], p["M"], p["E"], p["v_max"], delta=p["delta"])
     times = np.linspace(0.0, plan.duration, 501)
     reason = {"anthropomorphic": "distance 0.974115 m from the shoulder .* exceeds the reach l2 \\+ l3 = 0.78 m",
               "scara": "negative stroke lambda3 = -0.635 m"}[name]
     with pytest.raises(ValueError, match=rf"sample 0 \(t = 0 s\) at \[0.5, 0.5, 1\] m .*{reason}.*501 of 501 samples"):
-        pr.get_robot(name).joint_trajectory(plan, times)
+        get_robot(name).joint_trajectory(plan, times)
     positions = plan.sample(times)[0]
     distance = np.linalg.norm(positions - [0.0, 0.0, 0.33], axis=1)
-    assert 0.974 < distance.min() and distance.max() < 1.032  # ERRATA rounds to 0.97-1.03 m
+    assert 0.974 < distance.min() and distance.max() < 1.032  # docs/papers.md rounds to 0.97-1.03 m
 
 
 def test_cartesian_runs_the_paper_example_path_unmoved():
-    p = pr.PAPER_LOOP
-    placement = pr.paper_loop_placement("cartesian")
+    p = PAPER_LOOP
+    placement = paper_loop_placement("cartesian")
     np.testing.assert_array_equal(placement.offset, 0.0)
     plan = plan_loop_path(p["B"], p["M"], p["E"], p["v_max"], delta=p["delta"])
     times = np.linspace(0.0, plan.duration, 501)
-    q, qd, qdd = pr.get_robot("cartesian").joint_trajectory(plan, times)
+    q, qd, qdd = get_robot("cartesian").joint_trajectory(plan, times)
     np.testing.assert_allclose(q[:, 0], 0.76, atol=1e-15)  # lambda1 = s_z - l2 (eq. 30), constant
     _, v, a = plan.sample(times)[:3]
     np.testing.assert_allclose(qd, np.column_stack([v[:, 2], v[:, 1], -v[:, 0]]), atol=1e-15)
@@ -269,9 +270,9 @@ def test_cartesian_runs_the_paper_example_path_unmoved():
 
 def test_joint_rates_refuse_singular_configurations():
     with pytest.raises(ValueError, match="point 1 .* Jacobian is singular"):
-        pr.get_robot("scara").joint_rates([[0.3, -1.0, 0.1], [0.3, 0.0, 0.1]], np.ones(3), np.zeros(3))
+        get_robot("scara").joint_rates([[0.3, -1.0, 0.1], [0.3, 0.0, 0.1]], np.ones(3), np.zeros(3))
     with pytest.raises(ValueError, match="point 0 .* Jacobian is singular"):
-        pr.get_robot("anthropomorphic").joint_rates([0.3, 0.2, 0.0], np.ones(3), np.zeros(3))
+        get_robot("anthropomorphic").joint_rates([0.3, 0.2, 0.0], np.ones(3), np.zeros(3))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -281,13 +282,13 @@ def test_joint_rates_refuse_singular_configurations():
 
 @pytest.mark.parametrize("name", NAMES)
 def test_placement_keeps_the_paper_shape(name):
-    placement = pr.paper_loop_placement(name)
+    placement = paper_loop_placement(name)
     for key in ("B", "M", "E"):
-        np.testing.assert_allclose(getattr(placement, key), np.array(pr.PAPER_LOOP[key]) + placement.offset, atol=0)
+        np.testing.assert_allclose(getattr(placement, key), np.array(PAPER_LOOP[key]) + placement.offset, atol=0)
     assert (placement.delta, placement.v_max) == (0.02, 0.25)
     assert placement.reason
     plan = placement.plan()
-    assert plan.duration == pytest.approx(0.81368, abs=1e-5)  # ERRATA t_e, shape unchanged
+    assert plan.duration == pytest.approx(0.81368, abs=1e-5)  # docs/papers.md t_e, shape unchanged
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -1,8 +1,8 @@
-"""Tests for the 4-DOF collaborative robot of seed 002 (Li, Zhang, Zhou 2019): DH kinematics
+"""Tests for the 4-DOF collaborative robot of Li et al. 2019 (Li, Zhang, Zhou): DH kinematics
 against Drake's MultibodyPlant (models/li_4dof.urdf), inverse kinematics, joint rates, reach
 checks, limits and the closed test path.
 
-OCR corrections (ERRATA seed 002): Table 3 printed "057" for 0.5 pi; Table 5 printed "0.757" for
+OCR corrections (docs/papers.md): Table 3 printed "057" for 0.5 pi; Table 5 printed "0.757" for
 0.75 pi, "0.257" / "1.257" for 0.25 pi / 1.25 pi, "25" for 2.5 rad/s and "15" for 1.5 rad/s^2.
 """
 
@@ -16,8 +16,9 @@ import pytest
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
-from drake_traj import li_robot
-from drake_traj.li_robot import LI_4DOF, li_closed_path
+from drake_traj.planners.li import system as li_system
+from drake_traj.planners.li.system import li_closed_path
+from drake_traj.robots import LI_4DOF
 
 PI = math.pi
 
@@ -64,8 +65,8 @@ def test_dh_table_and_limits_are_the_papers():
     np.testing.assert_array_equal(LI_4DOF.velocity_limits, [2.0, 2.5, 3.0, 3.0])
     np.testing.assert_array_equal(LI_4DOF.acceleration_limits, [1.0, 1.2, 1.5, 1.8])
     # Table 4.
-    assert li_robot.CARTESIAN_VELOCITY_LIMIT == 0.2
-    assert li_robot.CARTESIAN_ACCELERATION_LIMIT == 0.1
+    assert li_system.CARTESIAN_VELOCITY_LIMIT == 0.2
+    assert li_system.CARTESIAN_ACCELERATION_LIMIT == 0.1
 
 
 def test_initial_pose():
@@ -110,18 +111,15 @@ def test_plant_limits_equal_module(plant):
     np.testing.assert_array_equal(plant.GetAccelerationLowerLimits(), -LI_4DOF.acceleration_limits)
 
 
-def test_closed_loop_model_loads(plant):
-    from drake_traj.diagram import add_robot
-
-    model = li_robot.closed_loop_model()
+def test_robot_contract(plant):
+    model = LI_4DOF
     assert model.name == "li_4dof"
     assert model.num_joints == 4
-    assert model.joint_names == LI_4DOF.joint_names
-    np.testing.assert_array_equal(model.effort_limit, LI_4DOF.effort_limits)
+    np.testing.assert_array_equal(model.effort_limits, [40.0, 60.0, 30.0, 10.0])
     q = np.array([0.1, -0.9, 0.3, 0.6])
     np.testing.assert_allclose(model.tcp_pose(q), np.r_[LI_4DOF.fk(q), 0.0, 0.0, 0.0])
     other = MultibodyPlant(1e-3)
-    add_robot(other, model)
+    model.add_to_plant(other)
     other.Finalize()
     assert other.num_actuators() == 4
     assert other.num_positions() == 4

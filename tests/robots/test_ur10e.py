@@ -1,4 +1,4 @@
-"""drake_traj.robot: k(q), Z-Y-X Euler angles, the analytic Jacobian and dJ/dt qd.
+"""drake_traj.robots.ur10e: k(q), Z-Y-X Euler angles, the analytic Jacobian and dJ/dt qd.
 
 Checked against Drake's MultibodyPlant (geometric Jacobian, bias acceleration, RollPitchYaw)
 and against finite differences of k(q).
@@ -10,8 +10,8 @@ from pydrake.math import RollPitchYaw
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable
 
-from drake_traj import robot
-from drake_traj.diagram import add_ur10e
+from drake_traj.robots import ur10e as robot
+from drake_traj.robots import UR10E
 
 Q0 = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
 
@@ -19,7 +19,7 @@ Q0 = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np
 @pytest.fixture(scope="module")
 def plant_and_context():
     plant = MultibodyPlant(0.0)
-    add_ur10e(plant)
+    UR10E.add_to_plant(plant)
     plant.Finalize()
     return plant, plant.CreateDefaultContext()
 
@@ -30,9 +30,9 @@ def random_configurations(count, seed=0):
 
 
 def test_k_of_seed_000_start_is_p0():
-    # Seed 000 prints p0 = [-0.174, -0.524, 0.273, pi, 0, 3pi/4]; ur10e_facts.md gives the flange
+    # Pająk 2024 prints p0 = [-0.174, -0.524, 0.273, pi, 0, 3pi/4]; docs/ur10e.md gives the flange
     # at (-0.17415, -0.52400, 0.27270), itself rounded to 5 decimals (exact: y = -0.5239969,
-    # z = 0.2727031). phi_X comes out as +-pi (ERRATA): compare it wrapped.
+    # z = 0.2727031). phi_X comes out as +-pi (docs/papers.md): compare it wrapped.
     pose = robot.task_pose(Q0)
     np.testing.assert_allclose(pose[:3], [-0.17415, -0.52400, 0.27270], atol=5e-6)
     np.testing.assert_allclose(pose[:3], [-0.174, -0.524, 0.273], atol=5e-4)

@@ -3,7 +3,7 @@
 Round trips FK(IK(x)) = x over random configurations on all eight branches, nearest-solution
 selection, a circular Cartesian path on one branch, reach / singularity / shape errors, and an
 independent check against Drake: poses from MultibodyPlant's forward kinematics of models/ur10e.urdf
-and Drake's numerical InverseKinematics, so the closed form is not validated only by robot.py's FK.
+and Drake's numerical InverseKinematics, so the closed form is not validated only by the module's FK.
 """
 
 import numpy as np
@@ -13,10 +13,10 @@ from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.solvers import Solve
 
-from drake_traj import robot
-from drake_traj.diagram import add_ur10e
+from drake_traj.robots import ur10e as robot
+from drake_traj.robots import UR10E
 
-Q0 = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])  # seed 000 q(0)
+Q0 = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])  # Pająk 2024 q(0)
 TOL = 1e-9
 MIN_SINGULARITY_MEASURE = 0.05
 
@@ -289,7 +289,7 @@ def test_bad_arguments_raise_value_error():
 @pytest.fixture(scope="module")
 def drake_ur10e():
     plant = MultibodyPlant(time_step=0.0)
-    add_ur10e(plant)
+    UR10E.add_to_plant(plant)
     plant.Finalize()
     return plant
 

@@ -1,4 +1,4 @@
-"""models/ur10e.urdf: kinematics, inertials, limits, actuators and shapes against ur10e_facts.md.
+"""models/ur10e.urdf: kinematics, inertials, limits, actuators and shapes against docs/ur10e.md.
 
 The model is checked against numbers that do not come from Drake: robot.dh_frames (UR's standard DH
 table) for the kinematics, the published mass / CoM / inertia table for the inertials, and gravity
@@ -16,9 +16,10 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import JointActuatorIndex
 from pydrake.systems.framework import DiagramBuilder
 
-from drake_traj import robot
+from drake_traj.robots import base as robot_base
+from drake_traj.robots import ur10e as robot
 
-MODEL_FILE = Path(__file__).resolve().parents[1] / "models" / "ur10e.urdf"
+MODEL_FILE = Path(__file__).resolve().parents[2] / "models" / "ur10e.urdf"
 LINK_NAMES = (
     "shoulder_link",
     "upper_arm_link",
@@ -29,10 +30,10 @@ LINK_NAMES = (
 )
 GRAVITY = 9.81  # [m/s^2], Drake's default gravity field is (0, 0, -9.81)
 
-# Seed 000's start configuration q(0) and the paper's p0 (printed rounded to [-0.174, -0.524, 0.273]).
+# Pająk 2024's start configuration q(0) and the paper's p0 (printed rounded to [-0.174, -0.524, 0.273]).
 Q0 = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
 
-# Published dynamics (ur10e_facts.md), link i in standard-DH frame i.
+# Published dynamics (docs/ur10e.md), link i in standard-DH frame i.
 COM_IN_DH_FRAME = np.array(
     [
         [0.021, 0.0, 0.027],
@@ -323,7 +324,7 @@ def test_13_model_path_points_at_the_shipped_file():
 
 
 def test_14_model_path_reports_a_missing_file(monkeypatch, tmp_path):
-    monkeypatch.setattr(robot, "resources", SimpleNamespace(files=lambda package: tmp_path))
+    monkeypatch.setattr(robot_base, "resources", SimpleNamespace(files=lambda package: tmp_path))
     with pytest.raises(ValueError, match="ur10e.urdf") as info:
         robot.model_path()
     assert str(tmp_path / "ur10e.urdf") in str(info.value)

@@ -1,6 +1,6 @@
-"""UR-style "MoveJ" with radius blending: the baseline of seed 000's experiment 1.
+"""UR-style "MoveJ" with radius blending: the baseline of Pająk 2024's experiment 1.
 
-Seed 000 (Pająk 2024), experiment 1, ran its task on the real UR10e with the controller's own
+Pająk 2024, experiment 1, ran its task on the real UR10e with the controller's own
 "MoveJ" command between the waypoints, with the default joint limits 1.05 rad/s and 1.40 rad/s^2
 and "radius blending" of 0.05 m around each waypoint so the robot does not stop there. The paper
 reports that the controller respects the acceleration limit between the waypoints but exceeds it
@@ -18,7 +18,7 @@ UR's own description of MoveJ and of blending:
    acceleration limit, the others are scaled to finish together"; with per-joint limits the
    constraining joint reaches its limit and no joint exceeds its own.
 2. Blends. With radius r > 0, around every intermediate waypoint q_k (0 < k < m) the next segment
-   starts before the current one ends, while the TCP (here: the flange origin, as in seed 000) is
+   starts before the current one ends, while the TCP (here: the flange origin, as in Pająk 2024) is
    within r of the waypoint's TCP position p_k. On segment k-1 the TCP enters the sphere at local
    time tau_in (last time with |p(q) - p_k| = r, found by FK sampling and bisection); on segment k
    it leaves the sphere at tau_out (first such time). The overlap lasts
@@ -41,15 +41,14 @@ more raises ValueError.
 Consecutive identical waypoints are dropped (no zero-length segments).
 """
 
-from __future__ import annotations
-
 from bisect import bisect_right
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from drake_traj import robot
-from drake_traj.planners.base import TimeLawPlanner
-from drake_traj.validation import positive_vector
+from drake_traj.planners.base import TimeLawPlanner, start_and_goals
+from drake_traj.robots import UR10E, Robot
+from drake_traj.validation import limit_or_default, positive_vector
 
 __all__ = [
     "MovejBlendLaw",
@@ -60,10 +59,6 @@ __all__ = [
 
 _SAMPLES_PER_SEGMENT = 200  # FK samples for locating the sphere crossings (then bisection)
 _BISECTION_STEPS = 60
-
-
-def _flange_position(q) -> np.ndarray:
-    return robot.flange_pose(q)[:3, 3]
 
 
 def trapezoid_profile(tau, ta: float, duration: float, accel: float):
@@ -135,9 +130,9 @@ class MovejBlendLaw:
             raise ValueError(f"blend_radius must be finite and >= 0 [m], got {blend_radius}")
         self.blend_radius = radius
         if tcp_position is None:
-            if radius > 0.0 and n != robot.NUM_JOINTS:
+            if radius > 0.0 and n != UR10E.num_joints:
                 raise ValueError(f"tcp_position is required for blending with n = {n} joints (the default is the UR10e flange)")
-            tcp_position = _flange_position
+            tcp_position = UR10E.tool_position
         self._tcp = tcp_position
 
         keep = np.concatenate([[True], np.any(np.diff(waypoints, axis=0) != 0.0, axis=1)])
@@ -296,21 +291,6 @@ class MovejBlendLaw:
         return np.array([self._tcp(q) for q in self.q_waypoints])
 
 
-def paper_task_joint_waypoints() -> np.ndarray:
-    """Joint waypoints of seed 000's task: q(0), then IK of p1, p2, p3, p_f, each near the previous.
-
-    q(0) = [-pi/2, -pi/2, -3pi/4, -pi/4, pi/2, pi/4]; shape (5, 6) [rad].
-    """
-    from drake_traj.planners.pajak import paper_initial_configuration, paper_parameters
-
-    q = paper_initial_configuration()
-    waypoints = [q]
-    for pose in paper_parameters().waypoints:
-        q = robot.inverse_kinematics(pose, near=q)
-        waypoints.append(q)
-    return np.array(waypoints)
-
-
 class MovejPlanner(TimeLawPlanner):
     """Planner system for a :class:`MovejBlendLaw` (UR MoveJ baseline, see the module doc).
 
@@ -321,13 +301,46 @@ class MovejPlanner(TimeLawPlanner):
         law: the MoveJ time law.
         speed_cap: the largest clock rate c, in (0, 1].
         update_period: how often the speed override is read [s].
+        robot: the robot (for the tool positions at the waypoints).
     """
 
-    def __init__(self, law: MovejBlendLaw, *, speed_cap: float = 1.0, update_period: float = 0.01):
+    def __init__(self, law: MovejBlendLaw, *, speed_cap: float = 1.0, update_period: float = 0.01,
+                 robot: Robot = UR10E):
         if not isinstance(law, MovejBlendLaw):
             raise ValueError(f"law must be a MovejBlendLaw, got {type(law).__name__}")
         super().__init__(law, law.velocity_limit, law.acceleration_limit, speed_cap=speed_cap, update_period=update_period)
+        self.robot = robot
 
     def task_waypoints(self) -> np.ndarray:
-        """Flange positions at the goal waypoints q_1..q_m [m], shape (m, 3)."""
-        return np.array([robot.flange_pose(q)[:3, 3] for q in self.law.q_waypoints[1:]])
+        """Tool positions at the goal waypoints q_1..q_m [m], shape (m, 3)."""
+        return self.robot.tool_position(self.law.q_waypoints[1:])
+
+
+@dataclass
+class MovejConfig:
+    """The UR-style MoveJ baseline through joint goals: the scenario's ``planner: !MovejConfig``.
+
+    Attributes:
+        goals: joint waypoints after the start [rad], one row of n per waypoint.
+        blend_radius: r [m] around every intermediate waypoint's tool position; 0 stops at each.
+        velocity_limit, acceleration_limit: per joint; empty: the robot's joint-move limits.
+    """
+
+    goals: list[list[float]] = field(default_factory=list)
+    blend_radius: float = 0.0
+    velocity_limit: list[float] = field(default_factory=list)
+    acceleration_limit: list[float] = field(default_factory=list)
+
+
+def make(config: MovejConfig, robot: Robot, q_initial) -> MovejPlanner:
+    """The baseline of ``config`` on ``robot`` from ``q_initial``."""
+    default_velocity, default_acceleration = robot.joint_move_limits
+    n = robot.num_joints
+    law = MovejBlendLaw(
+        start_and_goals(q_initial, config.goals, n),
+        limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", n),
+        limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit", n),
+        config.blend_radius,
+        tcp_position=robot.tool_position,
+    )
+    return MovejPlanner(law, robot=robot)

@@ -22,16 +22,15 @@ with every joint's (qd, qdd, jerk) at each knot: one bisect plus a few (n,) nump
 about 5 us per call.
 """
 
-from __future__ import annotations
-
 from bisect import bisect_right
+from dataclasses import dataclass, field
 
 import numpy as np
 import ruckig
 
-from drake_traj import robot
-from drake_traj.planners.base import TimeLawPlanner
-from drake_traj.validation import positive_vector
+from drake_traj.planners.base import TimeLawPlanner, start_and_goals
+from drake_traj.robots import UR10E, Robot
+from drake_traj.validation import limit_or_default, positive_vector
 
 __all__ = ["DEFAULT_JERK_FACTOR", "RuckigPlanner", "RuckigStopLaw", "default_jerk_limit"]
 
@@ -219,9 +218,11 @@ class RuckigPlanner(TimeLawPlanner):
     Args:
         law: the Ruckig time law.
         speed_cap, update_period: as in :class:`TimeLawPlanner`.
+        robot: the robot (for the tool positions at the waypoints).
     """
 
-    def __init__(self, law: RuckigStopLaw, *, speed_cap: float = 1.0, update_period: float = 0.01):
+    def __init__(self, law: RuckigStopLaw, *, speed_cap: float = 1.0, update_period: float = 0.01,
+                 robot: Robot = UR10E):
         super().__init__(
             law,
             law.velocity_limit,
@@ -229,7 +230,39 @@ class RuckigPlanner(TimeLawPlanner):
             speed_cap=speed_cap,
             update_period=update_period,
         )
+        self.robot = robot
 
     def task_waypoints(self) -> np.ndarray:
-        """Flange positions [m] at the waypoints q_1..q_m (the goals), shape (m, 3)."""
-        return np.array([robot.flange_pose(q)[:3, 3] for q in self.law.q_waypoints[1:]])
+        """Tool positions [m] at the waypoints q_1..q_m (the goals), shape (m, 3)."""
+        return self.robot.tool_position(self.law.q_waypoints[1:])
+
+
+@dataclass
+class RuckigConfig:
+    """The Ruckig baseline, jerk-limited moves through joint goals with a stop at each: the
+    scenario's ``planner: !RuckigConfig`` entry.
+
+    Attributes:
+        goals: joint waypoints after the start [rad], one row of n per waypoint.
+        velocity_limit, acceleration_limit: per joint; empty: the robot's joint-move limits.
+        jerk_limit: per joint [rad/s^3]; empty: :func:`default_jerk_limit` of the acceleration limit.
+    """
+
+    goals: list[list[float]] = field(default_factory=list)
+    velocity_limit: list[float] = field(default_factory=list)
+    acceleration_limit: list[float] = field(default_factory=list)
+    jerk_limit: list[float] = field(default_factory=list)
+
+
+def make(config: RuckigConfig, robot: Robot, q_initial) -> RuckigPlanner:
+    """The baseline of ``config`` on ``robot`` from ``q_initial``."""
+    default_velocity, default_acceleration = robot.joint_move_limits
+    n = robot.num_joints
+    acceleration = limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit", n)
+    law = RuckigStopLaw(
+        start_and_goals(q_initial, config.goals, n),
+        limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", n),
+        acceleration,
+        limit_or_default(config.jerk_limit, default_jerk_limit(acceleration), "jerk_limit", n),
+    )
+    return RuckigPlanner(law, robot=robot)

@@ -25,8 +25,7 @@ has continuous q''; its weakness (overshoot between unevenly spaced or noisy kno
 decimating the samples to knots roughly evenly spaced in arc length, on a dense, smooth log.
 """
 
-from __future__ import annotations
-
+from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.multibody.optimization import CalcGridPointsOptions, Toppra, ToppraDiscretization
@@ -34,8 +33,9 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import RevoluteJoint, SpatialInertia, UnitInertia
 from pydrake.trajectories import PathParameterizedTrajectory, PiecewisePolynomial
 
-from drake_traj.planners.base import TimeLawPlanner
-from drake_traj.validation import positive_vector
+from drake_traj.planners.base import TimeLawPlanner, start_and_goals
+from drake_traj.robots import Robot
+from drake_traj.validation import limit_or_default, positive_vector
 
 __all__ = [
     "ToppraLaw",
@@ -287,3 +287,32 @@ class ToppraPlanner(TimeLawPlanner):
             speed_cap=speed_cap,
             update_period=update_period,
         )
+
+
+@dataclass
+class ToppraConfig:
+    """The time-optimal baseline along a joint path (Drake's Toppra): the scenario's
+    ``planner: !ToppraConfig`` entry.
+
+    Attributes:
+        path: joint samples after the start [rad], one row of n per sample, dense enough to
+            define the path (:func:`geometric_path_from_samples` smooths and decimates them).
+        velocity_limit, acceleration_limit: per joint; empty: the robot's joint-move limits.
+        grid_points: Toppra grid points evenly spaced in arc length; 0: Drake's CalcGridPoints.
+    """
+
+    path: list[list[float]] = field(default_factory=list)
+    velocity_limit: list[float] = field(default_factory=list)
+    acceleration_limit: list[float] = field(default_factory=list)
+    grid_points: int = 0
+
+
+def make(config: ToppraConfig, robot: Robot, q_initial) -> ToppraPlanner:
+    """The baseline of ``config`` on ``robot``: time-optimal along the path from ``q_initial``."""
+    default_velocity, default_acceleration = robot.joint_move_limits
+    n = robot.num_joints
+    velocity = limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", n)
+    acceleration = limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit", n)
+    path = geometric_path_from_samples(start_and_goals(q_initial, config.path, n))
+    _, trajectory = time_optimal_along_path(path, velocity, acceleration, grid_points=config.grid_points or None)
+    return ToppraPlanner(ToppraLaw(trajectory), velocity, acceleration)

@@ -1,6 +1,6 @@
-"""Velocity look-ahead and cubic ACC/DEC along a Cartesian polyline (seed 002, Li, Zhang, Zhou).
+"""Velocity look-ahead and cubic ACC/DEC along a Cartesian polyline (Li et al. 2019, Li, Zhang, Zhou).
 
-Seed 002 (Li, Zhang, Zhou 2019: "Trajectory planning of high precision collaborative robots") plans
+Li et al. 2019 (Li, Zhang, Zhou: "Trajectory planning of high precision collaborative robots") plans
 the tool path in Cartesian space first, then re-times the joints and fits a quintic B-spline. This
 module is the Cartesian stage only (section 2):
 
@@ -12,7 +12,7 @@ module is the Cartesian stage only (section 2):
    of seven cases;
 4. the whole path: the segment profiles laid end to end, sampled densely in time.
 
-Equation numbers in comments are the paper's. The OCR text has errors; the project ERRATA (seed 002)
+Equation numbers in comments are the paper's. The OCR text has errors; the corrections in docs/papers.md
 is followed and wins where they differ:
 
 - eq. 3 and 6 are indexed one off: the direction change at P_i is from P_{i-1}P_i to P_iP_{i+1};
@@ -21,7 +21,7 @@ is followed and wins where they differ:
 - eq. 8-10 and 13 use the average ACC/DEC acceleration A = (2/3) a_m of eq. 12, not a_m: the cubic
   ramp's peak acceleration is 1.5 times its average, so with A = (2/3) a_m the peak is exactly a_m;
 - eq. 13: L_e = (2 V_m^2 - V_s^2 - V_e^2) / (2A), V_a = sqrt((2 A L + V_s^2 + V_e^2) / 2);
-- the seven cases and their times are the ERRATA's list (see :class:`AccDecCase`).
+- the seven cases and their times are the list of docs/papers.md (see :class:`AccDecCase`).
 
 Everything here is plain numpy; tests call the functions directly. Units: metres, seconds.
 """
@@ -138,7 +138,7 @@ def break_point_geometry(points, step_length: float | None = None) -> BreakPoint
     The velocity change at P_i (eq. 2-3) is |v_i| times the change of the direction cosines
     (cos theta_x, cos theta_y, cos theta_z) from P_{i-1}P_i to P_iP_{i+1}; those cosines are the
     components of the unit direction u, so K_i (eq. 6) = |u_{i+1} - u_i| = 2 sin(phi_i / 2) with
-    phi_i the turning angle. (The paper indexes eq. 3 and 6 one off; ERRATA.)
+    phi_i the turning angle. (The paper indexes eq. 3 and 6 one off; docs/papers.md.)
 
     Args:
         points: P_0 ... P_n [m], shape (n + 1, 3), n >= 1; consecutive points must differ.
@@ -172,7 +172,7 @@ def break_point_limits(points, v_max: float, a_max: float, step_length: float | 
     """Maximum permissible speed v_i at each point of a polyline (eq. 4-7, corrected).
 
     Passing P_i at speed v turns the velocity by dv_i = v K_i (eq. 2-3) while covering dl_i, i.e.
-    in dt_i = dl_i / v; eq. 1 asks dv_i / dt_i <= a_m, so (eq. 4, ERRATA)
+    in dt_i = dl_i / v; eq. 1 asks dv_i / dt_i <= a_m, so (eq. 4, docs/papers.md)
 
         v_i = min{v_m, sqrt(a_m dl_i / K_i)},    dl_i = min{l_step, l_i},
 
@@ -251,7 +251,7 @@ def look_ahead(limits, lengths, a_max: float) -> np.ndarray:
         limits: upper bounds on the speed at P_0 ... P_n [m/s], >= 0, shape (n + 1,) (from
             :func:`break_point_limits`: v_0 = v_n = 0).
         lengths: l_1 ... l_n [m], > 0, shape (n,).
-        a_max: a_m [m/s^2], > 0; the look-ahead uses A = (2/3) a_m (eq. 12, ERRATA).
+        a_max: a_m [m/s^2], > 0; the look-ahead uses A = (2/3) a_m (eq. 12, docs/papers.md).
 
     Returns:
         The adjusted speeds [m/s], shape (n + 1,): v_i <= limits_i and
@@ -300,7 +300,7 @@ def forward_backward_pass(limits, lengths, a_max: float) -> np.ndarray:
 
 
 class AccDecCase(IntEnum):
-    """The seven velocity profiles of Fig. 3 / Table 1 (numbering and times per ERRATA).
+    """The seven velocity profiles of Fig. 3 / Table 1 (numbering and times as corrected in docs/papers.md).
 
     With A = (2/3) a_m, L_min = |V_e^2 - V_s^2| / (2A) and L_e, V_a from eq. 13:
 
@@ -487,7 +487,7 @@ def acc_dec_profile(length, v_start, v_end, v_max, a_max) -> AccDecProfile:
 
     Classifies the segment (Table 1, :func:`classify_acc_dec`) and sets the phases so that every
     ramp has the average acceleration A = (2/3) a_m (eq. 12) and so peaks at a_m, and the total
-    time is Table 2's (ERRATA). Cases II and III (L = L_min to 1e-9) use T = 2 L / (V_s + V_e),
+    time is Table 2's (docs/papers.md). Cases II and III (L = L_min to 1e-9) use T = 2 L / (V_s + V_e),
     which equals (V_e - V_s) / A there and makes the distance covered exactly L.
 
     Args:
@@ -563,7 +563,7 @@ class CartesianSample:
 
 @dataclass(frozen=True, eq=False)
 class CartesianPlan:
-    """The Cartesian time law of seed 002 section 2: a polyline with one ACC/DEC law per segment.
+    """The Cartesian time law of Li et al. 2019 section 2: a polyline with one ACC/DEC law per segment.
 
     Built by :func:`plan_cartesian_path`. Segment k runs from P_k to P_{k+1}, from time
     ``t_starts[k]`` for ``profiles[k].duration``, from speed ``velocities[k]`` to
@@ -667,7 +667,7 @@ class CartesianPlan:
 def plan_cartesian_path(
     points, v_max: float, a_max: float, step_length: float | None = None
 ) -> CartesianPlan:
-    """Seed 002's Cartesian stage: limits (eq. 4-7), look-ahead (Fig. 2), ACC/DEC (eq. 11-13).
+    """Li et al. 2019's Cartesian stage: limits (eq. 4-7), look-ahead (Fig. 2), ACC/DEC (eq. 11-13).
 
     The tool starts and stops at rest, moves straight from point to point, never exceeds v_max,
     and its tangential acceleration peaks at a_max on every ramp (average A = (2/3) a_max).

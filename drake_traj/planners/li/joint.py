@@ -1,6 +1,6 @@
-"""Joint-space stage of seed 002 (Li, Zhang, Zhou 2019): re-timing, quintic B-spline, limit repair.
+"""Joint-space stage of Li et al. 2019 (Li, Zhang, Zhou): re-timing, quintic B-spline, limit repair.
 
-Seed 002 plans the tool path in Cartesian space first (:mod:`drake_traj.planners.li_lookahead`),
+Li et al. 2019 plans the tool path in Cartesian space first (:mod:`drake_traj.planners.li_lookahead`),
 maps the discrete path points to joint space by inverse kinematics, and then (section 3):
 
 1. re-times the joint samples (section 3.1, eq. 14): each interval gets the time the slowest
@@ -10,7 +10,7 @@ maps the discrete path points to joint space by inverse kinematics, and then (se
 
 The functions here are that stage, generic over the robot: inputs are joint samples q (N, n) and
 their times, so any inverse kinematics can feed them. Equation numbers are the paper's; the
-project ERRATA (seed 002) is followed where it differs from the OCR text:
+corrections in docs/papers.md are followed where it differs from the OCR text:
 
 - eq. 22 omits the chain-rule factor of the time normalisation u = (t - t_0) / (t_n - t_0), and its
   end index is the last control point. scipy's ``make_interp_spline(k=5)`` with first and second
@@ -32,8 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
-from drake_traj.planners.base import TimeLawPlanner
-from drake_traj.planners.li_lookahead import acc_dec_profile, plan_cartesian_path
+from drake_traj.planners.li.cartesian import acc_dec_profile, plan_cartesian_path
 
 __all__ = [
     "JointSplineLaw",
@@ -153,7 +152,7 @@ def joint_interval_times(times, q, velocity_limit, acceleration_limit) -> np.nda
       samples are break points and their speeds are lowered by the look-ahead of Fig. 2 (eq. 9-10)
       with A = (2/3) alpha_m and segment lengths |q_{i+1,j} - q_ij| (one forward and one backward
       pass, which gives the same speeds as the paper's multi-pass walk);
-    - Delta T_ij is the cubic ACC/DEC time of Table 2 (ERRATA's seven cases, V_m = omega_m,
+    - Delta T_ij is the cubic ACC/DEC time of Table 2 (the seven cases of docs/papers.md, V_m = omega_m,
       A = (2/3) alpha_m) from the start to the end speed over that length
       (:func:`drake_traj.planners.li_lookahead.acc_dec_profile`); 0 for a joint that does not move.
 
@@ -196,7 +195,7 @@ def retime_joint_samples(
     The paper (eq. 14) sets each interval to the time of its slowest joint,
     max{Delta T_i1, ..., Delta T_ip} (:func:`joint_interval_times`), and drops the Cartesian times.
     That can make an interval shorter than the Cartesian plan's, which runs the tool over its
-    Cartesian speed limit (ERRATA). With ``keep_input_times`` (default) each interval is
+    Cartesian speed limit (docs/papers.md). With ``keep_input_times`` (default) each interval is
     max(original interval, max_j Delta T_ij): never faster than the Cartesian plan, and never
     faster than any joint allows. With ``keep_input_times=False`` the paper's eq. 14 as printed.
 
@@ -238,7 +237,7 @@ def fit_quintic_spline(times, q) -> BSpline:
     Eq. 18-19: interpolate (t_i, q_i); eq. 22: first and second derivatives zero at t_0 and t_N
     (the 4 = 2 (k - 1) extra equations); eq. 17: knots at the sample times, multiplicity k + 1 = 6
     at the ends. ``scipy.interpolate.make_interp_spline`` with these end conditions solves the same
-    banded system (ERRATA), in time units directly (the chain-rule factor of the paper's
+    banded system (docs/papers.md), in time units directly (the chain-rule factor of the paper's
     normalisation u in [0, 1] is not needed).
 
     Args:
@@ -734,7 +733,7 @@ def repair_time_stretch(
 
 @dataclass(frozen=True)
 class LiPlan:
-    """All stages of one seed-002 plan.
+    """All stages of one Li et al. 2019 plan.
 
     Attributes:
         cartesian: the Cartesian stage (look-ahead and ACC/DEC on the tool path).
@@ -768,7 +767,7 @@ def tool_speed_and_acceleration(law: JointSplineLaw, tool_motion, samples_per_in
 
 def plan_li_path(points, ik, tool_motion, velocity_limit, acceleration_limit, tool_velocity_limit,
                  tool_acceleration_limit) -> LiPlan:
-    """Seed 002 end to end, with the joint and the tool limits kept.
+    """Li et al. 2019 end to end, with the joint and the tool limits kept.
 
     1. Cartesian stage on ``points`` (N,3) [m] with the tool limits (eq. 1-13, Fig. 2);
     2. ``ik(points) -> q (N, n)`` at the path points, timed by the Cartesian stage;
@@ -776,7 +775,7 @@ def plan_li_path(points, ik, tool_motion, velocity_limit, acceleration_limit, to
        (:func:`repair_time_stretch`, exact joint peaks);
     4. the tool limits through ``tool_motion`` (FK rates) on TOOL_SAMPLES_PER_INTERVAL samples per
        knot interval, with TOOL_LIMIT_MARGIN: the
-       spline can run the tool too fast (ERRATA), so the whole motion is stretched uniformly by
+       spline can run the tool too fast (docs/papers.md), so the whole motion is stretched uniformly by
        k = max(peak speed / limit, sqrt(peak |a| / limit)), which scales tool speed by 1/k and
        acceleration by 1/k^2 and only lowers the joint rates. (Stretching only the offending
        intervals and refitting was tried: the uneven knots made the spline oscillate more and the
@@ -792,63 +791,3 @@ def plan_li_path(points, ik, tool_motion, velocity_limit, acceleration_limit, to
     if stretch > 1.0:
         law = JointSplineLaw(law.knot_times * stretch, law.samples)
     return LiPlan(cartesian, law, report, stretch)
-
-
-class LiPathPlanner(TimeLawPlanner):
-    """Seed 002's planner under the contract: follows :attr:`LiPlan.law` on the scaled clock.
-
-    Args:
-        plan: from :func:`plan_li_path`.
-        velocity_limit, acceleration_limit: the joint limits the plan keeps.
-        tool_motion: the robot's FK rates, for the tool speed figure.
-        tool_limits: (speed [m/s], acceleration [m/s^2]) of the tool.
-    """
-
-    def __init__(self, plan: LiPlan, velocity_limit, acceleration_limit, tool_motion, tool_limits):
-        super().__init__(plan.law, velocity_limit, acceleration_limit)
-        self.li_plan = plan
-        self._tool_motion = tool_motion
-        self.tool_limits = tool_limits
-
-    def tool_statistics(self) -> dict:
-        """Tool speed and acceleration peaks and the share of time above 0.5 and 0.8 a_max
-        (the paper's efficiency figure), on dense samples."""
-        t, speed, acceleration = tool_speed_and_acceleration(self.law, self._tool_motion)
-        v_max, a_max = self.tool_limits
-        weights = np.gradient(t)
-        return {
-            "peak_speed": float(speed.max()),
-            "peak_acceleration": float(acceleration.max()),
-            "share_above_half_a_max": float(weights[acceleration > 0.5 * a_max].sum() / t[-1]),
-            "share_above_0.8_a_max": float(weights[acceleration > 0.8 * a_max].sum() / t[-1]),
-        }
-
-    def figures(self) -> dict:
-        from matplotlib.figure import Figure
-
-        cartesian = self.li_plan.cartesian
-        figure = Figure(figsize=(9, 8), layout="constrained")
-        path_ax, speed_ax, accel_ax = figure.subplots(3, 1)
-        length = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(cartesian.points, axis=0), axis=1))])
-        path_ax.plot(1e3 * length, 1e3 * cartesian.limits, label="break-point limit (eq. 4-7)")
-        path_ax.plot(1e3 * length, 1e3 * cartesian.velocities, label="after look-ahead (Fig. 2)")
-        path_ax.set_xlabel("path length [mm]")
-        path_ax.set_ylabel("speed [mm/s]")
-        t, speed, acceleration = tool_speed_and_acceleration(self.law, self._tool_motion)
-        v_max, a_max = self.tool_limits
-        speed_ax.plot(t, 1e3 * speed)
-        speed_ax.axhline(1e3 * v_max, color="grey", linestyle="--")
-        speed_ax.set_ylabel("tool speed [mm/s]")
-        accel_ax.plot(t, 1e3 * acceleration)
-        for level, style in ((1.0, "--"), (0.8, ":"), (0.5, ":")):
-            accel_ax.axhline(1e3 * level * a_max, color="grey", linestyle=style)
-        stats = self.tool_statistics()
-        accel_ax.set_title(
-            f"time above 0.5 a_max: {stats['share_above_half_a_max']:.1%}, "
-            f"above 0.8 a_max: {stats['share_above_0.8_a_max']:.1%}", fontsize="small")
-        accel_ax.set_ylabel("tool |a| [mm/s$^2$]")
-        accel_ax.set_xlabel("t [s] (executed motion)")
-        for ax in (path_ax, speed_ax, accel_ax):
-            ax.grid(True, alpha=0.3)
-        path_ax.legend(fontsize="small")
-        return {"tool_speed": figure}

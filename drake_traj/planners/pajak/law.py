@@ -1,4 +1,4 @@
-"""Acceleration-level planning law of seed 000 (Pająk 2024), as plain numpy.
+"""Acceleration-level planning law of Pająk 2024, as plain numpy.
 
 The paper plans the joint trajectory of a 6-DOF arm by integrating a joint acceleration law:
 the task-space error e = k(q) - p (eq. 6) is driven by e'' + Λ_V e' + Λ_P e = 0 (eq. 9), which
@@ -13,7 +13,7 @@ This module is the law only: a LeafSystem (continuous state [q; q̇], discrete s
 update. :func:`integrate` is a small fixed-step RK4 loop for tests and benchmarks, and
 :func:`integrate_many` runs many tasks at once (vectorised over tasks).
 
-Corrections and readings (``/work/shared/ERRATA.md``, seed 000):
+Corrections and readings (``docs/papers.md``, Pająk 2024):
 
 - the orientation error is wrapped to (-π, π];
 - cases (2) and (4) of the scaling choice use q̈_min (the paper prints q̈_max), and ĉ is chosen
@@ -27,12 +27,12 @@ Corrections and readings (``/work/shared/ERRATA.md``, seed 000):
   task is 1.2-1.35 ϵ). It grows whenever the TCP moves, so the target always leads; the literal
   1 - δ/ϵ is not monotone and a projection on p_i -> p_{i+1} does not grow while the TCP still
   heads for p_i: both stall inside the first ball.
-- the kinematics (k(q), the analytic J and J̇q̇) are the same as ``drake_traj.robot`` (checked
+- the kinematics (k(q), the analytic J and J̇q̇) are the same as ``drake_traj.robots.ur10e`` (checked
   by the tests to 1e-9) written in closed form, ~20x faster (acceleration() is called 3-4
   times per simulated millisecond).
 
-Improvements over the literal method (each a flag of :class:`PajakParameters`, default on; all
-off gives the paper's method as printed, with the ERRATA corrections):
+Improvements over the literal method (each a flag of :class:`PajakConfig`, default on; all
+off gives the paper's method as printed, with the corrections of docs/papers.md):
 
 1. ``smooth_penalty`` / ``continuous_switching``: q̈ continuous after t = 0. The penalty minus
    its tangent at the threshold has zero slope there (the literal q̈ jumps by ρ/(R ϑ²) = 1.43
@@ -71,36 +71,28 @@ off gives the paper's method as printed, with the ERRATA corrections):
 Equation numbers in comments are the paper's.
 """
 
+
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields
 
 import numpy as np
 
-from drake_traj import robot
-from drake_traj.planners.base import PlannerSystem
+from drake_traj.errors import PlanningError
+from drake_traj.planners.pajak.parameters import PajakConfig
 from drake_traj.planners.scaling import relaxed_scaling
-from drake_traj.validation import positive_vector
+from drake_traj.robots import ur10e as robot
 
 __all__ = [
     "DISCRETE_NAMES",
     "DISCRETE_SIZE",
     "PajakLaw",
-    "PajakParameters",
-    "PajakPlanner",
-    "PAPER_METHOD",
-    "PlanningError",
     "acceleration_terms",
     "approach_damping",
     "blend_progress",
     "blended_target",
     "choose_scaling",
     "damping_factor",
-    "integrate",
-    "integrate_many",
-    "paper_parameters",
-    "paper_initial_configuration",
     "scaling_interval",
     "velocity_penalty",
 ]
@@ -125,202 +117,11 @@ DISCRETE_NAMES = (
     "t_best", "saturated",
 )
 
-# The improvement flags of PajakParameters switched off: the paper's method as printed, with the
-# ERRATA corrections (used for the Table 2 reproduction and to show what each improvement fixes).
-PAPER_METHOD = dict(
-    smooth_penalty=False,
-    continuous_switching=False,
-    bounded_scaling=False,
-    damped_inverse=False,
-    preserve_damping=False,
-)
-
-# UR10e geometry (standard DH, robot.py).
-_D1 = float(robot.DH_D[0])
-SHOULDER = np.array([0.0, 0.0, _D1])  # shoulder point (joint-2 axis on the base axis) [m]
-REACH = 1.3  # [m], UR10e reach from the shoulder (ur10e_facts.md)
 _ORIENTATION_LENGTH = 0.1  # [m/rad], weight of orientation in the progress measure
 _MIN_COS_PITCH = 1e-6  # Euler gimbal lock (as robot.analytic_jacobian_and_bias)
 _BRAKE_TIME = 0.05  # [s], time constant of the fallback braking at low speed (improvement 2)
 _BRAKE_GAP = 0.1  # emptiness of the c interval at which the fallback is pure braking
 
-
-class PlanningError(ValueError):
-    """The planner cannot complete the task: names the time, configuration and cause.
-
-    Attributes:
-        time: simulation time [s] (None if not known).
-        configuration: q [rad] at that time (None if not known).
-        cause: short machine-readable cause ("stall", "singular", "non-finite", "timeout", ...).
-        partial: what was computed before the failure (dict of arrays, set by :func:`integrate`).
-    """
-
-    def __init__(self, message: str, *, time=None, configuration=None, cause: str = "", partial=None):
-        where = ""
-        if time is not None:
-            where = f"at t = {float(time):.4f} s"
-        if configuration is not None:
-            where += f"{', ' if where else 'at '}q = {np.round(np.asarray(configuration, float), 4).tolist()}"
-        super().__init__(f"{message} ({where})" if where else message)
-        self.time = time
-        self.configuration = None if configuration is None else np.array(configuration, dtype=float)
-        self.cause = cause
-        self.partial = partial
-
-
-# --------------------------------------------------------------------------------------------
-# Parameters
-# --------------------------------------------------------------------------------------------
-
-
-@dataclass
-class PajakParameters:
-    """Parameters of the planning law (seed 000, section "Model and task of the manipulator").
-
-    Attributes:
-        waypoints: (w, 6) task poses p_1..p_w [x, y, z, φ_X, φ_Y, φ_Z] [m, rad]; p_w is p_f.
-        position_gain: Λ_P (scalar or 6 values) [1/s²], eq. 9.
-        velocity_gain: Λ_V (scalar or 6 values) [1/s], eq. 9.
-        velocity_limit: q̇_max = -q̇_min (scalar or 6) [rad/s], eq. 4.
-        acceleration_limit: q̈_max = -q̈_min (scalar or 6) [rad/s²], eq. 5.
-        vartheta: ϑ, penalty threshold on the normalised distance d (eq. 14), in (0, 0.5).
-        rho: ρ, penalty strength (eq. 14) [rad²/s³], not given in the paper (ERRATA: 0.03).
-        accuracy: ε, the task is finished when the TCP is this close to p_w [m].
-        neighbourhood: ϵ, radius of the blending ball around each waypoint [m] (eq. 19).
-        limit_velocity: add the penalty perturbation Δq̈ (eq. 15-16); sims 2 and 3.
-        limit_acceleration: scale the trajectory (eq. 17-18), c(0) = 0; sim 3.
-        blend_waypoints: pass waypoints without stopping (eq. 19); False stops at each.
-        smooth_penalty: improvement 1, penalty with zero slope at the threshold.
-        continuous_switching: improvement 1, the waypoint switches when σ reaches 1 (literal:
-            when the TCP leaves the ball).
-        bounded_scaling: improvement 2, c in [0, 1], limits kept by braking when no c works.
-        damped_inverse: improvement 3, damped least squares near a singular J.
-        preserve_damping: improvement 4, no error component changes sign (overshoot) near the
-            final goal, whatever c.
-        scaling_rate: rate of eq. 18 [1/s] (1 in the paper).
-        singularity_threshold: damped least squares below this :func:`drake_traj.robot.singularity_measure`.
-        max_damping: damping λ of the damped least squares at a singular J.
-        stop_speed: stop mode: TCP speed [m/s] below which a waypoint counts as reached.
-        stall_time: no progress (remaining path shorter by 0.1 mm) for this long [s] raises
-            PlanningError.
-        blend_length: σ = path length through the ball / (blend_length · ϵ) (eq. 19 reading).
-    """
-
-    waypoints: np.ndarray
-    position_gain: float | np.ndarray = 20.0
-    velocity_gain: float | np.ndarray = 9.392
-    velocity_limit: float | np.ndarray = robot.DEFAULT_JOINT_MOVE_VELOCITY
-    acceleration_limit: float | np.ndarray = robot.DEFAULT_JOINT_MOVE_ACCELERATION
-    vartheta: float = 0.1
-    rho: float = 0.03
-    accuracy: float = 0.001
-    neighbourhood: float = 0.05
-    limit_velocity: bool = False
-    limit_acceleration: bool = False
-    blend_waypoints: bool = True
-    smooth_penalty: bool = True
-    continuous_switching: bool = True
-    bounded_scaling: bool = True
-    damped_inverse: bool = True
-    preserve_damping: bool = True
-    scaling_rate: float = 1.0
-    singularity_threshold: float = 0.1
-    max_damping: float = 0.2
-    stop_speed: float = 0.01
-    stall_time: float = 3.0
-    blend_length: float = 1.25
-
-    def validate(self) -> "PajakParameters":
-        """Check every field; return a copy with arrays normalised ((w, 6) waypoints, (6,) gains
-        and limits). Raises ValueError naming the field."""
-        n = robot.NUM_JOINTS
-        try:
-            waypoints = np.array(self.waypoints, dtype=float)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"waypoints must be an array of numbers of shape (w, 6): {exc}") from exc
-        if waypoints.ndim == 1 and waypoints.shape == (6,):
-            waypoints = waypoints[None, :]
-        if waypoints.ndim != 2 or waypoints.shape[1] != 6 or waypoints.shape[0] == 0:
-            raise ValueError(f"waypoints must have shape (w, 6) with w >= 1, got shape {waypoints.shape}")
-        if not np.all(np.isfinite(waypoints)):
-            k = int(np.argwhere(~np.isfinite(waypoints))[0, 0])
-            raise ValueError(f"waypoints[{k}] must be finite, got {waypoints[k].tolist()}")
-        reach = np.linalg.norm(waypoints[:, :3] - SHOULDER, axis=1)
-        if np.any(reach > REACH):
-            k = int(np.argmax(reach > REACH))
-            raise ValueError(
-                f"waypoints[{k}] position {waypoints[k, :3].tolist()} is {reach[k]:.3f} m from the "
-                f"shoulder (0, 0, {_D1}), beyond the UR10e reach of {REACH} m"
-            )
-        if np.any(np.abs(np.cos(waypoints[:, 4])) < 1e-3):
-            k = int(np.argmax(np.abs(np.cos(waypoints[:, 4])) < 1e-3))
-            raise ValueError(
-                f"waypoints[{k}] phi_Y = {waypoints[k, 4]:.4f} rad is at +-pi/2: Z-Y-X Euler angles are "
-                "singular (gimbal lock) there"
-            )
-        values = {}
-        for name in ("position_gain", "velocity_gain", "velocity_limit", "acceleration_limit"):
-            values[name] = positive_vector(getattr(self, name), name, n)
-        for name in (
-            "rho", "accuracy", "neighbourhood", "scaling_rate", "singularity_threshold", "max_damping",
-            "stop_speed", "stall_time", "blend_length",
-        ):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-                raise ValueError(f"{name} must be a real number, got {value!r}")
-            if not np.isfinite(value) or value <= 0:
-                raise ValueError(f"{name} must be finite and > 0, got {value}")
-            values[name] = float(value)
-        vartheta = self.vartheta
-        if isinstance(vartheta, bool) or not isinstance(vartheta, (int, float, np.floating)) or not (
-            0.0 < vartheta < 0.5
-        ):
-            raise ValueError(f"vartheta must be a number in (0, 0.5), got {vartheta!r}")
-        if values["accuracy"] > values["neighbourhood"]:
-            raise ValueError(
-                f"accuracy ({values['accuracy']} m) must not be larger than neighbourhood "
-                f"({values['neighbourhood']} m)"
-            )
-        steps = np.linalg.norm(np.diff(waypoints[:, :3], axis=0), axis=1)
-        if np.any(steps < values["neighbourhood"]):
-            k = int(np.argmax(steps < values["neighbourhood"]))
-            raise ValueError(
-                f"waypoints[{k}] and waypoints[{k + 1}] are {steps[k]:.4f} m apart, closer than the "
-                f"neighbourhood {values['neighbourhood']} m"
-            )
-        for flag in (
-            "limit_velocity", "limit_acceleration", "blend_waypoints", "smooth_penalty",
-            "continuous_switching", "bounded_scaling", "damped_inverse", "preserve_damping",
-        ):
-            if not isinstance(getattr(self, flag), (bool, np.bool_)):
-                raise ValueError(f"{flag} must be True or False, got {getattr(self, flag)!r}")
-        return replace(self, waypoints=waypoints, vartheta=float(vartheta), **values)
-
-
-def paper_initial_configuration() -> np.ndarray:
-    """q(0) of the paper's task: [-π/2, -π/2, -3π/4, -π/4, π/2, π/4] [rad]."""
-    return np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])
-
-
-def paper_parameters(simulation: int = 3, **overrides) -> PajakParameters:
-    """The paper's task and parameters for simulation 1 (no limits), 2 (velocity) or 3 (both).
-
-    Waypoints p1, p2, p3, p_f with orientation (π, 0, 3π/4); Λ_P = 20, Λ_V = 9.392, ε = 1 mm,
-    ϵ = 5 cm, ϑ = 0.1, limits 1.05 rad/s and 1.40 rad/s². ``overrides`` replace any field.
-    """
-    if simulation not in (1, 2, 3):
-        raise ValueError(f"simulation must be 1, 2 or 3, got {simulation!r}")
-    orientation = [np.pi, 0.0, 3 * np.pi / 4]
-    positions = [
-        [-0.175, -0.525, 0.730],  # p1
-        [-0.175, -0.800, 0.730],  # p2
-        [0.275, -0.800, 0.730],  # p3
-        [0.275, -0.525, 0.730],  # p_f
-    ]
-    waypoints = np.array([p + orientation for p in positions])
-    settings = dict(waypoints=waypoints, limit_velocity=simulation >= 2, limit_acceleration=simulation == 3)
-    settings.update(overrides)
-    return PajakParameters(**settings)
 
 
 # --------------------------------------------------------------------------------------------
@@ -414,7 +215,7 @@ def acceleration_terms(jac, bias, error, qd, position_gain, velocity_gain, penal
 def scaling_interval(a, b, qdd_min, qdd_max):
     """Interval [c_lo, c_hi] of c with q̈_min <= a + c b <= q̈_max on every joint (last axis).
 
-    Each joint gives the bound of cases (1)-(4) (ERRATA: (2) and (4) use q̈_min):
+    Each joint gives the bound of cases (1)-(4) (Corrected (docs/papers.md): (2) and (4) use q̈_min):
     b_i > 0: (q̈_min - a_i)/b_i <= c <= (q̈_max - a_i)/b_i; b_i < 0: the same with the roles
     of q̈_min and q̈_max swapped; b_i = 0: no bound if a_i is inside the box, else empty.
     Upper bounds (cases 1, 2) combine by min (case a), lower bounds (3, 4) by max (case b).
@@ -462,17 +263,10 @@ def blend_progress(position, reference, travel, length):
     at the updates since the TCP entered the ball and x_ref the TCP position at the last update.
     It is 0 on entry, continuous in x and grows whenever the TCP moves, so the target always
     leads (a projection on p_i -> p_{i+1} does not grow while the TCP is still heading for p_i,
-    and 1 - δ/ϵ is not monotone: both stall, ERRATA). ``length`` = ``blend_length`` · ϵ.
+    and 1 - δ/ϵ is not monotone: both stall, docs/papers.md). ``length`` = ``blend_length`` · ϵ.
     """
     step = np.sqrt(np.sum((position - reference) ** 2, axis=-1))
     return np.clip((travel + step) / length, 0.0, 1.0), step
-
-
-def _pose_error(pose, goal):
-    """robot.task_pose_error over leading dimensions: pose - goal, orientation wrapped."""
-    error = pose - goal
-    error[..., 3:] = robot.wrap_angle(error[..., 3:])
-    return error
 
 
 def blended_target(p_i, p_next, sigma):
@@ -501,22 +295,22 @@ class _Evaluation:
 
 
 class PajakLaw:
-    """The planning law of seed 000 for one task, or for several tasks at once.
+    """The planning law of Pająk 2024 for one task, or for several tasks at once.
 
     State: continuous (q, q̇) and the discrete vector of :data:`DISCRETE_NAMES` (size
     :data:`DISCRETE_SIZE`; the first three entries are [c, t0, c0] of the scaling contract).
 
     Args:
-        parameters: one :class:`PajakParameters` (then q, q̇ have shape (6,) and the discrete
+        parameters: one :class:`PajakConfig` (then q, q̇ have shape (6,) and the discrete
             state (DISCRETE_SIZE,)), or a sequence of them for a batch of tasks (shapes (N, 6)
             and (N, DISCRETE_SIZE)); all must share the boolean flags.
     """
 
     def __init__(self, parameters):
-        single = isinstance(parameters, PajakParameters)
+        single = isinstance(parameters, PajakConfig)
         plist = [parameters] if single else list(parameters)
         if not plist:
-            raise ValueError("parameters must be a PajakParameters or a non-empty sequence of them")
+            raise ValueError("parameters must be a PajakConfig or a non-empty sequence of them")
         plist = [p.validate() for p in plist]
         flags = (
             "limit_velocity", "limit_acceleration", "blend_waypoints", "smooth_penalty",
@@ -628,7 +422,7 @@ class PajakLaw:
             sigma = self._zeros
             target = p_i  # eq. 6
         error = pose - target
-        error[:, 3:] = robot.wrap_angle(error[:, 3:])  # orientation wrapped (ERRATA)
+        error[:, 3:] = robot.wrap_angle(error[:, 3:])  # orientation wrapped (docs/papers.md)
         if self.limit_velocity and (np.abs(qd) > self.penalty_onset).any():
             penalty = velocity_penalty(
                 qd, -self.qd_max, self.qd_max, self.rho[:, None], self.vartheta[:, None],
@@ -859,274 +653,3 @@ class PajakLaw:
 
 
 _CAUSES = {-1: "stall", -2: "singular", -3: "non-finite", -4: "timeout"}
-
-
-# --------------------------------------------------------------------------------------------
-# Fixed-step integration for tests and benchmarks
-# --------------------------------------------------------------------------------------------
-
-
-def _rk4_step(law, t, q, qd, d, dt, k1a, peak):
-    """One RK4 step of (q, q̇)' = (q̇, q̈) with the discrete state held; k1a = q̈(t, q, q̇).
-    ``peak`` (6,) accumulates max |q̈| over the stages."""
-    h = 0.5 * dt
-    k2v = qd + h * k1a
-    k2a = law._evaluate(t + h, q + h * qd, k2v, d).qdd
-    k3v = qd + h * k2a
-    k3a = law._evaluate(t + h, q + h * k2v, k3v, d).qdd
-    k4v = qd + dt * k3a
-    k4a = law._evaluate(t + dt, q + dt * k3v, k4v, d).qdd
-    np.maximum(peak, np.abs(k2a[0]), out=peak)
-    np.maximum(peak, np.abs(k3a[0]), out=peak)
-    np.maximum(peak, np.abs(k4a[0]), out=peak)
-    q_new = q + dt / 6.0 * (qd + 2.0 * k2v + 2.0 * k3v + k4v)
-    qd_new = qd + dt / 6.0 * (k1a + 2.0 * k2a + 2.0 * k3a + k4a)
-    return q_new, qd_new
-
-
-def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settle_time: float = 0.0,
-              raise_on_timeout: bool = True) -> dict:
-    """Integrate one task with RK4 at a fixed step, updating the discrete state every step.
-
-    At every step k: discrete update at t_k, then the sample (t_k, q_k, q̇_k, q̈_k, c_k, TCP,
-    waypoint), then an RK4 step with the discrete state held (its first stage is the sample).
-    Stops at the first sample where the task is finished, or ``settle_time`` later (to look at
-    what happens after the finish, e.g. an overshoot).
-
-    Args:
-        law: a single-task :class:`PajakLaw`.
-        q0: initial joint positions [rad], (6,); the arm starts at rest.
-        dt: step [s].
-        t_max: give up after this long [s].
-        settle_time: keep integrating this long after the finish [s].
-        raise_on_timeout: False returns what was computed up to t_max (T = nan) instead of
-            raising (to look at the start of a motion).
-
-    Returns:
-        dict of arrays: t (K,), q, qd, qdd (K, 6), c (K,), tcp (K, 6) pose, waypoint (K,),
-        saturated (K,) bool, discrete (K, DISCRETE_SIZE); and T (finish time [s]), finish_index,
-        error (TCP position error at the finish [m]) and stage_peak (6,): max |q̈| over every
-        evaluation, RK4 stages included.
-
-    Raises:
-        PlanningError: singularity, no progress, non-finite values or not finished by t_max;
-            ``.partial`` holds the arrays computed so far.
-    """
-    if not law.single:
-        raise ValueError("law must be a single-task PajakLaw (use integrate_many for batches)")
-    if not np.isfinite(dt) or dt <= 0:
-        raise ValueError(f"dt must be a positive number of seconds, got {dt}")
-    if not np.isfinite(t_max) or t_max <= 0:
-        raise ValueError(f"t_max must be a positive number of seconds, got {t_max}")
-    if not np.isfinite(settle_time) or settle_time < 0:
-        raise ValueError(f"settle_time must be a non-negative number of seconds, got {settle_time}")
-    q = law._batch(robot._as_joint_vector(q0, "q0"), 6).copy()
-    qd = np.zeros_like(q)
-    d = law._batch(law.initial_discrete(), DISCRETE_SIZE)
-    steps = int(math.ceil(t_max / dt))
-    names = ("t", "q", "qd", "qdd", "c", "tcp", "waypoint", "saturated", "discrete")
-    log = {name: [] for name in names}
-    peak = np.zeros(6)
-
-    def partial():
-        out = {k: np.array(v) for k, v in log.items()}
-        out["stage_peak"] = peak.copy()
-        return out
-
-    t = 0.0
-    finish_time = finish_index = final_error = None
-    for k in range(steps + int(math.ceil(settle_time / dt)) + 1):
-        t = k * dt
-        try:
-            d, status, message = law._update(t, q, qd, d)
-            if status[0] < 0 and finish_time is None:
-                raise PlanningError(message[0], time=t, configuration=q[0], cause=_CAUSES[int(status[0])])
-            ev = law._evaluate(t, q, qd, d)
-            law._check(t, q[0], ev, 0)
-        except PlanningError as exc:
-            exc.partial = partial()
-            raise
-        except (np.linalg.LinAlgError, FloatingPointError) as exc:
-            raise PlanningError(
-                f"numerical failure: {exc}", time=t, configuration=q[0], cause="non-finite", partial=partial()
-            ) from exc
-        np.maximum(peak, np.abs(ev.qdd[0]), out=peak)
-        for name, value in zip(
-            names,
-            (t, q[0].copy(), qd[0].copy(), ev.qdd[0].copy(), float(ev.c[0]), ev.pose[0].copy(),
-             int(d[0, WAYPOINT]), bool(ev.saturated[0]), d[0].copy()),
-        ):
-            log[name].append(value)
-        if status[0] == 1 and finish_time is None:
-            finish_time = t
-            finish_index = len(log["t"]) - 1
-            final_error = float(np.linalg.norm(ev.pose[0, :3] - law.waypoints[0, law.num_waypoints[0] - 1, :3]))
-        if finish_time is not None and t >= finish_time + settle_time - 1e-12:
-            break
-        if finish_time is None and k >= steps:
-            if raise_on_timeout:
-                raise PlanningError(
-                    f"the task did not finish within t_max = {t_max} s", time=t, configuration=q[0],
-                    cause="timeout", partial=partial(),
-                )
-            break
-        try:
-            q, qd = _rk4_step(law, t, q, qd, d, dt, ev.qdd, peak)
-        except (np.linalg.LinAlgError, FloatingPointError) as exc:
-            raise PlanningError(
-                f"numerical failure: {exc}", time=t, configuration=q[0], cause="non-finite", partial=partial()
-            ) from exc
-    out = partial()
-    out["T"] = np.nan if finish_time is None else finish_time
-    out["finish_index"] = finish_index
-    out["error"] = np.nan if final_error is None else final_error
-    return out
-
-
-def integrate_many(law: PajakLaw, q0, *, dt: float = 2e-3, t_max: float = 30.0) -> list[dict]:
-    """Integrate a batch of tasks at once (RK4, vectorised over tasks), without raising.
-
-    Each task stops when it finishes or fails; the batch is compacted to the running tasks as
-    they end. Nothing is stored per sample; the summary per task has: status ("finished" or
-    the failure cause), message, T, error (final TCP distance to p_w [m]), q (final), and
-    max_velocity_ratio = max |q̇|/q̇_max and max_acceleration_ratio = max |q̈|/q̈_max over every
-    evaluated sample (RK4 stages included), c_range (min, max of c over the same samples),
-    saturated (updates with the improvement-2 fallback), nan (a non-finite value was seen).
-    """
-    if law.single:
-        raise ValueError("law must be a batch PajakLaw (built from a sequence of parameters)")
-    if not np.isfinite(dt) or dt <= 0:
-        raise ValueError(f"dt must be a positive number of seconds, got {dt}")
-    q = np.array(q0, dtype=float)
-    if q.shape != (law.count, 6):
-        raise ValueError(f"q0 must have shape ({law.count}, 6), got {q.shape}")
-    parameters = list(law.parameters)
-    active = np.arange(law.count)  # original index of each row of the current batch
-    qd = np.zeros_like(q)
-    d = law.initial_discrete()
-    result = [
-        dict(status="timeout", message=f"the task did not finish within t_max = {t_max} s", T=np.nan,
-             error=np.nan, q=None, max_velocity_ratio=0.0, max_acceleration_ratio=0.0, saturated=0, nan=False)
-        for _ in range(law.count)
-    ]
-    vel_ratio = np.zeros(law.count)
-    acc_ratio = np.zeros(law.count)
-    nan = np.zeros(law.count, dtype=bool)
-    c_min = np.full(law.count, np.inf)
-    c_max = np.full(law.count, -np.inf)
-    steps = int(math.ceil(t_max / dt))
-    current = law
-
-    def stage(t_s, q_s, qd_s):
-        ev = current._evaluate(t_s, q_s, qd_s, d)
-        qdd = ev.qdd
-        c_min[active] = np.fmin(c_min[active], ev.c)
-        c_max[active] = np.fmax(c_max[active], ev.c)
-        ok = np.all(np.isfinite(qdd), axis=1)
-        nan[active[~ok]] = True
-        ratio = np.max(np.abs(qdd) / current.qdd_max, axis=1)
-        acc_ratio[active] = np.maximum(acc_ratio[active], np.where(ok, ratio, np.inf))
-        return np.where(ok[:, None], qdd, 0.0)
-
-    t = 0.0
-    with np.errstate(all="ignore"):
-        for k in range(steps + 1):
-            t = k * dt
-            d, status, message = current._update(t, q, qd, d)
-            vel_ratio[active] = np.maximum(vel_ratio[active], np.max(np.abs(qd) / current.qd_max, axis=1))
-            ended = np.flatnonzero(status != 0)
-            if ended.size:
-                pose, *_ = robot.ur10e_kinematics(q[ended], qd[ended])
-                for row, j in enumerate(ended):
-                    r = result[active[j]]
-                    r["status"] = "finished" if status[j] == 1 else _CAUSES[int(status[j])]
-                    r["message"] = message[j]
-                    r["T"] = t
-                    goal = current.waypoints[j, current.num_waypoints[j] - 1, :3]
-                    r["error"] = float(np.linalg.norm(pose[row, :3] - goal))
-                    r["q"] = q[j].copy()
-                    r["saturated"] = int(d[j, SATURATED])
-                keep = status == 0
-                if not keep.any():
-                    active = active[keep]
-                    break
-                active, q, qd, d = active[keep], q[keep], qd[keep], d[keep]
-                current = PajakLaw([parameters[j] for j in active])
-            h = 0.5 * dt
-            k1a = stage(t, q, qd)
-            k2v = qd + h * k1a
-            k2a = stage(t + h, q + h * qd, k2v)
-            k3v = qd + h * k2a
-            k3a = stage(t + h, q + h * k2v, k3v)
-            k4v = qd + dt * k3a
-            k4a = stage(t + dt, q + dt * k3v, k4v)
-            q = q + dt / 6.0 * (qd + 2 * k2v + 2 * k3v + k4v)
-            qd = qd + dt / 6.0 * (k1a + 2 * k2a + 2 * k3a + k4a)
-    for row, j in enumerate(active):  # still running at t_max
-        result[j]["T"] = t
-        result[j]["q"] = q[row].copy()
-        result[j]["saturated"] = int(d[row, SATURATED])
-    for j in range(law.count):
-        result[j]["max_velocity_ratio"] = float(vel_ratio[j])
-        result[j]["max_acceleration_ratio"] = float(acc_ratio[j])
-        result[j]["nan"] = bool(nan[j])
-        result[j]["c_range"] = (float(c_min[j]), float(c_max[j]))
-    return result
-
-
-# --------------------------------------------------------------------------------------------
-# The planner system (DESIGN.md contract): a thin shell around PajakLaw.
-# --------------------------------------------------------------------------------------------
-
-
-class PajakPlanner(PlannerSystem):
-    """Seed 000's planner as a LeafSystem: continuous [q; q̇], discrete ``scaling`` [c, t0, c0]
-    and ``task`` (the rest of :data:`DISCRETE_NAMES`), updated every ``update_period``.
-
-    The acceleration (and c) are evaluated by :meth:`PajakLaw.acceleration` at every derivative
-    call, so the acceleration limit holds at every integrator stage, not only at updates. A
-    :class:`PlanningError` from the law ends the simulation; ``simulate`` keeps the log.
-    The ``speed_override`` input is not used by this planner (its clock is real time).
-
-    Args:
-        parameters: the task and the law's settings.
-        q_initial: joint positions at t = 0 [rad].
-        update_period: period of the discrete update (anchor, waypoint switching) [s].
-    """
-
-    def __init__(self, parameters: PajakParameters, q_initial, *, update_period: float = 1e-3):
-        if not np.isfinite(update_period) or update_period <= 0:
-            raise ValueError(f"update_period must be a positive number of seconds, got {update_period}")
-        self.law = PajakLaw(parameters)
-        initial = self.law.initial_discrete()
-        super().__init__(robot._as_joint_vector(q_initial, "q_initial"), initial_scaling=float(initial[C]))
-        self.task_state_index = self.DeclareDiscreteState(initial[C0 + 1 :])
-        self.velocity_limit = self.law.qd_max[0]
-        self.acceleration_limit = self.law.qdd_max[0]
-        self.DeclarePeriodicDiscreteUpdateEvent(update_period, 0.0, self._update)
-
-    def _law_arguments(self, context):
-        state = self.reference_state(context)
-        discrete = np.concatenate(
-            [
-                context.get_discrete_state(self.scaling_state_index).get_value(),
-                context.get_discrete_state(self.task_state_index).get_value(),
-            ]
-        )
-        return context.get_time(), state[: self.num_joints], state[self.num_joints :], discrete
-
-    def evaluate(self, context) -> tuple[np.ndarray, float]:
-        qdd, c = self.law.acceleration(*self._law_arguments(context))
-        return qdd, float(c)
-
-    def finished(self, context) -> bool:
-        _, q, qd, discrete = self._law_arguments(context)
-        return bool(self.law.finished(q, qd, discrete))
-
-    def task_waypoints(self) -> np.ndarray:
-        return self.law.parameters.waypoints[:, :3].copy()
-
-    def _update(self, context, discrete_state):
-        updated = self.law.update(*self._law_arguments(context))
-        discrete_state.get_mutable_vector(self.scaling_state_index).SetFromVector(updated[: C0 + 1])
-        discrete_state.get_mutable_vector(self.task_state_index).SetFromVector(updated[C0 + 1 :])

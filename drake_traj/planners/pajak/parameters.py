@@ -1,0 +1,183 @@
+"""Parameters of the Pająk 2024 planner: :class:`PajakConfig` (also the scenario's ``planner``
+entry, tag ``!PajakConfig``) and the paper's task (:func:`paper_parameters`)."""
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from drake_traj.robots import ur10e as robot
+from drake_traj.validation import positive_vector
+
+__all__ = ["PAPER_METHOD", "PajakConfig", "paper_initial_configuration", "paper_parameters"]
+
+# The improvement flags of PajakConfig switched off: the paper's method as printed, with the
+# ERRATA corrections (used for the Table 2 reproduction and to show what each improvement fixes).
+PAPER_METHOD = dict(
+    smooth_penalty=False,
+    continuous_switching=False,
+    bounded_scaling=False,
+    damped_inverse=False,
+    preserve_damping=False,
+)
+
+# UR10e geometry (standard DH) for the reach check of the waypoints.
+_D1 = float(robot.DH_D[0])
+SHOULDER = np.array([0.0, 0.0, _D1])  # shoulder point (joint-2 axis on the base axis) [m]
+REACH = 1.3  # [m], UR10e reach from the shoulder (ur10e_facts.md)
+
+
+@dataclass
+class PajakConfig:
+    """The Pająk 2024 planner's task and settings (section "Model and task of the manipulator"):
+    the scenario's ``planner: !PajakConfig`` entry and the law's parameters.
+
+    Attributes:
+        waypoints: (w, 6) task poses p_1..p_w [x, y, z, φ_X, φ_Y, φ_Z] [m, rad]; p_w is p_f.
+        position_gain: Λ_P (scalar or 6 values) [1/s²], eq. 9.
+        velocity_gain: Λ_V (scalar or 6 values) [1/s], eq. 9.
+        velocity_limit: q̇_max = -q̇_min (scalar or 6) [rad/s], eq. 4.
+        acceleration_limit: q̈_max = -q̈_min (scalar or 6) [rad/s²], eq. 5.
+        vartheta: ϑ, penalty threshold on the normalised distance d (eq. 14), in (0, 0.5).
+        rho: ρ, penalty strength (eq. 14) [rad²/s³], not given in the paper (ERRATA: 0.03).
+        accuracy: ε, the task is finished when the TCP is this close to p_w [m].
+        neighbourhood: ϵ, radius of the blending ball around each waypoint [m] (eq. 19).
+        limit_velocity: add the penalty perturbation Δq̈ (eq. 15-16); sims 2 and 3.
+        limit_acceleration: scale the trajectory (eq. 17-18), c(0) = 0; sim 3.
+        blend_waypoints: pass waypoints without stopping (eq. 19); False stops at each.
+        smooth_penalty: improvement 1, penalty with zero slope at the threshold.
+        continuous_switching: improvement 1, the waypoint switches when σ reaches 1 (literal:
+            when the TCP leaves the ball).
+        bounded_scaling: improvement 2, c in [0, 1], limits kept by braking when no c works.
+        damped_inverse: improvement 3, damped least squares near a singular J.
+        preserve_damping: improvement 4, no error component changes sign (overshoot) near the
+            final goal, whatever c.
+        scaling_rate: rate of eq. 18 [1/s] (1 in the paper).
+        singularity_threshold: damped least squares below this :func:`drake_traj.robot.singularity_measure`.
+        max_damping: damping λ of the damped least squares at a singular J.
+        stop_speed: stop mode: TCP speed [m/s] below which a waypoint counts as reached.
+        stall_time: no progress (remaining path shorter by 0.1 mm) for this long [s] raises
+            PlanningError.
+        blend_length: σ = path length through the ball / (blend_length · ϵ) (eq. 19 reading).
+        update_period: period of the planner system's discrete update (eq. 18 anchor, waypoint
+            switching) [s].
+
+    Gains and limits are one number for every joint (task component) in a scenario file; from
+    Python they may also be 6 values.
+    """
+
+    waypoints: list[list[float]] = field(default_factory=list)
+    position_gain: float = 20.0
+    velocity_gain: float = 9.392
+    velocity_limit: float = robot.DEFAULT_JOINT_MOVE_VELOCITY
+    acceleration_limit: float = robot.DEFAULT_JOINT_MOVE_ACCELERATION
+    vartheta: float = 0.1
+    rho: float = 0.03
+    accuracy: float = 0.001
+    neighbourhood: float = 0.05
+    limit_velocity: bool = True
+    limit_acceleration: bool = True
+    blend_waypoints: bool = True
+    smooth_penalty: bool = True
+    continuous_switching: bool = True
+    bounded_scaling: bool = True
+    damped_inverse: bool = True
+    preserve_damping: bool = True
+    scaling_rate: float = 1.0
+    singularity_threshold: float = 0.1
+    max_damping: float = 0.2
+    stop_speed: float = 0.01
+    stall_time: float = 3.0
+    blend_length: float = 1.25
+    update_period: float = 0.001
+
+    def validate(self) -> "PajakConfig":
+        """Check every field; return a copy with arrays normalised ((w, 6) waypoints, (6,) gains
+        and limits). Raises ValueError naming the field."""
+        n = robot.NUM_JOINTS
+        try:
+            waypoints = np.array(self.waypoints, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"waypoints must be an array of numbers of shape (w, 6): {exc}") from exc
+        if waypoints.ndim == 1 and waypoints.shape == (6,):
+            waypoints = waypoints[None, :]
+        if waypoints.ndim != 2 or waypoints.shape[1] != 6 or waypoints.shape[0] == 0:
+            raise ValueError(f"waypoints must have shape (w, 6) with w >= 1, got shape {waypoints.shape}")
+        if not np.all(np.isfinite(waypoints)):
+            k = int(np.argwhere(~np.isfinite(waypoints))[0, 0])
+            raise ValueError(f"waypoints[{k}] must be finite, got {waypoints[k].tolist()}")
+        reach = np.linalg.norm(waypoints[:, :3] - SHOULDER, axis=1)
+        if np.any(reach > REACH):
+            k = int(np.argmax(reach > REACH))
+            raise ValueError(
+                f"waypoints[{k}] position {waypoints[k, :3].tolist()} is {reach[k]:.3f} m from the "
+                f"shoulder (0, 0, {_D1}), beyond the UR10e reach of {REACH} m"
+            )
+        if np.any(np.abs(np.cos(waypoints[:, 4])) < 1e-3):
+            k = int(np.argmax(np.abs(np.cos(waypoints[:, 4])) < 1e-3))
+            raise ValueError(
+                f"waypoints[{k}] phi_Y = {waypoints[k, 4]:.4f} rad is at +-pi/2: Z-Y-X Euler angles are "
+                "singular (gimbal lock) there"
+            )
+        values = {}
+        for name in ("position_gain", "velocity_gain", "velocity_limit", "acceleration_limit"):
+            values[name] = positive_vector(getattr(self, name), name, n)
+        for name in (
+            "rho", "accuracy", "neighbourhood", "scaling_rate", "singularity_threshold", "max_damping",
+            "stop_speed", "stall_time", "blend_length", "update_period",
+        ):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+                raise ValueError(f"{name} must be a real number, got {value!r}")
+            if not np.isfinite(value) or value <= 0:
+                raise ValueError(f"{name} must be finite and > 0, got {value}")
+            values[name] = float(value)
+        vartheta = self.vartheta
+        if isinstance(vartheta, bool) or not isinstance(vartheta, (int, float, np.floating)) or not (
+            0.0 < vartheta < 0.5
+        ):
+            raise ValueError(f"vartheta must be a number in (0, 0.5), got {vartheta!r}")
+        if values["accuracy"] > values["neighbourhood"]:
+            raise ValueError(
+                f"accuracy ({values['accuracy']} m) must not be larger than neighbourhood "
+                f"({values['neighbourhood']} m)"
+            )
+        steps = np.linalg.norm(np.diff(waypoints[:, :3], axis=0), axis=1)
+        if np.any(steps < values["neighbourhood"]):
+            k = int(np.argmax(steps < values["neighbourhood"]))
+            raise ValueError(
+                f"waypoints[{k}] and waypoints[{k + 1}] are {steps[k]:.4f} m apart, closer than the "
+                f"neighbourhood {values['neighbourhood']} m"
+            )
+        for flag in (
+            "limit_velocity", "limit_acceleration", "blend_waypoints", "smooth_penalty",
+            "continuous_switching", "bounded_scaling", "damped_inverse", "preserve_damping",
+        ):
+            if not isinstance(getattr(self, flag), (bool, np.bool_)):
+                raise ValueError(f"{flag} must be True or False, got {getattr(self, flag)!r}")
+        return replace(self, waypoints=waypoints, vartheta=float(vartheta), **values)
+
+
+def paper_initial_configuration() -> np.ndarray:
+    """q(0) of the paper's task: [-π/2, -π/2, -3π/4, -π/4, π/2, π/4] [rad] (the UR10e's home)."""
+    return np.array(robot.HOME)
+
+
+def paper_parameters(simulation: int = 3, **overrides) -> PajakConfig:
+    """The paper's task and parameters for simulation 1 (no limits), 2 (velocity) or 3 (both).
+
+    Waypoints p1, p2, p3, p_f with orientation (π, 0, 3π/4); Λ_P = 20, Λ_V = 9.392, ε = 1 mm,
+    ϵ = 5 cm, ϑ = 0.1, limits 1.05 rad/s and 1.40 rad/s². ``overrides`` replace any field.
+    """
+    if simulation not in (1, 2, 3):
+        raise ValueError(f"simulation must be 1, 2 or 3, got {simulation!r}")
+    orientation = [np.pi, 0.0, 3 * np.pi / 4]
+    positions = [
+        [-0.175, -0.525, 0.730],  # p1
+        [-0.175, -0.800, 0.730],  # p2
+        [0.275, -0.800, 0.730],  # p3
+        [0.275, -0.525, 0.730],  # p_f
+    ]
+    waypoints = np.array([p + orientation for p in positions])
+    settings = dict(waypoints=waypoints, limit_velocity=simulation >= 2, limit_acceleration=simulation == 3)
+    settings.update(overrides)
+    return PajakConfig(**settings)

@@ -1,0 +1,78 @@
+"""The Pająk 2024 planner as a Drake system: a thin shell around :class:`PajakLaw`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drake_traj.planners.base import PlannerSystem
+from drake_traj.planners.pajak.integration import integrate
+from drake_traj.planners.pajak.law import C, C0, PajakLaw
+from drake_traj.planners.pajak.parameters import PajakConfig
+from drake_traj.robots import ur10e
+from drake_traj.robots.base import Robot
+
+__all__ = ["PajakPlanner", "make"]
+
+
+class PajakPlanner(PlannerSystem):
+    """Pająk 2024's planner as a LeafSystem: continuous [q; q̇], discrete ``scaling`` [c, t0, c0]
+    and ``task`` (the rest of :data:`DISCRETE_NAMES`), updated every ``update_period``.
+
+    The acceleration (and c) are evaluated by :meth:`PajakLaw.acceleration` at every derivative
+    call, so the acceleration limit holds at every integrator stage, not only at updates. A
+    :class:`PlanningError` from the law ends the simulation; ``simulate`` keeps the log.
+    The ``speed_override`` input is not used by this planner (its clock is real time).
+
+    Args:
+        parameters: the task and the law's settings.
+        q_initial: joint positions at t = 0 [rad].
+    """
+
+    def __init__(self, parameters: PajakConfig, q_initial):
+        self.law = PajakLaw(parameters)
+        update_period = self.law.parameters.update_period
+        initial = self.law.initial_discrete()
+        super().__init__(ur10e._as_joint_vector(q_initial, "q_initial"), initial_scaling=float(initial[C]))
+        self.task_state_index = self.DeclareDiscreteState(initial[C0 + 1 :])
+        self.velocity_limit = self.law.qd_max[0]
+        self.acceleration_limit = self.law.qdd_max[0]
+        self.DeclarePeriodicDiscreteUpdateEvent(update_period, 0.0, self._update)
+
+    def _law_arguments(self, context):
+        state = self.reference_state(context)
+        discrete = np.concatenate(
+            [
+                context.get_discrete_state(self.scaling_state_index).get_value(),
+                context.get_discrete_state(self.task_state_index).get_value(),
+            ]
+        )
+        return context.get_time(), state[: self.num_joints], state[self.num_joints :], discrete
+
+    def evaluate(self, context) -> tuple[np.ndarray, float]:
+        qdd, c = self.law.acceleration(*self._law_arguments(context))
+        return qdd, float(c)
+
+    def finished(self, context) -> bool:
+        _, q, qd, discrete = self._law_arguments(context)
+        return bool(self.law.finished(q, qd, discrete))
+
+    def preflight(self) -> None:
+        """Integrate the law alone over the whole task (:func:`integrate`); raises its
+        :class:`PlanningError` (time, configuration, cause) if the task cannot be completed."""
+        integrate(self.law, self.initial_positions())
+
+    def task_waypoints(self) -> np.ndarray:
+        return self.law.parameters.waypoints[:, :3].copy()
+
+    def _update(self, context, discrete_state):
+        updated = self.law.update(*self._law_arguments(context))
+        discrete_state.get_mutable_vector(self.scaling_state_index).SetFromVector(updated[: C0 + 1])
+        discrete_state.get_mutable_vector(self.task_state_index).SetFromVector(updated[C0 + 1 :])
+
+
+def make(config: PajakConfig, robot: Robot, q_initial) -> PajakPlanner:
+    """The planner of ``config`` on ``robot`` (the UR10e: the law uses its closed-form task
+    kinematics), starting at rest at ``q_initial`` [rad]."""
+    if robot.name != ur10e.UR10E.name:
+        raise ValueError(f"the Pająk planner runs on the UR10e (closed-form task kinematics), not on {robot.name!r}")
+    return PajakPlanner(config, q_initial)

@@ -1,0 +1,23 @@
+"""Robots under one contract (:class:`Robot`): the UR10e, the three example robots of Boryga and
+the 4-DOF robot of Li et al. 2019. ``get_robot(name)`` returns one by its scenario name."""
+
+from drake_traj.robots.base import PointRobot, Robot
+from drake_traj.robots.boryga_robots import AnthropomorphicArm, CartesianRobot, ScaraArm
+from drake_traj.robots.li_4dof import LI_4DOF, Li4Dof
+from drake_traj.robots.ur10e import UR10E, UR10e
+
+__all__ = [
+    "ROBOT_NAMES", "AnthropomorphicArm", "CartesianRobot", "LI_4DOF", "Li4Dof", "PointRobot", "Robot", "ScaraArm",
+    "UR10E", "UR10e", "get_robot",
+]
+
+_ROBOTS = {robot.name: robot for robot in (UR10E, LI_4DOF, AnthropomorphicArm(), ScaraArm(), CartesianRobot())}
+ROBOT_NAMES = tuple(_ROBOTS)
+
+
+def get_robot(name: str) -> Robot:
+    """The robot called ``name`` (one of :data:`ROBOT_NAMES`)."""
+    try:
+        return _ROBOTS[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"robot must be one of {ROBOT_NAMES}, got {name!r}") from None

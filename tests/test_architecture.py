@@ -1,0 +1,90 @@
+"""The package's structure: no import cycle, dependencies pointing one way, configs YAML can type,
+and a public API that imports."""
+
+import ast
+import dataclasses
+from pathlib import Path
+
+import pytest
+
+import drake_traj
+from drake_traj.planners import PLANNER_CONFIGS
+from drake_traj.scenario import Scenario
+
+PACKAGE = Path(drake_traj.__file__).resolve().parent
+
+
+def module_name(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES = {module_name(path): path for path in PACKAGE.rglob("*.py")}
+
+
+def imports_of(name: str) -> list[tuple[str, bool]]:
+    """(imported drake_traj module, imported at module level) for every import in ``name``."""
+    tree = ast.parse(MODULES[name].read_text())
+    top_level = {id(node) for node in tree.body}
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            targets = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            targets = [f"{node.module}.{alias.name}" if f"{node.module}.{alias.name}" in MODULES else node.module
+                       for alias in node.names]
+        else:
+            continue
+        found += [(target, id(node) in top_level) for target in targets if target.startswith("drake_traj")]
+    return found
+
+
+GRAPH = {name: {target for target, _ in imports_of(name)} for name in MODULES}
+
+
+def test_the_import_graph_has_no_cycle():
+    state = {}  # 1: on the current path, 2: done
+
+    def visit(name, path):
+        state[name] = 1
+        for target in sorted(GRAPH.get(name, ())):
+            if state.get(target) == 1:
+                cycle = path[path.index(target):] + [target]
+                pytest.fail("import cycle: " + " -> ".join(cycle))
+            if state.get(target) is None and target in GRAPH:
+                visit(target, path + [target])
+        state[name] = 2
+
+    for name in sorted(GRAPH):
+        if name not in state:
+            visit(name, [name])
+
+
+def test_every_import_of_the_package_is_at_module_level():
+    late = [(name, target) for name in MODULES for target, top in imports_of(name) if not top]
+    assert not late, f"function-level imports hide dependencies: {late}"
+
+
+def test_dependencies_point_one_way():
+    for name, targets in GRAPH.items():
+        if name.startswith("drake_traj.robots"):
+            assert not {t for t in targets if t.startswith(("drake_traj.planners", "drake_traj.diagram",
+                                                            "drake_traj.scenario"))}, name
+        if name.startswith("drake_traj.planners.baselines"):
+            assert not {t for t in targets if t.startswith("drake_traj.planners.pajak")}, name
+    assert "drake_traj.diagram" not in set().union(*(GRAPH[n] for n in MODULES if n.startswith("drake_traj.planners")))
+
+
+@pytest.mark.parametrize("config", PLANNER_CONFIGS + (Scenario,), ids=lambda c: c.__name__)
+def test_config_fields_have_real_types_for_yaml(config):
+    # pydrake's yaml_load_typed reads dataclass field types; ``from __future__ import annotations``
+    # in a config's module would turn them into strings it cannot use.
+    for item in dataclasses.fields(config):
+        assert not isinstance(item.type, str), f"{config.__name__}.{item.name}: {item.type!r}"
+
+
+def test_public_api():
+    for name in drake_traj.__all__:
+        assert getattr(drake_traj, name) is not None
+    assert issubclass(drake_traj.PlanningError, drake_traj.DrakeTrajError)
+    assert issubclass(drake_traj.DrakeTrajError, ValueError)
