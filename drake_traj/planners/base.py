@@ -75,10 +75,21 @@ class PlannerSystem(LeafSystem):
         """q at t = 0 [rad]: where the robot starts."""
         return self._q_initial.copy()
 
-    def preflight(self) -> None:
+    def preflight(self) -> np.ndarray | None:
         """Check the whole task before t = 0; raise :class:`~drake_traj.errors.PlanningError` if
         it cannot be completed. Planners that plan the whole motion when they are made have
-        nothing left to check (this default); online planners run their law ahead of time."""
+        nothing left to check (this default); online planners run their law ahead of time.
+
+        Returns:
+            The planned tool path [m], shape (N, 3) in the base frame, where the check computes
+            it (for drawing before the motion), else None.
+        """
+        return None
+
+    def goal_pose(self) -> np.ndarray | None:
+        """The tool pose the task ends at, [x, y, z, phi_X, phi_Y, phi_Z] [m, rad], where the task
+        is given in task space; None where it is given in joint space."""
+        return None
 
     # --- shared ------------------------------------------------------------------------------
     def speed_override(self, context) -> float:

@@ -56,10 +56,15 @@ class PajakPlanner(PlannerSystem):
         _, q, qd, discrete = self._law_arguments(context)
         return bool(self.law.finished(q, qd, discrete))
 
-    def preflight(self) -> None:
+    def preflight(self) -> np.ndarray:
         """Integrate the law alone over the whole task (:func:`integrate`); raises its
-        :class:`PlanningError` (time, configuration, cause) if the task cannot be completed."""
-        integrate(self.law, self.initial_positions())
+        :class:`PlanningError` (time, configuration, cause) if the task cannot be completed.
+        Returns the planned TCP path [m], (N, 3)."""
+        return integrate(self.law, self.initial_positions())["tcp"][:, :3]
+
+    def goal_pose(self) -> np.ndarray:
+        """p_f, the last waypoint [m, rad]."""
+        return self.law.parameters.waypoints[-1].copy()
 
     def task_waypoints(self) -> np.ndarray:
         return self.law.parameters.waypoints[:, :3].copy()
