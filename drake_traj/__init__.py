@@ -10,7 +10,7 @@ Planner configs (``PajakConfig``, ``QuinticConfig``, ...) build planners with
 :func:`drake_traj.planners.make_planner`; robots come from :func:`get_robot`.
 """
 
-from drake_traj.diagram import ControllerGains, simulate
+from drake_traj.station import ControllerGains, add_station, build_station, make_station, run_station, simulate
 from drake_traj.errors import DrakeTrajError, Failure, PlanningError, SingularConfigurationError
 from drake_traj.planners import (
     BorygaConfig,
@@ -28,7 +28,7 @@ from drake_traj.scenario import Scenario, load_scenario, make_planner
 __version__ = "0.1.0"
 
 __all__ = [
-    "BorygaConfig", "ControllerGains", "DrakeTrajError", "Failure", "LiConfig", "Metrics", "MovejConfig",
+    "BorygaConfig", "ControllerGains", "add_station", "build_station", "make_station", "run_station", "add_station", "build_station", "make_station", "run_station", "DrakeTrajError", "Failure", "LiConfig", "Metrics", "MovejConfig",
     "PajakConfig", "PlanningError", "QuinticConfig", "Robot", "RuckigConfig", "Scenario", "SimulationResult",
     "SingularConfigurationError", "ToppraConfig", "get_robot", "load_scenario", "make_planner", "simulate",
 ]

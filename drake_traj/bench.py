@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drake_traj.diagram import simulate
+from drake_traj.station import simulate
 from drake_traj.planners import (
     MovejConfig,
     PajakConfig,

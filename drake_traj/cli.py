@@ -18,10 +18,9 @@ from pathlib import Path
 from pydrake.geometry import Meshcat
 
 from drake_traj.bench import bench
-from drake_traj.diagram import simulate
+from drake_traj.station import simulate
 from drake_traj.meshcat import draw_task, export_html
-from drake_traj.robots import get_robot
-from drake_traj.scenario import DEFAULT_SCENARIO, default_scenario_path, load_scenario, make_planner
+from drake_traj.scenario import DEFAULT_SCENARIO, default_scenario_path, load_scenario
 
 
 def run(scenario_path, out_dir, *, variant: str | None = None, live_meshcat: bool = False) -> int:
@@ -31,19 +30,13 @@ def run(scenario_path, out_dir, *, variant: str | None = None, live_meshcat: boo
     meshcat = Meshcat()
     if live_meshcat:
         print(f"Meshcat: {meshcat.web_url()}", flush=True)
-    planner = make_planner(scenario)
-    result = simulate(
-        planner,
-        name=scenario.name,
-        robot=get_robot(scenario.robot),
-        gains=scenario.controller,
-        time_step=scenario.time_step,
-        log_period=scenario.log_period,
-        settle_time=scenario.settle_time,
-        max_duration=scenario.max_duration,
-        meshcat=meshcat,
-        realtime_rate=1.0 if live_meshcat else 0.0,
-    )
+    arguments = scenario.station_arguments()
+    planner = arguments.pop("planner")
+    simulator_config = scenario.simulator
+    if live_meshcat:
+        simulator_config.target_realtime_rate = 1.0
+    result = simulate(planner, name=scenario.name, simulator_config=simulator_config, settle_time=scenario.settle_time,
+                      max_duration=scenario.max_duration, meshcat=meshcat, **arguments)
     result.save(out_dir)
     result.save_figures(out_dir)
     for stem, figure in planner.figures().items():

@@ -18,7 +18,17 @@ from matplotlib.figure import Figure
 
 from drake_traj.errors import Failure
 
-__all__ = ["ARRAY_NAMES", "Metrics", "SimulationResult"]
+__all__ = ["ARRAY_NAMES", "LOGGERS", "Metrics", "SimulationResult"]
+
+# The station's loggers (drake_traj.station), by subsystem name: what each records, one column per
+# sample (VectorLogSink.data() has one row per entry below, n = the robot's joint count).
+LOGGERS = {
+    "reference_logger": "the planner's desired_state: q_ref (n rows) then qd_ref (n rows) [rad, rad/s]",
+    "acceleration_logger": "the planner's desired_acceleration: qdd_ref (n rows) [rad/s^2]",
+    "scaling_logger": "the planner's scaling coefficient c (1 row)",
+    "measured_logger": "the plant's state: q_meas (n rows) then qd_meas (n rows) [rad, rad/s]",
+    "torque_logger": "the drives' net actuation, PD + feed-forward, saturated (n rows) [N m]",
+}
 
 ARRAY_NAMES = ("t", "q_ref", "qd_ref", "qdd_ref", "q_meas", "qd_meas", "tau", "scaling", "tcp", "tcp_ref")
 _LIMIT_NAMES = ("velocity_limit", "acceleration_limit", "effort_limit", "waypoints")
@@ -114,6 +124,44 @@ class SimulationResult:
             simulated_time_s=simulated,
             wall_time_s=self.wall_time,
             real_time_factor=simulated / self.wall_time if self.wall_time > 0 else None,
+        )
+
+    @classmethod
+    def from_station(cls, station, station_context, *, name: str = "run", failure: Failure | None = None,
+                     wall_time: float = float("nan")) -> "SimulationResult":
+        """The result of a run of a station (:func:`drake_traj.station.build_station`), from its
+        loggers, its planner and its robot. ``station_context`` is the station's context (for a
+        station inside a larger diagram: ``station.GetMyContextFromRoot(root_context)``).
+        The TCP poses are computed from the logged joint positions."""
+        planner = station.GetSubsystemByName("planner")
+        robot = station.GetSubsystemByName("tcp_pose").robot
+        logs = {}
+        for key in LOGGERS:
+            logger = station.GetSubsystemByName(key)
+            logs[key] = logger.GetLog(station.GetSubsystemContext(logger, station_context))
+        count = min(log.num_samples() for log in logs.values())
+        data = {key: log.data()[:, :count].T for key, log in logs.items()}
+        n = robot.num_joints
+        q_ref, q_meas = data["reference_logger"][:, :n], data["measured_logger"][:, :n]
+        return cls(
+            name=name,
+            t=logs["reference_logger"].sample_times()[:count].copy(),
+            q_ref=q_ref,
+            qd_ref=data["reference_logger"][:, n:],
+            qdd_ref=data["acceleration_logger"],
+            q_meas=q_meas,
+            qd_meas=data["measured_logger"][:, n:],
+            tau=data["torque_logger"],
+            scaling=data["scaling_logger"][:, 0],
+            tcp=robot.tcp_pose(q_meas).reshape(-1, 6),
+            tcp_ref=robot.tcp_pose(q_ref).reshape(-1, 6),
+            velocity_limit=np.broadcast_to(planner.velocity_limit, (n,)).astype(float),
+            acceleration_limit=np.broadcast_to(planner.acceleration_limit, (n,)).astype(float),
+            effort_limit=robot.effort_limits,
+            waypoints=planner.task_waypoints(),
+            duration=planner.finish_time(station.GetSubsystemContext(planner, station_context)),
+            failure=failure,
+            wall_time=wall_time,
         )
 
     # --- persistence ---------------------------------------------------------------------------

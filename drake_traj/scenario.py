@@ -14,8 +14,10 @@ from pathlib import Path
 
 import numpy as np
 from pydrake.common.yaml import yaml_load, yaml_load_typed
+from pydrake.multibody.plant import MultibodyPlantConfig
+from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
-from drake_traj.diagram import ControllerGains
+from drake_traj.station import ControllerGains, default_plant_config, default_simulator_config
 from drake_traj.planners import PlannerConfig, PlannerSystem, QuinticConfig
 from drake_traj.planners import make_planner as make_planner_from_config
 from drake_traj.robots import get_robot
@@ -38,7 +40,11 @@ class Scenario:
             start from the inverse kinematics of the path instead.
         planner: the planner's config (see :data:`drake_traj.planners.PLANNER_CONFIGS`).
         controller: PD gains (empty: the robot's defaults) and the feed-forward choice.
-        time_step: the plant's discrete step [s]; log_period: the loggers' period [s].
+        plant: Drake's ``MultibodyPlantConfig`` of the robot plant (default: discrete at 1 ms,
+            SAP); ``plant: {time_step: 0.002}`` runs at the UR controller's 500 Hz.
+        simulator: Drake's ``SimulatorConfig`` (integration scheme, step, accuracy, real-time
+            rate; default fixed-step RK2 at 1 ms, see ``station.default_simulator_config``).
+        log_period: the loggers' period [s].
         settle_time: how long the run goes on after the planner finishes [s].
         max_duration: the run stops with a failure if the planner has not finished by then [s].
     """
@@ -48,7 +54,8 @@ class Scenario:
     q_initial: list[float] = field(default_factory=list)
     planner: PlannerConfig = field(default_factory=QuinticConfig)
     controller: ControllerGains = field(default_factory=ControllerGains)
-    time_step: float = 0.001
+    plant: MultibodyPlantConfig = field(default_factory=default_plant_config)
+    simulator: SimulatorConfig = field(default_factory=default_simulator_config)
     log_period: float = 0.001
     settle_time: float = 0.5
     max_duration: float = 120.0
@@ -76,12 +83,22 @@ class Scenario:
             raise ValueError(
                 f"q_initial[{j}] = {q[j]} {unit} is outside the joint range [{lower[j]:.6f}, {upper[j]:.6f}] {unit}"
             )
-        for label in ("time_step", "log_period", "max_duration", "settle_time"):
-            value = getattr(self, label)
+        for label, value in (("plant.time_step", self.plant.time_step), ("log_period", self.log_period),
+                             ("max_duration", self.max_duration), ("settle_time", self.settle_time),
+                             ("simulator.max_step_size", self.simulator.max_step_size)):
             smallest_allowed = 0.0 if label == "settle_time" else np.nextafter(0.0, 1.0)
             if not np.isfinite(value) or value < smallest_allowed:
                 raise ValueError(f"{label} must be a finite, positive number of seconds, got {value}")
+        if self.simulator.integration_scheme not in GetIntegrationSchemes():
+            raise ValueError(f"simulator.integration_scheme must be one of {GetIntegrationSchemes()}, "
+                             f"got {self.simulator.integration_scheme!r}")
         self.controller.for_robot(robot)
+
+    def station_arguments(self) -> dict:
+        """The keyword arguments of :func:`drake_traj.station.build_station` for this scenario
+        (its planner made by :func:`make_planner`)."""
+        return dict(planner=make_planner(self), robot=get_robot(self.robot), gains=self.controller,
+                    plant_config=self.plant, log_period=self.log_period)
 
 
 def default_scenario_path() -> Path:

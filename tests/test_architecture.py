@@ -68,11 +68,11 @@ def test_every_import_of_the_package_is_at_module_level():
 def test_dependencies_point_one_way():
     for name, targets in GRAPH.items():
         if name.startswith("drake_traj.robots"):
-            assert not {t for t in targets if t.startswith(("drake_traj.planners", "drake_traj.diagram",
+            assert not {t for t in targets if t.startswith(("drake_traj.planners", "drake_traj.station",
                                                             "drake_traj.scenario"))}, name
         if name.startswith("drake_traj.planners.baselines"):
             assert not {t for t in targets if t.startswith("drake_traj.planners.pajak")}, name
-    assert "drake_traj.diagram" not in set().union(*(GRAPH[n] for n in MODULES if n.startswith("drake_traj.planners")))
+    assert "drake_traj.station" not in set().union(*(GRAPH[n] for n in MODULES if n.startswith("drake_traj.planners")))
 
 
 @pytest.mark.parametrize("config", PLANNER_CONFIGS + (Scenario,), ids=lambda c: c.__name__)

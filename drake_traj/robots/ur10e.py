@@ -689,7 +689,11 @@ class UR10e(Robot):
         return np.array(HOME)
 
     def tcp_pose(self, q) -> np.ndarray:
-        return task_pose(q)
+        """:func:`task_pose` for one q; the closed form of :func:`ur10e_kinematics` for many."""
+        q = np.asarray(q, dtype=float)
+        if q.ndim == 1:
+            return task_pose(q)
+        return ur10e_kinematics(q, np.zeros_like(q))[0]
 
     def tool_position(self, q) -> np.ndarray:
         q = np.asarray(q, dtype=float)

@@ -150,7 +150,7 @@ def test_toppra_failure_is_reported(monkeypatch):
 
 
 def test_planner_runs_in_the_closed_loop():
-    from drake_traj.diagram import simulate
+    from drake_traj.station import simulate
 
     path = geometric_path_from_samples(np.array([Q0, Q0 + np.array([0.6, -0.4, 0.3, 0.2, 0.0, 0.1])]))
     duration, trajectory = time_optimal_along_path(path, KV, KA)
@@ -165,7 +165,7 @@ def test_planner_runs_in_the_closed_loop():
 
 
 def test_faster_than_the_pajak_run_on_its_own_path():
-    from drake_traj.diagram import simulate
+    from drake_traj.station import simulate
     from drake_traj.scenario import load_scenario, make_planner
 
     result = simulate(make_planner(load_scenario("diagrams/pajak.yaml", "sim3")))

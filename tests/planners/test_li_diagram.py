@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from drake_traj.diagram import simulate
+from drake_traj.station import simulate
 from drake_traj.robots import get_robot
 from drake_traj.scenario import load_scenario, make_planner
 

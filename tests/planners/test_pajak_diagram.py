@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from drake_traj.robots import ur10e as robot
-from drake_traj.diagram import simulate
+from drake_traj.station import simulate
 from drake_traj.planners import pajak as P
 from drake_traj.planners.pajak import parameters as pajak_parameters
 from drake_traj.result import SimulationResult

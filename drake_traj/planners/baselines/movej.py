@@ -304,7 +304,7 @@ class MovejPlanner(TimeLawPlanner):
         robot: the robot (for the tool positions at the waypoints).
     """
 
-    def __init__(self, law: MovejBlendLaw, *, speed_cap: float = 1.0, update_period: float = 0.01,
+    def __init__(self, law: MovejBlendLaw, *, speed_cap: float = 1.0, update_period: float = 0.001,
                  robot: Robot = UR10E):
         if not isinstance(law, MovejBlendLaw):
             raise ValueError(f"law must be a MovejBlendLaw, got {type(law).__name__}")

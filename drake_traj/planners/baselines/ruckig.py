@@ -221,7 +221,7 @@ class RuckigPlanner(TimeLawPlanner):
         robot: the robot (for the tool positions at the waypoints).
     """
 
-    def __init__(self, law: RuckigStopLaw, *, speed_cap: float = 1.0, update_period: float = 0.01,
+    def __init__(self, law: RuckigStopLaw, *, speed_cap: float = 1.0, update_period: float = 0.001,
                  robot: Robot = UR10E):
         super().__init__(
             law,

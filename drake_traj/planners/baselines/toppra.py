@@ -278,7 +278,7 @@ class ToppraPlanner(TimeLawPlanner):
     """
 
     def __init__(self, law: ToppraLaw, velocity_limit, acceleration_limit, *, speed_cap: float = 1.0,
-                 update_period: float = 0.01):
+                 update_period: float = 0.001):
         n = law.num_joints
         super().__init__(
             law,

@@ -28,6 +28,8 @@ class PajakPlanner(PlannerSystem):
         q_initial: joint positions at t = 0 [rad].
     """
 
+    plans_online = True
+
     def __init__(self, parameters: PajakConfig, q_initial):
         self.law = PajakLaw(parameters)
         update_period = self.law.parameters.update_period
@@ -70,9 +72,12 @@ class PajakPlanner(PlannerSystem):
         return self.law.parameters.waypoints[:, :3].copy()
 
     def _update(self, context, discrete_state):
-        updated = self.law.update(*self._law_arguments(context))
+        t, q, qd, discrete = self._law_arguments(context)
+        updated = self.law.update(t, q, qd, discrete)
         discrete_state.get_mutable_vector(self.scaling_state_index).SetFromVector(updated[: C0 + 1])
         discrete_state.get_mutable_vector(self.task_state_index).SetFromVector(updated[C0 + 1 :])
+        if self.law.finished(q, qd, updated):
+            self._record_finish(discrete_state.get_mutable_vector(self.finish_state_index), t)
 
 
 def make(config: PajakConfig, robot: Robot, q_initial) -> PajakPlanner:
