@@ -1,85 +1,217 @@
-"""``drake-traj``: run scenarios from the command line.
+"""``drake-traj``: run scenarios, list them, benchmark the planners.
 
-    drake-traj run [SCENARIO.yaml] [--variant NAME] [--out DIR] [--meshcat]
+    drake-traj run [SCENARIO] [--variant NAME] [--out DIR] [--overwrite] [--no-preflight]
+                   [--meshcat [--port P] [--rate R] [--no-wait] [--wait-timeout S]]
+    drake-traj list
     drake-traj bench [--out DIR] [--count N] [--seed S] [--repeats R]
 
-``run`` writes DIR/result.npz, DIR/metrics.json, DIR/*.png and DIR/meshcat.html; ``bench`` runs
+``run`` writes DIR/result.npz, metrics.json, *.png, meshcat.html and run.json (the manifest);
+SCENARIO is a YAML file or the name of a shipped scenario (``drake-traj list``). ``bench`` runs
 every planner and baseline on Pająk 2024's task and N seeded tasks and writes DIR/bench.csv,
-DIR/bench.md and DIR/bench.png.
-"""
+bench.md and bench.png.
 
-from __future__ import annotations
+Exit codes: 0 success; 1 the run failed (its log is kept in the output folder); 2 bad input
+(nothing was run); 130 interrupted (what was logged is kept). ``--debug`` shows the traceback of
+an error.
+"""
 
 import argparse
 import json
 import sys
+import traceback
 from pathlib import Path
 
-from pydrake.geometry import Meshcat
+import numpy as np
+from tqdm import tqdm
 
+from drake_traj import __version__
 from drake_traj.bench import bench
+from drake_traj.errors import DrakeTrajError, PlanningError
+from drake_traj.meshcat import add_live_view, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
+from drake_traj.rundir import prepare_output, write_manifest
+from drake_traj.scenario import DEFAULT_SCENARIO, default_scenario_path, find_scenario, load_scenario, shipped_scenarios
 from drake_traj.station import simulate
-from drake_traj.meshcat import draw_task, export_html
-from drake_traj.scenario import DEFAULT_SCENARIO, default_scenario_path, load_scenario
+
+EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+SUMMARY = ("name", "succeeded", "failure", "duration_s", "max_velocity_over_limit", "max_acceleration_over_limit",
+           "tracking_error_joint_max_rad", "tracking_error_tcp_max_m", "real_time_factor")
 
 
-def run(scenario_path, out_dir, *, variant: str | None = None, live_meshcat: bool = False) -> int:
-    """Simulate one scenario and write its outputs; returns the process exit code."""
-    scenario = load_scenario(scenario_path, variant)
-    out_dir = Path(out_dir) if out_dir else Path("out") / scenario.name
-    meshcat = Meshcat()
-    if live_meshcat:
-        print(f"Meshcat: {meshcat.web_url()}", flush=True)
-    arguments = scenario.station_arguments()
-    planner = arguments.pop("planner")
-    simulator_config = scenario.simulator
-    if live_meshcat:
-        simulator_config.target_realtime_rate = 1.0
-    result = simulate(planner, name=scenario.name, simulator_config=simulator_config, settle_time=scenario.settle_time,
-                      max_duration=scenario.max_duration, meshcat=meshcat, **arguments)
-    result.save(out_dir)
-    result.save_figures(out_dir)
-    for stem, figure in planner.figures().items():
-        figure.savefig(out_dir / f"{stem}.png", dpi=110)
-    draw_task(meshcat, result)
-    export_html(meshcat, out_dir / "meshcat.html")
+class Progress:
+    """The stage and the simulated time, as a tqdm bar on a terminal; silent otherwise."""
+
+    def __init__(self, total: float, *, enabled: bool):
+        self._bar = tqdm(total=round(total, 3), unit="s", desc="planning", disable=not enabled, file=sys.stderr,
+                         bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}]")
+
+    def stage(self, name: str) -> None:
+        self._bar.set_description_str(name)
+
+    def expect(self, total: float) -> None:
+        """The simulated time the run is expected to take [s]."""
+        self._bar.total = round(total, 3)
+
+    def simulated(self, t: float) -> None:
+        self._bar.n = min(round(t, 3), self._bar.total)
+        self._bar.refresh()
+
+    def close(self) -> None:
+        self._bar.close()
+
+
+def _scenario_reference(args) -> tuple[Path, str | None]:
+    if args.scenario is None:
+        return default_scenario_path(), args.variant or DEFAULT_SCENARIO[1]
+    return find_scenario(args.scenario, args.variant)
+
+
+def run(args) -> int:
+    """``drake-traj run``: simulate one scenario and write its outputs; returns the exit code."""
+    scenario = load_scenario(*_scenario_reference(args))
+    out_dir = prepare_output(Path(args.out) if args.out else Path("out") / scenario.name, overwrite=args.overwrite)
+    progress = Progress(scenario.max_duration, enabled=sys.stderr.isatty())
+    try:
+        arguments = scenario.station_arguments()
+        planner = arguments.pop("planner")
+        planned_path = None
+        if args.preflight:
+            progress.stage("preflight")
+            planned_path = planner.preflight()
+        duration = planner.planned_duration()
+        progress.expect(duration + scenario.settle_time if np.isfinite(duration) else scenario.max_duration)
+        meshcat = start_meshcat(args.port, announce=args.meshcat)
+        draw_task(meshcat, planner.task_waypoints(), planned_path=planned_path)
+        frame_task(meshcat, np.vstack([planner.task_waypoints().reshape(-1, 3),
+                                       planned_path if planned_path is not None else np.zeros((0, 3))]))
+        simulator_config = scenario.simulator
+        add_systems = before_run = None
+        if args.meshcat:
+            simulator_config.target_realtime_rate = args.rate
+            print(f"Meshcat: {meshcat.web_url()}", file=sys.stderr, flush=True)
+
+            def add_systems(builder, station):
+                add_live_view(builder, station, meshcat, arguments["robot"])
+
+            def before_run(simulator):
+                if args.wait:
+                    print(f"waiting up to {args.wait_timeout:g} s for a browser at {meshcat.web_url()} "
+                          "(--no-wait starts at once)", file=sys.stderr, flush=True)
+                    if not wait_for_browser(meshcat, args.wait_timeout):
+                        print(f"no browser connected within {args.wait_timeout:g} s; starting the motion",
+                              file=sys.stderr, flush=True)
+
+        progress.stage("simulating")
+        result = simulate(planner, name=scenario.name, simulator_config=simulator_config,
+                          settle_time=scenario.settle_time, max_duration=scenario.max_duration,
+                          speed_override=None if args.meshcat else scenario.speed_override, meshcat=meshcat,
+                          progress=progress.simulated, add_systems=add_systems, before_run=before_run, **arguments)
+        progress.stage("writing figures")
+        result.save(out_dir)
+        files = ["result.npz", "metrics.json"] + [path.name for path in result.save_figures(out_dir)]
+        for stem, figure in planner.figures().items():
+            figure.savefig(out_dir / f"{stem}.png", dpi=110)
+            files.append(f"{stem}.png")
+        draw_tcp_path(meshcat, result.tcp)
+        files.append(export_html(meshcat, out_dir / "meshcat.html").name)
+        write_manifest(out_dir, files, scenario=scenario.name, drake_traj=__version__,
+                       failure=None if result.failure is None else result.failure.to_dict())
+    finally:
+        progress.close()
     metrics = result.metrics().to_dict()
-    print(json.dumps({key: metrics[key] for key in (
-        "name", "succeeded", "failure", "duration_s", "max_velocity_over_limit",
-        "max_acceleration_over_limit", "tracking_error_joint_max_rad", "tracking_error_tcp_max_m",
-        "real_time_factor")}, indent=2))
-    print(f"wrote {out_dir}/result.npz, metrics.json, *.png, meshcat.html")
-    if live_meshcat:
-        input("Meshcat is serving the recording; press Enter to quit. ")
-    return 0 if result.succeeded else 1
+    print(json.dumps({key: metrics[key] for key in SUMMARY}, indent=2))
+    print(f"wrote {out_dir}: {', '.join(sorted(files))}")
+    if args.meshcat and sys.stdin.isatty():
+        print(f"Meshcat is serving the recording at {meshcat.web_url()}; press Ctrl-C to quit.", file=sys.stderr)
+        try:
+            while True:
+                input()
+        except (KeyboardInterrupt, EOFError):
+            pass
+    if result.succeeded:
+        return EXIT_OK
+    return EXIT_INTERRUPTED if result.failure.cause == "interrupted" else EXIT_RUN_FAILED
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="drake-traj", description=__doc__.splitlines()[0])
+def list_scenarios(args) -> int:
+    """``drake-traj list``: the shipped scenarios, a line each."""
+    entries = shipped_scenarios()
+    width = max(len(entry.name) for entry in entries)
+    for entry in entries:
+        print(f"{entry.name:{width}}  {entry.description}")
+    return EXIT_OK
+
+
+def run_bench(args) -> int:
+    """``drake-traj bench``."""
+    bench(args.out, count=args.count, seed=args.seed, repeats=args.repeats)
+    return EXIT_OK
+
+
+def check_options(parser: argparse.ArgumentParser, args) -> None:
+    """Options argparse cannot check by type: an error (exit 2) names the option and the value."""
+    checks = []
+    if args.command == "run":
+        checks = [("--port", args.port is None or 1 <= args.port <= 65535, args.port, "a port number 1-65535"),
+                  ("--rate", np.isfinite(args.rate) and args.rate > 0, args.rate, "a positive real-time rate"),
+                  ("--wait-timeout", np.isfinite(args.wait_timeout) and args.wait_timeout >= 0, args.wait_timeout,
+                   "a number of seconds >= 0")]
+    for option, ok, value, expected in checks:
+        if not ok:
+            parser.error(f"{option} must be {expected}, got {value}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="drake-traj", description=__doc__.splitlines()[0],
+                                     epilog="exit codes: 0 success, 1 run failed (log kept), 2 bad input, 130 interrupted")
+    parser.add_argument("--version", action="version", version=f"drake-traj {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     commands = parser.add_subparsers(dest="command", required=True)
     run_parser = commands.add_parser("run", help="simulate a scenario and write its results")
+    run_parser.set_defaults(handler=run)
     run_parser.add_argument("scenario", nargs="?", default=None,
-                            help=f"scenario YAML (default: {DEFAULT_SCENARIO[0]}, variant {DEFAULT_SCENARIO[1]})")
+                            help=f"a scenario YAML file or a shipped scenario's name (default: {DEFAULT_SCENARIO[0]}, "
+                                 f"variant {DEFAULT_SCENARIO[1]}; see drake-traj list)")
     run_parser.add_argument("--variant", default=None, help="the variant to run, in a file of several")
-    run_parser.add_argument("--out", default=None, help="output directory (default: out/<scenario name>)")
-    run_parser.add_argument("--meshcat", action="store_true", help="serve Meshcat live during the run")
+    run_parser.add_argument("--out", default=None, help="output folder (default: out/<scenario name>)")
+    run_parser.add_argument("--overwrite", action="store_true", help="replace an earlier run in the output folder")
+    run_parser.add_argument("--no-preflight", dest="preflight", action="store_false",
+                            help="do not check the whole task before the motion (online planners)")
+    live = run_parser.add_argument_group("live view")
+    live.add_argument("--meshcat", action="store_true", help="show the run live in Meshcat, in real time")
+    live.add_argument("--port", type=int, default=None, help="Meshcat's port (default: the first free from 7000)")
+    live.add_argument("--rate", type=float, default=1.0, help="real-time rate of the live run (default 1)")
+    live.add_argument("--no-wait", dest="wait", action="store_false", help="start the motion without waiting for a browser")
+    live.add_argument("--wait-timeout", type=float, default=60.0, help="how long to wait for a browser [s] (default 60)")
+    list_parser = commands.add_parser("list", help="list the shipped scenarios")
+    list_parser.set_defaults(handler=list_scenarios)
     bench_parser = commands.add_parser("bench", help="compare every planner and baseline on UR10e tasks")
+    bench_parser.set_defaults(handler=run_bench)
     bench_parser.add_argument("--out", default="out/bench", help="output directory (default: out/bench)")
     bench_parser.add_argument("--count", type=int, default=20, help="seeded random tasks besides the paper's")
     bench_parser.add_argument("--seed", type=int, default=0)
     bench_parser.add_argument("--repeats", type=int, default=5, help="planning-time repeats on the paper task")
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
     args = parser.parse_args(argv)
-    if args.command == "bench":
-        bench(args.out, count=args.count, seed=args.seed, repeats=args.repeats)
-        return 0
     try:
-        if args.scenario is None:
-            return run(default_scenario_path(), args.out, variant=args.variant or DEFAULT_SCENARIO[1],
-                       live_meshcat=args.meshcat)
-        return run(args.scenario, args.out, variant=args.variant, live_meshcat=args.meshcat)
-    except ValueError as error:
-        print(f"drake-traj: error: {error}", file=sys.stderr)
-        return 2
+        check_options(parser, args)
+        return args.handler(args)
+    except KeyboardInterrupt:
+        print("drake-traj: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except (DrakeTrajError, ValueError) as error:  # bad input: one paragraph, no traceback
+        kind = "the task cannot be done" if isinstance(error, PlanningError) else "error"
+        print(f"drake-traj: {kind}: {error}", file=sys.stderr)
+        code = EXIT_BAD_INPUT
+    except Exception as error:  # a bug, or the machine (disk full, ...): still no traceback unless asked
+        print(f"drake-traj: internal error: {type(error).__name__}: {error} (--debug shows where)", file=sys.stderr)
+        code = EXIT_RUN_FAILED
+    if args.debug:
+        traceback.print_exc()
+    return code
 
 
 if __name__ == "__main__":

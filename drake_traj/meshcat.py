@@ -1,38 +1,131 @@
-"""Meshcat extras: the task's waypoints and TCP path, and the standalone HTML recording."""
+"""Meshcat: the task drawn before the motion, a live view (TCP trail, speed slider, waiting for a
+browser), and the standalone HTML recording.
 
-from __future__ import annotations
+Paths in the Meshcat scene tree: ``/drake_traj/waypoints/<k>`` (each waypoint's neighbourhood,
+orange), ``/drake_traj/planned_path`` (the path a planner computed before moving, grey),
+``/drake_traj/trail`` (the measured TCP, growing live, red) and ``/drake_traj/tcp_path`` (the
+measured TCP path of a finished run, red).
+"""
 
+import logging
+import time
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import Meshcat, Rgba, Sphere
+from pydrake.geometry import Meshcat, MeshcatParams, Rgba, Sphere
 from pydrake.math import RigidTransform
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
-from drake_traj.result import SimulationResult
+from drake_traj.robots import Robot
+
+__all__ = [
+    "SPEED_SLIDER", "SpeedSlider", "TcpTrail", "add_live_view", "draw_task", "draw_tcp_path", "export_html", "frame_task",
+    "start_meshcat", "wait_for_browser",
+]
 
 WAYPOINT_COLOUR = Rgba(1.0, 0.55, 0.0, 0.5)
 PATH_COLOUR = Rgba(0.9, 0.1, 0.1, 1.0)
+PLANNED_COLOUR = Rgba(0.35, 0.35, 0.35, 1.0)
+SPEED_SLIDER = "speed override"
 
 
-def draw_task(meshcat: Meshcat, result: SimulationResult, *, waypoint_radius: float = 0.05) -> None:
-    """Waypoint spheres (radius [m], default Pająk 2024's neighbourhood) and the measured TCP path."""
+def start_meshcat(port: int | None = None, *, announce: bool = True) -> Meshcat:
+    """A Meshcat server (on ``port``, or the first free one from 7000). Drake announces its URL on
+    the console; ``announce=False`` keeps it quiet (a server used only to write a recording)."""
+    drake_log = logging.getLogger("drake")
+    level = drake_log.level
+    if not announce:
+        drake_log.setLevel(logging.WARNING)
+    try:
+        return Meshcat(MeshcatParams(port=port)) if port is not None else Meshcat()
+    finally:
+        drake_log.setLevel(level)
+
+
+def draw_task(meshcat: Meshcat, waypoints, *, neighbourhood: float = 0.05, planned_path=None) -> None:
+    """Waypoint neighbourhoods (spheres of radius ``neighbourhood`` [m], default Pająk 2024's ϵ)
+    at ``waypoints`` (m, 3) [m], and the ``planned_path`` (N, 3) [m] where a planner computed it
+    before moving. Replaces what an earlier call drew."""
     meshcat.Delete("/drake_traj")
-    for index, point in enumerate(result.waypoints):
+    for index, point in enumerate(np.asarray(waypoints, dtype=float).reshape(-1, 3)):
         path = f"/drake_traj/waypoints/{index}"
-        meshcat.SetObject(path, Sphere(waypoint_radius), WAYPOINT_COLOUR)
-        meshcat.SetTransform(path, RigidTransform(np.asarray(point, dtype=float)))
-    if len(result.tcp) > 1:
-        meshcat.SetLine("/drake_traj/tcp_path", result.tcp[:, :3].T.copy(), 3.0, PATH_COLOUR)
+        meshcat.SetObject(path, Sphere(neighbourhood), WAYPOINT_COLOUR)
+        meshcat.SetTransform(path, RigidTransform(point))
+    if planned_path is not None and len(planned_path) > 1:
+        meshcat.SetLine("/drake_traj/planned_path", np.asarray(planned_path, dtype=float).T.copy(), 2.0, PLANNED_COLOUR)
+
+
+def draw_tcp_path(meshcat: Meshcat, points) -> None:
+    """The measured TCP path (N, 3) [m] of a run, red."""
+    if len(points) > 1:
+        meshcat.SetLine("/drake_traj/tcp_path", np.asarray(points, dtype=float)[:, :3].T.copy(), 3.0, PATH_COLOUR)
+
+
+def frame_task(meshcat: Meshcat, points) -> None:
+    """Point the camera at the task: from the front, above and to the side of the box around
+    ``points`` (N, 3) [m] and the robot's base (base frame, z up), far enough to see it all."""
+    points = np.vstack([np.asarray(points, dtype=float).reshape(-1, 3), np.zeros((1, 3))])
+    low, high = points.min(axis=0), points.max(axis=0)
+    target = 0.5 * (low + high)
+    size = max(float(np.linalg.norm(high - low)), 0.5)
+    direction = np.array([0.55, -0.7, 0.45])  # in front of the UR10e (its workspace is at -y), above
+    meshcat.SetCameraPose(camera_in_world=target + 1.2 * size * direction / np.linalg.norm(direction),
+                          target_in_world=target)
 
 
 def export_html(meshcat: Meshcat, path) -> Path:
-    """Write the scene and its recording as one self-contained HTML file (no server needed).
-
-    The camera is placed in front of and above the arm (base frame, z up) so the whole
-    workspace in front of it is in view.
-    """
+    """Write the scene and its recording as one self-contained HTML file (no server needed)."""
     path = Path(path)
-    meshcat.SetCameraPose(camera_in_world=[0.9, -1.6, 1.1], target_in_world=[-0.1, -0.4, 0.45])
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(meshcat.StaticHtml())
     return path
+
+
+def wait_for_browser(meshcat: Meshcat, timeout: float, *, poll: float = 0.1) -> bool:
+    """Wait until a browser has the page open, at most ``timeout`` [s]; True if one connected."""
+    deadline = time.monotonic() + timeout
+    while meshcat.GetNumActiveConnections() == 0:
+        if time.monotonic() >= deadline:
+            return False
+        time.sleep(poll)
+    return True
+
+
+class TcpTrail(LeafSystem):
+    """Draws the measured TCP as a growing line in Meshcat (``/drake_traj/trail``), ``rate`` times
+    per second of simulated time, from the plant state input [q; q̇]. Live view only: it is a
+    Python publish event, outside the per-step path at 1 ms."""
+
+    def __init__(self, meshcat: Meshcat, robot: Robot, *, rate: float = 20.0):
+        super().__init__()
+        self._meshcat = meshcat
+        self._robot = robot
+        self._points: list[np.ndarray] = []
+        self._state = self.DeclareVectorInputPort("state", 2 * robot.num_joints)
+        self.DeclarePeriodicPublishEvent(1.0 / rate, 0.0, self._draw)
+
+    def _draw(self, context):
+        q = self._state.Eval(context)[: self._robot.num_joints]
+        self._points.append(self._robot.tool_position(q))
+        if len(self._points) > 1:
+            self._meshcat.SetLine("/drake_traj/trail", np.array(self._points).T, 3.0, PATH_COLOUR)
+
+
+class SpeedSlider(LeafSystem):
+    """A Meshcat slider ``speed override`` (0 to 1) as a source for a station's speed_override."""
+
+    def __init__(self, meshcat: Meshcat, *, initial: float = 1.0):
+        super().__init__()
+        self._meshcat = meshcat
+        meshcat.AddSlider(SPEED_SLIDER, 0.0, 1.0, 0.01, initial)
+        self.DeclareVectorOutputPort("speed_override", 1,
+                                     lambda context, out: out.SetAtIndex(0, meshcat.GetSliderValue(SPEED_SLIDER)))
+
+
+def add_live_view(builder: DiagramBuilder, station, meshcat: Meshcat, robot: Robot) -> None:
+    """Add a :class:`TcpTrail` on the station's measured state and a :class:`SpeedSlider` on its
+    ``speed_override`` input."""
+    trail = builder.AddNamedSystem("tcp_trail", TcpTrail(meshcat, robot))
+    builder.Connect(station.GetOutputPort("measured_state"), trail.get_input_port())
+    slider = builder.AddNamedSystem("speed_slider", SpeedSlider(meshcat))
+    builder.Connect(slider.get_output_port(), station.GetInputPort("speed_override"))

@@ -17,12 +17,15 @@ from pydrake.common.yaml import yaml_load, yaml_load_typed
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
-from drake_traj.station import ControllerGains, default_plant_config, default_simulator_config
+from drake_traj.station import ControllerGains, SpeedOverride, default_plant_config, default_simulator_config
 from drake_traj.planners import PlannerConfig, PlannerSystem, QuinticConfig
 from drake_traj.planners import make_planner as make_planner_from_config
 from drake_traj.robots import get_robot
 
-__all__ = ["Scenario", "default_scenario_path", "load_scenario", "make_planner", "scenario_variants"]
+__all__ = [
+    "Scenario", "ShippedScenario", "default_scenario_path", "find_scenario", "load_scenario", "make_planner",
+    "scenario_variants", "shipped_scenarios",
+]
 
 DEFAULT_SCENARIO = ("pajak.yaml", "sim3")  # what ``drake-traj run`` runs when given no scenario
 
@@ -32,7 +35,8 @@ class Scenario:
     """One experiment: robot, start, planner, controller and simulation settings (times in seconds).
 
     Attributes:
-        name: a label (the default output folder's name).
+        name: a plain name (letters, digits, ``_``, ``-``, ``.``): the default output folder.
+        description: one line on what the scenario runs.
         robot: a name of :data:`drake_traj.robots.ROBOT_NAMES` ("ur10e", "li_4dof" of Li et al.
             2019, or Boryga's "anthropomorphic", "scara", "cartesian").
         q_initial: the robot's start [rad or m]; empty: its home configuration (the UR10e's is the
@@ -45,11 +49,14 @@ class Scenario:
         simulator: Drake's ``SimulatorConfig`` (integration scheme, step, accuracy, real-time
             rate; default fixed-step RK2 at 1 ms, see ``station.default_simulator_config``).
         log_period: the loggers' period [s].
+        speed_override: a speed-override profile (times [s], values in [0, 1]), like a pendant's
+            speed slider; empty: none.
         settle_time: how long the run goes on after the planner finishes [s].
         max_duration: the run stops with a failure if the planner has not finished by then [s].
     """
 
     name: str = "unnamed"
+    description: str = ""
     robot: str = "ur10e"
     q_initial: list[float] = field(default_factory=list)
     planner: PlannerConfig = field(default_factory=QuinticConfig)
@@ -57,6 +64,7 @@ class Scenario:
     plant: MultibodyPlantConfig = field(default_factory=default_plant_config)
     simulator: SimulatorConfig = field(default_factory=default_simulator_config)
     log_period: float = 0.001
+    speed_override: SpeedOverride = field(default_factory=SpeedOverride)
     settle_time: float = 0.5
     max_duration: float = 120.0
 
@@ -93,6 +101,7 @@ class Scenario:
             raise ValueError(f"simulator.integration_scheme must be one of {GetIntegrationSchemes()}, "
                              f"got {self.simulator.integration_scheme!r}")
         self.controller.for_robot(robot)
+        self.speed_override.validate()
 
     def station_arguments(self) -> dict:
         """The keyword arguments of :func:`drake_traj.station.build_station` for this scenario
@@ -101,9 +110,55 @@ class Scenario:
                     plant_config=self.plant, log_period=self.log_period)
 
 
+def shipped_directory() -> Path:
+    """The folder of the scenario files shipped with the package (``diagrams/``)."""
+    return Path(str(resources.files("drake_traj.diagrams")))
+
+
 def default_scenario_path() -> Path:
     """The scenario file ``drake-traj run`` uses when none is given (its variant: ``sim3``)."""
-    return Path(str(resources.files("drake_traj.diagrams").joinpath(DEFAULT_SCENARIO[0])))
+    return shipped_directory() / DEFAULT_SCENARIO[0]
+
+
+@dataclass(frozen=True)
+class ShippedScenario:
+    """A scenario shipped with the package: its name, file, variant (None for a file of one
+    scenario) and one-line description."""
+
+    name: str
+    path: Path
+    variant: str | None
+    description: str
+
+
+def shipped_scenarios() -> list[ShippedScenario]:
+    """Every scenario of the shipped files, in file order."""
+    entries = []
+    for path in sorted(shipped_directory().glob("*.yaml")):
+        for variant in scenario_variants(path) or [None]:
+            scenario = load_scenario(path, variant)
+            entries.append(ShippedScenario(scenario.name, path, variant, scenario.description))
+    return entries
+
+
+def find_scenario(reference: str, variant: str | None = None) -> tuple[Path, str | None]:
+    """(file, variant) of a scenario given as a path, or as the name of a shipped scenario
+    (``pajak_sim3``) or of a shipped file (``pajak``, with ``variant``)."""
+    path = Path(reference)
+    if path.is_file():
+        return path, variant
+    if path.suffix in (".yaml", ".yml") or len(path.parts) > 1:
+        raise ValueError(f"scenario file not found: {path}")
+    shipped = shipped_scenarios()
+    for entry in shipped:
+        if entry.name == reference and variant in (None, entry.variant):
+            return entry.path, entry.variant
+    stem = shipped_directory() / f"{reference}.yaml"
+    if stem.is_file():
+        return stem, variant
+    names = ", ".join(entry.name for entry in shipped)
+    raise ValueError(f"no scenario file {reference!r} and no shipped scenario of that name; "
+                     f"shipped: {names} (drake-traj list)")
 
 
 def scenario_variants(path) -> list[str]:

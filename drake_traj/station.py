@@ -53,7 +53,14 @@ from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 from pydrake.systems.controllers import InverseDynamics
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, TriggerType
-from pydrake.systems.primitives import LogVectorOutput, MatrixGain, Multiplexer
+from pydrake.systems.primitives import (
+    ConstantVectorSource,
+    LogVectorOutput,
+    MatrixGain,
+    Multiplexer,
+    TrajectorySource,
+)
+from pydrake.trajectories import PiecewisePolynomial
 
 from drake_traj.errors import Failure
 from drake_traj.planners.base import PlannerSystem
@@ -62,8 +69,8 @@ from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import positive_scalar
 
 __all__ = [
-    "ControllerGains", "Station", "add_station", "build_station", "default_plant_config",
-    "default_simulator_config", "make_station", "run_station", "simulate",
+    "ControllerGains", "SpeedOverride", "Station", "add_speed_override", "add_station", "build_station",
+    "default_plant_config", "default_simulator_config", "make_station", "run_station", "simulate",
 ]
 
 
@@ -111,6 +118,52 @@ class ControllerGains:
                 raise ValueError(f"controller.{name} must be finite and non-negative, got {gains.tolist()}")
         if not np.all(np.asarray(self.kp) > 0):
             raise ValueError(f"controller.kp must be positive, got {self.kp}")
+
+
+@dataclass
+class SpeedOverride:
+    """A speed-override profile, like a UR pendant's speed slider: ``values[k]`` in [0, 1] from
+    ``times[k]`` [s] on (held until the next time), 1 before the first time. Empty: no override.
+    """
+
+    times: list[float] = field(default_factory=list)
+    values: list[float] = field(default_factory=list)
+
+    def validate(self) -> None:
+        """Raise ValueError naming the field that is malformed."""
+        times, values = np.asarray(self.times, dtype=float), np.asarray(self.values, dtype=float)
+        if times.shape != values.shape or times.ndim != 1:
+            raise ValueError(f"speed_override.times and speed_override.values must be two lists of equal length, "
+                             f"got {len(self.times)} and {len(self.values)} entries")
+        if not np.all(np.isfinite(times)) or np.any(times < 0) or np.any(np.diff(times) <= 0):
+            raise ValueError(f"speed_override.times must be finite, >= 0 and increasing [s], got {self.times}")
+        if not np.all(np.isfinite(values)) or np.any((values < 0) | (values > 1)):
+            raise ValueError(f"speed_override.values must be in [0, 1], got {self.values}")
+
+    def trajectory(self) -> PiecewisePolynomial:
+        """The profile as a zero-order hold (1 before the first time)."""
+        self.validate()
+        breaks = [0.0] + [t for t in self.times if t > 0.0]
+        values = ([1.0] if self.times[0] > 0.0 else []) + list(self.values)
+        breaks.append(breaks[-1] + 1.0)  # a zero-order hold ignores its last sample: repeat the last value
+        values.append(values[-1])
+        return PiecewisePolynomial.ZeroOrderHold(breaks, np.array([values]))
+
+
+def add_speed_override(builder: DiagramBuilder, station: Diagram, speed_override) -> None:
+    """Drive ``station``'s ``speed_override`` input from a constant in [0, 1] or a
+    :class:`SpeedOverride` profile; None or an empty profile leaves it unconnected (1)."""
+    if speed_override is None or (isinstance(speed_override, SpeedOverride) and not speed_override.times):
+        return
+    if isinstance(speed_override, SpeedOverride):
+        source = TrajectorySource(speed_override.trajectory())
+    else:
+        value = float(speed_override)
+        if not 0.0 <= value <= 1.0:
+            raise ValueError(f"speed_override must be in [0, 1], got {speed_override}")
+        source = ConstantVectorSource([value])
+    builder.AddNamedSystem("speed_override", source)
+    builder.Connect(source.get_output_port(), station.GetInputPort("speed_override"))
 
 
 class TcpPose(LeafSystem):
@@ -247,12 +300,14 @@ def make_station(scenario, meshcat: Meshcat | None = None) -> Diagram:
 
 
 def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 0.5,
-                max_duration: float = 120.0) -> Failure | None:
+                max_duration: float = 120.0, progress=None) -> Failure | None:
     """Advance ``simulator`` (over ``station``, possibly inside a larger diagram) until the
     planner has finished plus ``settle_time`` [s], or ``max_duration`` [s].
 
-    Any exception from the simulation is caught: the state and logs stay as they were when it
-    happened. Returns None when the planner finished, else the :class:`Failure`.
+    Any exception from the simulation, and Ctrl-C (KeyboardInterrupt), is caught: the state and
+    logs stay as they were when it happened. ``progress(t)`` is called with the simulated time
+    every 10 ms of it. Returns None when the planner finished, else the :class:`Failure`
+    (cause "interrupted" for Ctrl-C).
     """
     positive_scalar(max_duration, "max_duration", "s")
     if not np.isfinite(settle_time) or settle_time < 0:
@@ -264,12 +319,16 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
     try:
         while root.get_time() < max_duration:
             simulator.AdvanceTo(min(root.get_time() + chunk, max_duration))
+            if progress is not None:
+                progress(root.get_time())
             finish = planner.finish_time(planner_context)
             if np.isfinite(finish):
                 simulator.AdvanceTo(min(max(finish + settle_time, root.get_time()), max_duration))
                 return None
         return Failure("timeout", f"planner did not finish within max_duration = {max_duration} s", root.get_time(),
                        tuple(planner.reference_state(planner_context)[: planner.num_joints].tolist()))
+    except KeyboardInterrupt:
+        return Failure("interrupted", f"interrupted at t = {root.get_time():.4f} s", root.get_time())
     except Exception as error:  # keep the log up to the failure; the reason goes in the result
         return Failure.from_exception(error, root.get_time())
 
@@ -285,31 +344,50 @@ def simulate(
     log_period: float = 1e-3,
     settle_time: float = 0.5,
     max_duration: float = 120.0,
+    speed_override=None,
     meshcat: Meshcat | None = None,
+    progress=None,
+    add_systems=None,
+    before_run=None,
 ) -> SimulationResult:
-    """Run ``planner`` in the station until it finishes, plus ``settle_time`` [s].
+    """Run ``planner`` in a station until it finishes, plus ``settle_time`` [s].
 
     The run stops at ``max_duration`` [s] if the planner has not finished. Whatever stops the run
-    early (an exception from a planner, a timeout) is caught: the result holds everything logged
-    up to that point and ``failure`` gives the reason. With ``meshcat``, the run is recorded there
-    (see :func:`drake_traj.meshcat.export_html`).
+    early (an exception from a planner, a timeout, Ctrl-C) is caught: the result holds everything
+    logged up to that point and ``failure`` gives the reason. With ``meshcat``, the run is recorded
+    there (see :func:`drake_traj.meshcat.export_html`).
 
     Args (the rest as :func:`add_station`):
         simulator_config: integration scheme, step, accuracy and real-time rate (default
             :func:`default_simulator_config`).
+        speed_override: a constant in [0, 1] or a :class:`SpeedOverride` profile on the
+            station's ``speed_override`` input (None: unconnected, 1).
+        progress: called with the simulated time [s] as the run goes (see :func:`run_station`).
+        add_systems: ``add_systems(builder, station)`` adds systems around the station before the
+            diagram is built (e.g. a speed-override source of one's own).
+        before_run: ``before_run(simulator)`` is called once the simulator is initialized (the
+            robot drawn at its start), before the motion (e.g. to wait for a browser).
     """
-    station = build_station(planner, robot=robot, gains=gains, plant_config=plant_config, log_period=log_period,
-                            meshcat=meshcat)
-    simulator = Simulator(station)
+    builder = DiagramBuilder()
+    station = builder.AddSystem(build_station(planner, robot=robot, gains=gains, plant_config=plant_config,
+                                              log_period=log_period, meshcat=meshcat))
+    add_speed_override(builder, station, speed_override)
+    if add_systems is not None:
+        add_systems(builder, station)
+    simulator = Simulator(builder.Build())
     ApplySimulatorConfig(simulator_config or default_simulator_config(), simulator)
     visualizer = station.GetSubsystemByName("visualizer") if meshcat is not None else None
     if visualizer is not None:
-        visualizer.StartRecording(False)
+        visualizer.StartRecording(True)  # and draw live
+    simulator.Initialize()
+    if before_run is not None:
+        before_run(simulator)
+        simulator.ResetStatistics()  # the real-time rate counts from here, not from Initialize()
     start = time.perf_counter()
-    failure = run_station(simulator, station, settle_time=settle_time, max_duration=max_duration)
+    failure = run_station(simulator, station, settle_time=settle_time, max_duration=max_duration, progress=progress)
     wall_time = time.perf_counter() - start
     if visualizer is not None:
         visualizer.StopRecording()
         visualizer.PublishRecording()
-    return SimulationResult.from_station(station, simulator.get_context(), name=name, failure=failure,
-                                         wall_time=wall_time)
+    return SimulationResult.from_station(station, station.GetMyContextFromRoot(simulator.get_context()), name=name,
+                                         failure=failure, wall_time=wall_time)

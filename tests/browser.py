@@ -14,10 +14,13 @@ with a shorter budget it shows an intermediate frame.
 from __future__ import annotations
 
 import os
+import select
 import shutil
 import signal
+import socket
 import subprocess
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -56,6 +59,35 @@ def find_chromium() -> str | None:
     return None
 
 
+def free_port() -> int:
+    """A TCP port nobody listens on now (for a Meshcat server of a test)."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def read_until(stream, text: str, *, timeout: float) -> str:
+    """Read ``stream`` line by line until a line contains ``text``; returns what was read.
+    Raises RuntimeError (with what was read) at EOF or after ``timeout`` [s]."""
+    deadline = time.monotonic() + timeout
+    seen = []
+    while time.monotonic() < deadline:
+        if not select.select([stream], [], [], 0.5)[0]:
+            continue
+        line = stream.readline()
+        if not line:
+            break
+        seen.append(line)
+        if text in line:
+            return "".join(seen)
+    raise RuntimeError(f"{text!r} not seen within {timeout} s; got:\n{''.join(seen)}")
+
+
+def screenshot_url(url: str, png_path, **kwargs) -> Path:
+    """:func:`screenshot_html` of a page served at ``url`` (e.g. a live Meshcat)."""
+    return screenshot_html(url, png_path, **kwargs)
+
+
 def screenshot_html(
     html_path: str | os.PathLike,
     png_path: str | os.PathLike,
@@ -68,7 +100,8 @@ def screenshot_html(
     """Render an HTML file in headless Chromium and save a PNG screenshot.
 
     Args:
-        html_path: The page to open, e.g. a file written from Meshcat.StaticHtml().
+        html_path: The page to open, e.g. a file written from Meshcat.StaticHtml(), or an
+            http:// URL (a live Meshcat).
         png_path: Where to write the screenshot; an existing file is replaced.
         width: Window width in pixels.
         height: Window height in pixels.
@@ -88,7 +121,7 @@ def screenshot_html(
         RuntimeError: If no Chromium is found, Chromium times out, or no PNG is
             written.  The message includes Chromium's stderr.
     """
-    html = Path(html_path).resolve(strict=True)
+    page = str(html_path) if str(html_path).startswith("http") else Path(html_path).resolve(strict=True).as_uri()
     png = Path(png_path).resolve()
     if virtual_time_ms <= 0:
         raise ValueError(f"virtual_time_ms must be positive, got {virtual_time_ms}")
@@ -104,7 +137,7 @@ def screenshot_html(
             f"--window-size={width},{height}",
             f"--virtual-time-budget={virtual_time_ms}",
             f"--screenshot={png}",
-            html.as_uri(),
+            page,
         ]
         # Chromium's helper processes inherit its output pipes, so on a timeout
         # the whole process group must be killed for the pipes to close.

@@ -1,4 +1,4 @@
-"""A real browser opens the exported Meshcat recording and the arm is on screen.
+"""A real browser opens the exported Meshcat recording, and the live view, and the arm is on screen.
 
 Headless Chromium (Debian package ``chromium``) renders meshcat.html with software WebGL; we
 count pixels of the arm's blue joint housings (rgba 0.2 0.4 0.9 in models/ur10e.urdf), of the
@@ -6,6 +6,9 @@ red TCP path and of the orange waypoint spheres, against an empty Meshcat scene 
 """
 
 import os
+import subprocess
+import sys
+import time
 
 import pytest
 from pydrake.geometry import Meshcat
@@ -41,3 +44,36 @@ def test_exported_recording_shows_the_arm_and_its_path(quintic_run_dir, empty_sc
     assert empty < 0.0005
     assert arm > 0.002, f"only {arm:.4%} arm-blue pixels: the arm is not drawn"
     assert red_pixels(png) > 200 > red_pixels(empty_scene_png)
+
+
+def orange_pixels(png):
+    rgb = browser._read_rgb(png).astype(int)
+    return int(((rgb[..., 0] > 150) & (rgb[..., 1] > 70) & (rgb[..., 1] < 170) & (rgb[..., 2] < 90)).sum())
+
+
+def test_live_view_shows_the_arm_the_task_and_a_growing_trail(tmp_path):
+    assert CHROMIUM is not None, "CI must install chromium"
+    port = browser.free_port()
+    out = tmp_path / "live"
+    # Half speed: the 6.2 s quintic motion takes 12 s of wall time; no terminal: no prompt after it.
+    process = subprocess.Popen(
+        [sys.executable, "-m", "drake_traj.cli", "run", "quintic_ptp", "--out", str(out), "--meshcat",
+         "--port", str(port), "--rate", "0.5", "--wait-timeout", "120"],
+        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        waiting = browser.read_until(process.stderr, "waiting up to", timeout=120)
+        assert f"http://localhost:{port}" in waiting
+        # The first browser to connect starts the motion; two screenshots 4 s apart catch it mid-way.
+        early = browser.screenshot_url(f"http://localhost:{port}", tmp_path / "early.png")
+        time.sleep(4.0)
+        later = browser.screenshot_url(f"http://localhost:{port}", tmp_path / "later.png")
+        stdout, stderr = process.communicate(timeout=180)
+    finally:
+        process.kill()
+    assert process.returncode == 0, stderr
+    final = browser.screenshot_html(out / "meshcat.html", tmp_path / "final.png", virtual_time_ms=20_000)
+    for png in (early, later):  # the arm and the task (the goals' neighbourhoods, orange)
+        assert browser.blue_pixel_fraction(png) > 0.002
+        assert orange_pixels(png) > 100
+    # The trail grows with the motion and is part of the final path (measured: about 300, 900, 1300).
+    assert 50 < red_pixels(early) < red_pixels(later) < red_pixels(final)

@@ -22,7 +22,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem, ValueProducer
 
-from drake_traj.planners.scaling import relaxed_scaling, scaled_clock
+from drake_traj.planners.scaling import admissible_clock_rate, clock_at, next_clock_rate
 from drake_traj.validation import finite_array
 
 
@@ -94,6 +94,10 @@ class PlannerSystem(LeafSystem):
         """
         return None
 
+    def planned_duration(self) -> float:
+        """How long the motion is planned to take [s] (NaN where it is not known before the run)."""
+        return float("nan")
+
     def goal_pose(self) -> np.ndarray | None:
         """The tool pose the task ends at, [x, y, z, phi_X, phi_Y, phi_Z] [m, rad], where the task
         is given in task space; None where it is given in joint space."""
@@ -154,54 +158,59 @@ class TimeLawPlanner(PlannerSystem):
 
     ``law`` provides ``q_start`` (n,), ``duration`` [s], ``rates_at(tau) -> (qd, qdd)``, the law's
     joint velocity and acceleration at law time tau (the hot path), and ``sample(tau) -> (q, qd,
-    qdd)``. The clock tau advances at the scaling rate c: with c = 1 the reference is the law
-    itself. c starts at ``speed_cap`` and its goal is ``speed_cap`` times the ``speed_override``
-    input (sampled every ``update_period``); c relaxes towards the goal by eq. 18 of Pająk 2024,
-    so tau, c and dc/dt have closed forms and the reference stays C^1 in velocity:
-    qd = q_law'(tau) c and qdd = q_law''(tau) c^2 + q_law'(tau) dc/dt. With c held at a constant
-    value, velocity scales by c and acceleration by c^2, so a law that breaks limits by a factor can
-    be slowed into them with ``speed_cap`` < 1. While c changes, |qdd| may exceed the law's peak
-    c^2 |q_law''| by up to |q_law'| |dc/dt|.
+    qdd)``. The clock tau advances at the rate c: with c = 1 the reference is the law itself,
+    qd = q_law'(tau) c and qdd = q_law''(tau) c² + q_law'(tau) ċ. c starts at ``speed_cap`` (a
+    law that breaks the limits by a factor is slowed into them with ``speed_cap`` < 1: velocity
+    scales by c, acceleration by c²) and relaxes towards ``speed_cap`` times the
+    ``speed_override`` input by eq. 18 of Pająk 2024, with ċ held over each ``update_period`` and
+    changed by at most ``clock_jerk`` × period, so q̈ stays continuous (see
+    :mod:`drake_traj.planners.scaling`), and never faster than the joint acceleration limits
+    allow at that point of the law (checked at both ends of the period).
 
     The Simulator integrates the reference [q; qd] from qdd; every ``update_period`` the update
     sets it back on the law, (q_law(tau), q_law'(tau) c), so the integrator's error, which a fixed
     step makes large where the law's acceleration jumps (Boryga's arc, trapezoids, Toppra's
-    bang-bang), never accumulates. The same update records the exact finish time (the clock's
-    closed form solved for tau = duration).
+    bang-bang), never accumulates. The same update records the exact finish time.
 
-    Discrete state: ``scaling`` = [c, t0, c0], ``clock`` = [tau at t0, goal of c] and ``finish``.
+    Discrete state: ``scaling`` = [c, t0, c0] (c at the last update t0, c0 = c there), ``clock``
+    = [tau at t0, ċ] and ``finish``.
 
     Args:
         law: the time law (see above).
         velocity_limit, acceleration_limit: the limits the reference promises, per joint.
         speed_cap: the largest clock rate c, in (0, 1].
-        update_period: the period of the update (speed override, reference on the law, finish) [s].
+        update_period: the period of the update (speed override, clock, reference on the law,
+            finish) [s].
+        scaling_rate: eq. 18's rate [1/s] (1 in the paper).
+        clock_jerk: the largest change of ċ per second [1/s²]: a step of the override changes q̈
+            by at most clock_jerk × update_period × |q_law'| per period (0.02 rad/s² per 1 ms at
+            1 rad/s with the default 20 /s²).
     """
 
-    def __init__(self, law, velocity_limit, acceleration_limit, *, speed_cap: float = 1.0, update_period: float = 0.001):
+    def __init__(self, law, velocity_limit, acceleration_limit, *, speed_cap: float = 1.0, update_period: float = 0.001,
+                 scaling_rate: float = 1.0, clock_jerk: float = 20.0):
         if not np.isfinite(speed_cap) or not 0.0 < speed_cap <= 1.0:
             raise ValueError(f"speed_cap must be in (0, 1], got {speed_cap}")
-        if not np.isfinite(update_period) or update_period <= 0:
-            raise ValueError(f"update_period must be a positive number of seconds, got {update_period}")
+        for name, value in (("update_period", update_period), ("scaling_rate", scaling_rate), ("clock_jerk", clock_jerk)):
+            if not np.isfinite(value) or value <= 0:
+                raise ValueError(f"{name} must be a positive number, got {value}")
         super().__init__(law.q_start, initial_scaling=speed_cap)
         self.law = law
         self.speed_cap = float(speed_cap)
         self.update_period = float(update_period)
+        self.scaling_rate = float(scaling_rate)
+        self.clock_jerk = float(clock_jerk)
         self.velocity_limit = np.asarray(velocity_limit, dtype=float)
         self.acceleration_limit = np.asarray(acceleration_limit, dtype=float)
-        self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, speed_cap]))
+        self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, 0.0]))
         self.DeclarePeriodicUnrestrictedUpdateEvent(update_period, 0.0, self._update)
 
-    def _clock_at(self, context, t: float):
-        """(tau [s], c, dc/dt [1/s]) at time t under the context's clock anchor."""
-        _, t0, c0 = context.get_discrete_state(self.scaling_state_index).get_value()
-        tau0, goal = context.get_discrete_state(self.clock_state_index).get_value()
-        c, c_rate = relaxed_scaling(t, t0, c0, goal)
-        return tau0 + scaled_clock(t, t0, c0, goal), float(c), float(c_rate)
-
     def _clock(self, context):
-        """(tau [s], c, dc/dt [1/s]) at the context's time."""
-        return self._clock_at(context, context.get_time())
+        """(tau [s], c, ċ [1/s]) at the context's time."""
+        c0, t0, _ = context.get_discrete_state(self.scaling_state_index).get_value()
+        tau0, c_rate = context.get_discrete_state(self.clock_state_index).get_value()
+        tau, c = clock_at(context.get_time() - t0, tau0, c0, c_rate)
+        return tau, c, c_rate
 
     def evaluate(self, context) -> tuple[np.ndarray, float]:
         tau, c, c_rate = self._clock(context)
@@ -211,34 +220,37 @@ class TimeLawPlanner(PlannerSystem):
     def finished(self, context) -> bool:
         return self._clock(context)[0] >= self.law.duration
 
-    def _finish_time(self, context) -> float:
-        """The time in (t - update_period, t] at which tau reached the law's duration [s]
-        (bisection on the clock's closed form, which holds since the last anchor)."""
-        t = context.get_time()
-        low = max(t - self.update_period, context.get_discrete_state(self.scaling_state_index).get_value()[1])
-        high = t
-        for _ in range(50):
-            middle = 0.5 * (low + high)
-            if self._clock_at(context, middle)[0] >= self.law.duration:
-                high = middle
-            else:
-                low = middle
-        return high
+    def planned_duration(self) -> float:
+        """The motion's duration at the speed cap, without override [s]."""
+        return self.law.duration / self.speed_cap
+
+    def _next_clock_rate(self, tau: float, c: float, c_rate: float, goal: float) -> float:
+        """ċ for the next period (:func:`next_clock_rate`), within the acceleration limits at
+        both ends of the period where they allow it."""
+        h = self.update_period
+        candidate = next_clock_rate(c, c_rate, goal, rate=self.scaling_rate, jerk=self.clock_jerk, period=h,
+                                    cap=self.speed_cap)
+        low, high = admissible_clock_rate(c, *self.law.rates_at(tau), self.acceleration_limit)
+        tau_end, c_end = clock_at(h, tau, c, candidate)
+        low_end, high_end = admissible_clock_rate(c_end, *self.law.rates_at(tau_end), self.acceleration_limit)
+        return min(max(candidate, max(low, low_end)), min(high, high_end))  # both intervals contain 0
 
     def _update(self, context, state):
         t = context.get_time()
-        tau, c, _ = self._clock(context)
+        c0, t0, _ = context.get_discrete_state(self.scaling_state_index).get_value()
+        tau0, c_rate = context.get_discrete_state(self.clock_state_index).get_value()
+        tau, c = clock_at(t - t0, tau0, c0, c_rate)
+        if tau >= self.law.duration > tau0:  # finished in (t0, t]: tau0 + c0 s + ċ s² / 2 = duration
+            s = np.roots([0.5 * c_rate, c0, tau0 - self.law.duration]) if c_rate else [(self.law.duration - tau0) / c0]
+            s = min(float(np.real(r)) for r in np.atleast_1d(s) if abs(np.imag(r)) < 1e-12 and np.real(r) >= -1e-12)
+            discrete = state.get_mutable_discrete_state()
+            self._record_finish(discrete.get_mutable_vector(self.finish_state_index), t0 + max(s, 0.0))
+        c_rate = self._next_clock_rate(tau, c, c_rate, self.speed_cap * self.speed_override(context))
         discrete = state.get_mutable_discrete_state()
-        goal = self.speed_cap * self.speed_override(context)
-        if goal != context.get_discrete_state(self.clock_state_index).get_value()[1]:
-            discrete.get_mutable_vector(self.scaling_state_index).SetFromVector([c, t, c])  # new eq. 18 anchor
-            discrete.get_mutable_vector(self.clock_state_index).SetFromVector([tau, goal])
-        else:
-            discrete.get_mutable_vector(self.scaling_state_index).SetAtIndex(0, c)
+        discrete.get_mutable_vector(self.scaling_state_index).SetFromVector([c, t, c])
+        discrete.get_mutable_vector(self.clock_state_index).SetFromVector([tau, c_rate])
         q_law, qd_law, _ = self.law.sample(tau)
         state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(np.concatenate([q_law, qd_law * c]))
-        if tau >= self.law.duration:
-            self._record_finish(discrete.get_mutable_vector(self.finish_state_index), self._finish_time(context))
 
 
 def start_and_goals(q_initial, goals, num_joints: int) -> np.ndarray:

@@ -1,10 +1,16 @@
-"""The trajectory-scaling coefficient c(t) shared by every planner.
+"""The trajectory-scaling coefficient c(t) shared by the planners.
 
-Pająk 2024, eq. 18: after the last change at t0, where c had the value c0, the
-coefficient relaxes exponentially back to 1:  c(t) = (c0 - 1) exp(-(t - t0)) + 1.
-We generalise the target 1 to a ``goal`` (the speed override, in [0, 1]) and keep a rate
-[1/s] (1 in the paper). The closed forms below let a planner evaluate c, dc/dt and the
-scaled clock at any time without integrating them.
+Pająk 2024, eq. 18: after the last change at t0, where c had the value c0, the coefficient relaxes
+exponentially back to 1:  c(t) = (c0 - 1) exp(-(t - t0)) + 1. :func:`relaxed_scaling` generalises
+the target 1 to a ``goal`` (the speed override, in [0, 1]) and keeps a rate [1/s] (1 in the
+paper); the Pająk planner uses it.
+
+The time-law planners run their law on a clock tau with d tau/dt = c. Their q̈ is
+c² q_law''(tau) + ċ q_law'(tau), so a step in ċ (eq. 18's relaxation when the override changes)
+is a step in q̈. Their clock is therefore piecewise quadratic: ċ is held over each update period
+and changes between periods by at most ``jerk`` × period (:func:`next_clock_rate`), towards eq.
+18's rate (goal - c) × rate, and never beyond what the joint acceleration limits allow at that
+point of the law (:func:`admissible_clock_rate`).
 """
 
 from __future__ import annotations
@@ -18,7 +24,35 @@ def relaxed_scaling(t, t0: float, c0: float, goal: float = 1.0, rate: float = 1.
     return (c0 - goal) * decay + goal, -rate * (c0 - goal) * decay
 
 
-def scaled_clock(t, t0: float, c0: float, goal: float = 1.0, rate: float = 1.0):
-    """Integral of c from t0 to t [s]: the planner-clock advance under eq. 18 scaling."""
-    elapsed = np.asarray(t, dtype=float) - t0
-    return goal * elapsed + (c0 - goal) * (1.0 - np.exp(-rate * elapsed)) / rate
+def clock_at(elapsed, tau: float, c: float, c_rate: float):
+    """(tau, c) after ``elapsed`` [s] with ċ = ``c_rate`` held: the piecewise-quadratic clock."""
+    return tau + c * elapsed + 0.5 * c_rate * elapsed * elapsed, c + c_rate * elapsed
+
+
+def admissible_clock_rate(c: float, qd_law, qdd_law, acceleration_limit) -> tuple[float, float]:
+    """Interval [lo, hi] of ċ [1/s] with |c² q_law'' + ċ q_law'| <= max(q̈_max, c² |q_law''|) on
+    every joint: within the limit, or no worse than the law itself where the law breaks it (a
+    baseline's blends). It always contains 0.
+
+    Per joint with q_law' != 0: ċ between (±bound - c² q_law'') / q_law'; joints at rest in the
+    law bound nothing.
+    """
+    qd_law = np.asarray(qd_law, dtype=float)
+    base = c * c * np.asarray(qdd_law, dtype=float)
+    moving = qd_law != 0.0
+    if not moving.any():
+        return -np.inf, np.inf
+    bound = np.maximum(np.asarray(acceleration_limit, dtype=float)[moving], np.abs(base[moving]))
+    upper = (bound - base[moving]) / qd_law[moving]
+    lower = (-bound - base[moving]) / qd_law[moving]
+    return float(np.max(np.minimum(upper, lower))), float(np.min(np.maximum(upper, lower)))
+
+
+def next_clock_rate(c: float, c_rate: float, goal: float, *, rate: float, jerk: float, period: float,
+                    cap: float = 1.0) -> float:
+    """ċ for the next update period: towards eq. 18's rate × (goal - c), changed by at most
+    ``jerk`` × ``period`` [1/s²] (so q̈ changes continuously), and keeping c in [0, cap] at the
+    period's end."""
+    step = jerk * period
+    candidate = c_rate + min(max(rate * (goal - c) - c_rate, -step), step)
+    return min(max(candidate, -c / period), (cap - c) / period)

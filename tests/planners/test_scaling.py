@@ -1,0 +1,48 @@
+"""The scaling coefficient: eq. 18 of Pająk 2024 and the time-law planners' piecewise-quadratic clock."""
+
+import numpy as np
+import pytest
+
+from drake_traj.planners.scaling import admissible_clock_rate, clock_at, next_clock_rate, relaxed_scaling
+
+
+def test_relaxed_scaling_is_eq_18_and_its_derivative():
+    t = np.linspace(0.0, 3.0, 7)
+    c, rate = relaxed_scaling(t, 0.5, 0.2, goal=0.8, rate=2.0)
+    np.testing.assert_allclose(c, (0.2 - 0.8) * np.exp(-2.0 * (t - 0.5)) + 0.8)
+    step = 1e-6
+    numeric = (relaxed_scaling(t + step, 0.5, 0.2, 0.8, 2.0)[0] - relaxed_scaling(t - step, 0.5, 0.2, 0.8, 2.0)[0]) / (2 * step)
+    np.testing.assert_allclose(rate, numeric, rtol=1e-6)
+
+
+def test_clock_is_the_integral_of_a_linear_c():
+    tau, c = clock_at(0.01, 2.0, 0.7, -3.0)
+    assert c == pytest.approx(0.7 - 0.03)
+    assert tau == pytest.approx(2.0 + 0.01 * (0.7 + c) / 2)  # trapezoid: exact for linear c
+
+
+def test_next_rate_moves_towards_eq_18_by_at_most_jerk_times_period():
+    # eq. 18 asks for ċ = 1 x (0.25 - 1) = -0.75 /s; 20 /s² over 1 ms allows a change of 0.02
+    assert next_clock_rate(1.0, 0.0, 0.25, rate=1.0, jerk=20.0, period=1e-3) == pytest.approx(-0.02)
+    assert next_clock_rate(1.0, -0.74, 0.25, rate=1.0, jerk=20.0, period=1e-3) == pytest.approx(-0.75)
+    assert next_clock_rate(0.5, 0.0, 0.5, rate=1.0, jerk=20.0, period=1e-3) == 0.0  # at the goal
+    # c stays in [0, cap] at the end of the period
+    assert next_clock_rate(0.001, -5.0, 0.0, rate=1.0, jerk=20.0, period=1e-3) == pytest.approx(-1.0)
+    assert next_clock_rate(0.999, 5.0, 1.0, rate=1.0, jerk=20.0, period=1e-3, cap=1.0) == pytest.approx(1.0)
+
+
+def test_admissible_rates_keep_the_limits_and_never_exclude_holding_the_clock():
+    rng = np.random.default_rng(3)
+    limit = np.full(6, 1.4)
+    for _ in range(200):
+        c = rng.uniform(0.0, 1.0)
+        qd, qdd = rng.uniform(-1.0, 1.0, 6), rng.uniform(-2.0, 2.0, 6)  # the law may break the limit
+        low, high = admissible_clock_rate(c, qd, qdd, limit)
+        assert low <= 0.0 <= high
+        for rate in np.linspace(max(low, -50), min(high, 50), 11):
+            q_ddot = c * c * qdd + rate * qd
+            assert np.all(np.abs(q_ddot) <= np.maximum(limit, np.abs(c * c * qdd)) + 1e-9)
+        if np.isfinite(high):  # the bound is tight: just beyond it a joint breaks its bound
+            q_ddot = c * c * qdd + (high + 1e-6) * qd
+            assert np.any(np.abs(q_ddot) > np.maximum(limit, np.abs(c * c * qdd)))
+    assert admissible_clock_rate(0.5, np.zeros(6), np.ones(6), limit) == (-np.inf, np.inf)
