@@ -1,6 +1,6 @@
-"""Joint-space stage of Li et al. 2019 (Li, Zhang, Zhou): re-timing, quintic B-spline, limit repair.
+"""Joint-space stage of Li et al. 2019 (Li, Zhang, Zhou): re-timing, quintic B-spline, limit check.
 
-Li et al. 2019 plans the tool path in Cartesian space first (:mod:`drake_traj.planners.li_lookahead`),
+Li et al. 2019 plans the tool path in Cartesian space first (:mod:`drake_traj.planners.li.cartesian`),
 maps the discrete path points to joint space by inverse kinematics, and then (section 3):
 
 1. re-times the joint samples (section 3.1, eq. 14): each interval gets the time the slowest
@@ -18,8 +18,8 @@ corrections in docs/papers.md are followed where it differs from the OCR text:
   sample times, multiplicity k + 1 at the ends), in seconds, so no normalisation is needed.
 - The paper's steps do not guarantee the joint limits: the fitted spline overshoots between the
   samples near sharp features (arcs, corners), and its acceleration there can exceed the limit
-  (recomputed on the paper's path: 2.0 vs 1.0 rad/s^2 for joint 1). :func:`repair_time_stretch` adds
-  the post-check (:func:`check_limits`) and a local time-stretch repair until every limit holds.
+  (docs/papers.md, correction 7). :func:`check_limits` is the post-check, with the exact
+  polynomial peaks of every knot interval; the repair that uses it is :mod:`.repair`.
 
 Everything is plain numpy / scipy; tests call the functions directly. Units: rad, s.
 """
@@ -32,16 +32,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
-from drake_traj.planners.li.cartesian import acc_dec_profile, plan_cartesian_path
+from drake_traj.planners.li.cartesian import acc_dec_profile
 
 __all__ = [
     "JointSplineLaw",
     "LimitReport",
-    "RepairReport",
     "check_limits",
     "fit_quintic_spline",
     "joint_interval_times",
-    "repair_time_stretch",
     "retime_joint_samples",
 ]
 
@@ -154,7 +152,7 @@ def joint_interval_times(times, q, velocity_limit, acceleration_limit) -> np.nda
       pass, which gives the same speeds as the paper's multi-pass walk);
     - Delta T_ij is the cubic ACC/DEC time of Table 2 (the seven cases of docs/papers.md, V_m = omega_m,
       A = (2/3) alpha_m) from the start to the end speed over that length
-      (:func:`drake_traj.planners.li_lookahead.acc_dec_profile`); 0 for a joint that does not move.
+      (:func:`drake_traj.planners.li.cartesian.acc_dec_profile`); 0 for a joint that does not move.
 
     Args:
         times: sample times [s], shape (N,), N >= 2, strictly increasing.
@@ -585,209 +583,3 @@ def check_limits(
         interval_acceleration=a_peak,
         margin=margin,
     )
-
-
-# --------------------------------------------------------------------------------------------
-# Repair: local time stretch until every limit holds.
-# --------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class RepairReport:
-    """What :func:`repair_time_stretch` did.
-
-    Attributes:
-        times: the repaired knot times [s] (law clock, from 0), shape (N,).
-        initial: the check of the un-repaired fit (the input times).
-        final: the check of the returned law (``final.ok`` is True).
-        initial_duration, final_duration: motion length before and after [s].
-        iterations: local stretch rounds performed (0 if the input already held every limit).
-        global_fallback: True if the local rounds did not converge within ``max_iterations`` and
-            the remaining excess was removed by a uniform stretch of the whole motion.
-    """
-
-    times: np.ndarray
-    initial: LimitReport
-    final: LimitReport
-    initial_duration: float
-    final_duration: float
-    iterations: int
-    global_fallback: bool
-
-    @property
-    def lengthening(self) -> float:
-        """final_duration / initial_duration (>= 1)."""
-        return self.final_duration / self.initial_duration
-
-    @property
-    def added_time(self) -> float:
-        """final_duration - initial_duration [s]."""
-        return self.final_duration - self.initial_duration
-
-
-def repair_time_stretch(
-    times,
-    q,
-    velocity_limit,
-    acceleration_limit,
-    *,
-    max_iterations: int = 30,
-    window: int = 2,
-    overshoot: float = 1e-3,
-    samples_per_interval: int = DEFAULT_SAMPLES_PER_INTERVAL,
-    margin: float = LIMIT_MARGIN,
-) -> tuple[JointSplineLaw, RepairReport]:
-    """Fit the quintic spline, check the limits, and stretch time locally until they all hold.
-
-    Each round fits :func:`fit_quintic_spline` to the current knot times and checks it
-    (:func:`check_limits`, exact peaks per knot interval). Every knot interval k whose required
-    stretch s_k = max_j max(peak |qd| / omega_j, sqrt(peak |qdd| / alpha_j)) exceeds 1 - margin
-    gets the factor f = s_k / (1 - margin) * (1 + overshoot) on its own duration and on the
-    ``window`` intervals either side (the largest factor wins where windows overlap), then the
-    spline is refitted. Durations only grow, so the rounds cannot cycle; after ``max_iterations``
-    rounds any remaining excess is removed by one uniform stretch of all intervals by the worst
-    ratio, which scales qd by 1/s and qdd by 1/s^2 exactly (the fit commutes with scaling time).
-
-    Guarantee: on return every joint's |qd| and |qdd| is <= (1 - margin) times its limit at every
-    point of the motion, not only on a grid: the check takes the exact polynomial extrema of each
-    knot interval (see :func:`check_limits`), plus ``samples_per_interval`` uniform samples.
-
-    Args:
-        times: knot times [s], shape (N,), strictly increasing (e.g. from
-            :func:`retime_joint_samples`).
-        q: joint samples [rad], shape (N, n).
-        velocity_limit: omega_m [rad/s], scalar or (n,), > 0.
-        acceleration_limit: alpha_m [rad/s^2], scalar or (n,), > 0.
-        max_iterations: local stretch rounds before the uniform fallback, >= 0.
-        window: intervals either side of a violating one that are stretched with it, >= 0.
-        overshoot: extra relative stretch per round, >= 0 (speeds convergence).
-        samples_per_interval: as :func:`check_limits`.
-        margin: relative margin below the limits, in [0, 1).
-
-    Returns:
-        (law, report): the repaired :class:`JointSplineLaw` (clock from 0) and
-        :class:`RepairReport`.
-
-    Raises:
-        ValueError: bad inputs (naming the argument), or if the limits still fail after the
-            uniform stretch (e.g. overflow of the times).
-    """
-    t, joints = _samples(times, q)
-    n = joints.shape[1]
-    omega = _limit(velocity_limit, "velocity_limit", "rad/s", n)
-    alpha = _limit(acceleration_limit, "acceleration_limit", "rad/s^2", n)
-    for name, value in (("max_iterations", max_iterations), ("window", window)):
-        if isinstance(value, bool) or int(value) != value or value < 0:
-            raise ValueError(f"{name} must be an integer >= 0, got {value!r}")
-    overshoot = float(overshoot)
-    if not overshoot >= 0.0 or not np.isfinite(overshoot):
-        raise ValueError(f"overshoot must be finite and >= 0, got {overshoot}")
-    margin = float(margin)
-    if not 0.0 <= margin < 1.0:
-        raise ValueError(f"margin must be in [0, 1), got {margin}")
-    target = 1.0 - margin
-
-    durations = np.diff(t)
-    law = JointSplineLaw(t, joints)
-    report = check_limits(law, omega, alpha, samples_per_interval, margin=margin)
-    initial = report
-    iterations = 0
-    while not report.ok and iterations < max_iterations:
-        need = report.interval_stretch / target
-        factors = np.ones_like(durations)
-        for k in np.nonzero(need > 1.0)[0]:
-            lo, hi = max(k - window, 0), min(k + window + 1, durations.size)
-            factors[lo:hi] = np.maximum(factors[lo:hi], need[k] * (1.0 + overshoot))
-        durations = durations * factors
-        iterations += 1
-        law = JointSplineLaw(np.concatenate([[0.0], np.cumsum(durations)]), joints)
-        report = check_limits(law, omega, alpha, samples_per_interval, margin=margin)
-    fallback = False
-    if not report.ok:
-        fallback = True
-        durations = durations * (np.max(report.interval_stretch) / target) * (1.0 + 1e-12)
-        if not np.all(np.isfinite(durations)):
-            raise ValueError("repair_time_stretch: the stretched times overflow")
-        law = JointSplineLaw(np.concatenate([[0.0], np.cumsum(durations)]), joints)
-        report = check_limits(law, omega, alpha, samples_per_interval, margin=margin)
-        if not report.ok:
-            raise ValueError(
-                "repair_time_stretch could not bring the joint limits within bounds after "
-                f"{iterations} local rounds and a uniform stretch: {report.describe()}"
-            )
-    return law, RepairReport(
-        times=law.knot_times,
-        initial=initial,
-        final=report,
-        initial_duration=float(t[-1] - t[0]),
-        final_duration=law.duration,
-        iterations=iterations,
-        global_fallback=fallback,
-    )
-
-
-# --------------------------------------------------------------------------------------------
-# The whole planner: Cartesian stage -> IK -> re-timing -> spline -> repairs, and its system.
-# --------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class LiPlan:
-    """All stages of one Li et al. 2019 plan.
-
-    Attributes:
-        cartesian: the Cartesian stage (look-ahead and ACC/DEC on the tool path).
-        law: the final joint spline (joint and tool limits hold).
-        repair: the joint-limit repair's report (re-timed duration before, repaired after).
-        tool_stretch: the uniform time factor (>= 1) applied after the joint repair so the tool's
-            speed and acceleration, through FK, keep the tool limits.
-    """
-
-    cartesian: object
-    law: JointSplineLaw
-    repair: RepairReport
-    tool_stretch: float
-
-
-# The tool limits are checked on samples (not exact peaks like the joints'): this many per knot
-# interval, with this relative margin for what lies between them.
-TOOL_SAMPLES_PER_INTERVAL = 64
-TOOL_LIMIT_MARGIN = 2e-3
-
-
-def tool_speed_and_acceleration(law: JointSplineLaw, tool_motion, samples_per_interval: int = TOOL_SAMPLES_PER_INTERVAL):
-    """(t, |v|, |a|) of the tool [s, m/s, m/s^2] on ``samples_per_interval`` samples per knot
-    interval; ``tool_motion(q, qd, qdd) -> (v (N,3), a (N,3))`` is the robot's FK rates."""
-    knots = law.knot_times
-    fractions = np.linspace(0.0, 1.0, samples_per_interval, endpoint=False)
-    t = np.append((knots[:-1, None] + np.diff(knots)[:, None] * fractions).ravel(), knots[-1])
-    velocity, acceleration = tool_motion(*law.sample(t))
-    return t, np.linalg.norm(velocity, axis=1), np.linalg.norm(acceleration, axis=1)
-
-
-def plan_li_path(points, ik, tool_motion, velocity_limit, acceleration_limit, tool_velocity_limit,
-                 tool_acceleration_limit) -> LiPlan:
-    """Li et al. 2019 end to end, with the joint and the tool limits kept.
-
-    1. Cartesian stage on ``points`` (N,3) [m] with the tool limits (eq. 1-13, Fig. 2);
-    2. ``ik(points) -> q (N, n)`` at the path points, timed by the Cartesian stage;
-    3. re-timing (eq. 14), quintic spline (eq. 15-22) and the local joint-limit repair
-       (:func:`repair_time_stretch`, exact joint peaks);
-    4. the tool limits through ``tool_motion`` (FK rates) on TOOL_SAMPLES_PER_INTERVAL samples per
-       knot interval, with TOOL_LIMIT_MARGIN: the
-       spline can run the tool too fast (docs/papers.md), so the whole motion is stretched uniformly by
-       k = max(peak speed / limit, sqrt(peak |a| / limit)), which scales tool speed by 1/k and
-       acceleration by 1/k^2 and only lowers the joint rates. (Stretching only the offending
-       intervals and refitting was tried: the uneven knots made the spline oscillate more and the
-       motion 2-3 times longer than the uniform stretch.)
-    """
-    cartesian = plan_cartesian_path(points, tool_velocity_limit, tool_acceleration_limit)
-    q = ik(cartesian.points)
-    times = retime_joint_samples(cartesian.segment_times, q, velocity_limit, acceleration_limit)
-    law, report = repair_time_stretch(times, q, velocity_limit, acceleration_limit)
-    _, speed, acceleration = tool_speed_and_acceleration(law, tool_motion)
-    ratio = max(speed.max() / tool_velocity_limit, np.sqrt(acceleration.max() / tool_acceleration_limit))
-    stretch = max(1.0, ratio / (1.0 - TOOL_LIMIT_MARGIN))
-    if stretch > 1.0:
-        law = JointSplineLaw(law.knot_times * stretch, law.samples)
-    return LiPlan(cartesian, law, report, stretch)

@@ -1,5 +1,5 @@
 """Li et al. 2019 under the planner contract: the closed test path of Fig. 6, the config, ``make``
-and :class:`LiPathPlanner` (the joint spline of :func:`plan_li_path` on the scaled clock)."""
+and :class:`LiPathPlanner` (the joint spline of :func:`~.plan.plan_li_path` on the scaled clock)."""
 
 import math
 from dataclasses import dataclass, field
@@ -7,7 +7,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from drake_traj.planners.base import TimeLawPlanner
-from drake_traj.planners.li.joint import LiPlan, plan_li_path, tool_speed_and_acceleration
+from drake_traj.planners.li.plan import LiPlan, plan_li_path
+from drake_traj.planners.li.repair import tool_speed_and_acceleration
 from drake_traj.robots import LI_4DOF, Robot
 from drake_traj.validation import limit_or_default
 
