@@ -89,6 +89,11 @@ class SimulationResult:
     duration: float = float("nan")
     failure: Failure | None = None
     wall_time: float = float("nan")
+    joint_types: tuple[str, ...] = ()  # "revolute" or "prismatic" per joint; empty: all revolute
+
+    def joint_unit(self, j: int) -> str:
+        """"rad" or "m", the position unit of joint ``j``."""
+        return "m" if self.joint_types and self.joint_types[j] == "prismatic" else "rad"
 
     @property
     def succeeded(self) -> bool:
@@ -162,6 +167,7 @@ class SimulationResult:
             duration=planner.finish_time(station.GetSubsystemContext(planner, station_context)),
             failure=failure,
             wall_time=wall_time,
+            joint_types=tuple(robot.joint_types),
         )
 
     # --- persistence ---------------------------------------------------------------------------
@@ -171,7 +177,8 @@ class SimulationResult:
         directory.mkdir(parents=True, exist_ok=True)
         arrays = {name: getattr(self, name) for name in ARRAY_NAMES + _LIMIT_NAMES}
         failure = None if self.failure is None else self.failure.to_dict()
-        meta = {"name": self.name, "duration": self.duration, "failure": failure, "wall_time": self.wall_time}
+        meta = {"name": self.name, "duration": self.duration, "failure": failure, "wall_time": self.wall_time,
+                "joint_types": list(self.joint_types)}
         np.savez_compressed(directory / "result.npz", meta=json.dumps(meta), **arrays)
         (directory / "metrics.json").write_text(json.dumps(self.metrics().to_dict(), indent=2))
         return directory
@@ -187,57 +194,74 @@ class SimulationResult:
             arrays = {f.name: data[f.name] for f in fields(cls) if f.name in data.files}
         if meta["failure"] is not None:
             meta["failure"] = Failure.from_dict(meta["failure"])
+        meta["joint_types"] = tuple(meta.get("joint_types", ()))
         return cls(**meta, **arrays)
 
     # --- figures -------------------------------------------------------------------------------
-    def joint_figure(self) -> Figure:
-        """q, qd, qdd per joint against time, with the velocity and acceleration limit lines."""
-        figure = Figure(figsize=(10, 9), layout="constrained")
-        axes = figure.subplots(3, 1, sharex=True)
-        for name, data, limit, ax, unit in (
-            ("q", self.q_ref, None, axes[0], "rad"),
-            ("qd", self.qd_ref, self.velocity_limit, axes[1], "rad/s"),
-            ("qdd", self.qdd_ref, self.acceleration_limit, axes[2], "rad/s$^2$"),
-        ):
-            for j in range(data.shape[1]):
-                ax.plot(self.t, data[:, j], label=f"joint {j + 1}")
-            if limit is not None:
-                for bound in (np.max(limit), -np.max(limit)):
-                    ax.axhline(bound, color="grey", linestyle="--", linewidth=1)
-            ax.set_ylabel(f"{name} [{unit}]")
-            ax.grid(True, alpha=0.3)
+    def _finish_line(self, axes) -> None:
+        """A labelled vertical line at the finish on each of ``axes``."""
         if np.isfinite(self.duration):
             for ax in axes:
-                ax.axvline(self.duration, color="black", linewidth=0.8, alpha=0.5)
-        axes[0].legend(ncol=6, fontsize="small", loc="upper center")
+                ax.axvline(self.duration, color="black", linewidth=0.8, alpha=0.5,
+                           label=f"finished, T = {self.duration:.3f} s" if ax is axes[0] else None)
+
+    def joint_figure(self) -> Figure:
+        """q, q̇, q̈ per joint against time, with the velocity and acceleration limit lines."""
+        figure = Figure(figsize=(11, 9), layout="constrained")
+        axes = figure.subplots(3, 1, sharex=True)
+        units = {self.joint_unit(j) for j in range(self.q_ref.shape[1])}
+        unit = units.pop() if len(units) == 1 else "rad or m"
+        for name, data, limit, ax, suffix in (
+            ("q", self.q_ref, None, axes[0], ""),
+            ("q̇", self.qd_ref, self.velocity_limit, axes[1], "/s"),
+            ("q̈", self.qdd_ref, self.acceleration_limit, axes[2], "/s²"),
+        ):
+            for j in range(data.shape[1]):
+                ax.plot(self.t, data[:, j], label=f"joint {j + 1} [{self.joint_unit(j)}{suffix or ''}]"
+                        if ax is axes[0] else None)
+            if limit is not None and np.all(np.isfinite(limit)):
+                for bound in (np.max(limit), -np.max(limit)):
+                    ax.axhline(bound, color="grey", linestyle="--", linewidth=1,
+                               label="limit" if bound > 0 and ax is axes[1] else None)
+            ax.set_ylabel(f"{name} [{unit}{suffix}]")
+            ax.grid(True, alpha=0.3)
+        self._finish_line(axes)
         axes[-1].set_xlabel("t [s]")
-        figure.suptitle(f"{self.name}: joint reference (dashed: limits)")
+        figure.legend(loc="outside right upper", fontsize="small")
+        figure.suptitle(f"{self.name}: joint reference")
         return figure
 
     def tracking_figure(self) -> Figure:
         """Joint tracking error q_ref - q_meas and torque over the effort limit."""
-        figure = Figure(figsize=(10, 6), layout="constrained")
+        figure = Figure(figsize=(11, 6), layout="constrained")
         error_ax, torque_ax = figure.subplots(2, 1, sharex=True)
         for j in range(self.q_ref.shape[1]):
-            error_ax.plot(self.t, 1e3 * (self.q_ref[:, j] - self.q_meas[:, j]), label=f"joint {j + 1}")
+            scale, unit = (1e3, "mm") if self.joint_unit(j) == "m" else (1e3, "mrad")
+            error_ax.plot(self.t, scale * (self.q_ref[:, j] - self.q_meas[:, j]), label=f"joint {j + 1} [{unit}]")
             torque_ax.plot(self.t, self.tau[:, j] / self.effort_limit[j])
-        error_ax.set_ylabel("q_ref - q_meas [mrad]")
-        torque_ax.set_ylabel("tau / effort limit")
+        error_ax.set_ylabel("q_ref - q_meas [mrad or mm]" if self.joint_types and "prismatic" in self.joint_types
+                            else "q_ref - q_meas [mrad]")
+        torque_ax.set_ylabel("effort / effort limit")
         torque_ax.set_xlabel("t [s]")
-        error_ax.legend(ncol=6, fontsize="small")
+        self._finish_line([error_ax, torque_ax])
         for ax in (error_ax, torque_ax):
             ax.grid(True, alpha=0.3)
+        figure.legend(loc="outside right upper", fontsize="small")
+        figure.suptitle(f"{self.name}: tracking")
         return figure
 
     def scaling_figure(self) -> Figure:
         """The scaling coefficient c(t)."""
         figure = Figure(figsize=(8, 3), layout="constrained")
         ax = figure.subplots()
-        ax.plot(self.t, self.scaling)
+        ax.plot(self.t, self.scaling, label="c")
+        self._finish_line([ax])
         ax.set_xlabel("t [s]")
         ax.set_ylabel("c")
         ax.set_ylim(-0.05, 1.05)
         ax.grid(True, alpha=0.3)
+        figure.legend(loc="outside right upper", fontsize="small")
+        figure.suptitle(f"{self.name}: scaling coefficient")
         return figure
 
     def tcp_path_figure(self) -> Figure:
@@ -248,6 +272,9 @@ class SimulationResult:
         ax.plot(*self.tcp[:, :3].T, "--", label="measured", linewidth=1)
         if len(self.waypoints):
             ax.scatter(*self.waypoints.T, color="tab:orange", s=60, label="waypoints")
+        if len(self.tcp_ref):
+            ax.scatter(*self.tcp_ref[0, :3], color="tab:green", marker="^", s=90, label="start", depthshade=False)
+            ax.scatter(*self.tcp_ref[-1, :3], color="black", marker="x", s=60, label="end")
         points = np.vstack([self.tcp_ref[:, :3], self.tcp[:, :3], self.waypoints.reshape(-1, 3)])
         centre = (points.max(axis=0) + points.min(axis=0)) / 2
         half = max(float(np.ptp(points, axis=0).max()) / 2, 1e-3)  # equal scales on all axes
@@ -256,7 +283,7 @@ class SimulationResult:
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
         ax.set_zlabel("z [m]")
-        ax.legend()
+        figure.legend(loc="outside right upper", fontsize="small")
         ax.set_title(f"{self.name}: TCP path")
         return figure
 

@@ -29,6 +29,8 @@ Exported ports of the station:
 port                   size    meaning
 =====================  ======  ===============================================================
 speed_override (in)    1       the planner's speed override in [0, 1]; unconnected means 1
+applied_generalized_   n       generalized forces added on the joints [N m], e.g. a disturbance;
+force (in)                     unconnected means none
 desired_state          2n      the planner's reference [q; q̇] [rad, rad/s]
 desired_acceleration   n       the planner's q̈ [rad/s²]
 scaling                1       the planner's scaling coefficient c
@@ -281,6 +283,7 @@ def build_station(planner: PlannerSystem, **kwargs) -> Diagram:
     builder = DiagramBuilder()
     parts = add_station(builder, planner, **kwargs)
     builder.ExportInput(planner.GetInputPort("speed_override"), "speed_override")
+    builder.ExportInput(parts.plant.get_applied_generalized_force_input_port(), "applied_generalized_force")
     for name in ("desired_state", "desired_acceleration", "scaling"):
         builder.ExportOutput(planner.GetOutputPort(name), name)
     builder.ExportOutput(parts.plant.get_state_output_port(parts.instance), "measured_state")

@@ -162,7 +162,8 @@ class TimeLawPlanner(PlannerSystem):
     qd = q_law'(tau) c and qdd = q_law''(tau) c² + q_law'(tau) ċ. c starts at ``speed_cap`` (a
     law that breaks the limits by a factor is slowed into them with ``speed_cap`` < 1: velocity
     scales by c, acceleration by c²) and relaxes towards ``speed_cap`` times the
-    ``speed_override`` input by eq. 18 of Pająk 2024, with ċ held over each ``update_period`` and
+    ``speed_override`` input in the form of eq. 18 of Pająk 2024 (at ``scaling_rate``; a speed
+    slider's response, faster than the paper's 1/s), with ċ held over each ``update_period`` and
     changed by at most ``clock_jerk`` × period, so q̈ stays continuous (see
     :mod:`drake_traj.planners.scaling`), and never faster than the joint acceleration limits
     allow at that point of the law (checked at both ends of the period).
@@ -181,14 +182,15 @@ class TimeLawPlanner(PlannerSystem):
         speed_cap: the largest clock rate c, in (0, 1].
         update_period: the period of the update (speed override, clock, reference on the law,
             finish) [s].
-        scaling_rate: eq. 18's rate [1/s] (1 in the paper).
+        scaling_rate: the rate of the eq. 18 relaxation towards the override [1/s]: 4 /s follows a
+            step of the override with a time constant of 0.25 s.
         clock_jerk: the largest change of ċ per second [1/s²]: a step of the override changes q̈
             by at most clock_jerk × update_period × |q_law'| per period (0.02 rad/s² per 1 ms at
             1 rad/s with the default 20 /s²).
     """
 
     def __init__(self, law, velocity_limit, acceleration_limit, *, speed_cap: float = 1.0, update_period: float = 0.001,
-                 scaling_rate: float = 1.0, clock_jerk: float = 20.0):
+                 scaling_rate: float = 4.0, clock_jerk: float = 20.0):
         if not np.isfinite(speed_cap) or not 0.0 < speed_cap <= 1.0:
             raise ValueError(f"speed_cap must be in (0, 1], got {speed_cap}")
         for name, value in (("update_period", update_period), ("scaling_rate", scaling_rate), ("clock_jerk", clock_jerk)):
