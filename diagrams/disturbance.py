@@ -50,8 +50,10 @@ def main(argv=None) -> SimulationResult:
     simulator = Simulator(builder.Build())
     ApplySimulatorConfig(scenario.simulator, simulator)
     failure = run_station(simulator, station, settle_time=scenario.settle_time, max_duration=scenario.max_duration)
+    # The pulse pushes the TCP centimetres off on purpose: a tolerance of 5 cm instead of 5 mm keeps
+    # the run a success while it shows the recovery (a saturated drive still fails it).
     result = SimulationResult.from_station(station, station.GetMyContextFromRoot(simulator.get_context()),
-                                           name="disturbance", failure=failure)
+                                           name="disturbance", failure=failure, tracking_tolerance=0.05)
 
     result.save(args.out)
     result.save_figures(args.out)

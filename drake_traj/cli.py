@@ -104,7 +104,8 @@ def run(args) -> int:
         result = simulate(planner, name=scenario.name, simulator_config=simulator_config,
                           settle_time=scenario.settle_time, max_duration=scenario.max_duration,
                           speed_override=None if args.meshcat else scenario.speed_override, meshcat=meshcat,
-                          progress=progress.simulated, add_systems=add_systems, before_run=before_run, **arguments)
+                          progress=progress.simulated, add_systems=add_systems, before_run=before_run,
+                          tracking_tolerance=scenario.tracking_tolerance, **arguments)
         progress.stage("writing figures")
         result.save(out_dir)
         files = ["result.npz", "metrics.json"] + [path.name for path in result.save_figures(out_dir)]

@@ -10,15 +10,36 @@ All arrays are time-major (one row per logged sample) on a uniform grid ``t`` [s
 from __future__ import annotations
 
 import json
+import zipfile
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
 
-from drake_traj.errors import Failure
+from drake_traj.errors import DrakeTrajError, Failure
 
-__all__ = ["ARRAY_NAMES", "LOGGERS", "Metrics", "SimulationResult"]
+__all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult"]
+
+SATURATION = 1.0 - 1e-6  # |torque| at or above this fraction of the effort limit counts as saturated
+# Far above the shipped scenarios' largest TCP tracking error (0.13 mm, Boryga's SCARA; 0.03 mm on
+# the UR10e), far below what an arm asked for the impossible shows (0.3 m at 5x its rated speed).
+DEFAULT_TRACKING_TOLERANCE = 0.005  # [m]
+
+
+class ResultFileError(DrakeTrajError):
+    """A saved result cannot be read: names the file and what is wrong with it."""
+
+
+def _json_ready(value):
+    """``value`` with every non-finite float replaced by None (strict JSON has no NaN)."""
+    if isinstance(value, float):
+        return value if np.isfinite(value) else None
+    if isinstance(value, (list, tuple)):
+        return [_json_ready(item) for item in value]
+    if isinstance(value, dict):
+        return {key: _json_ready(item) for key, item in value.items()}
+    return value
 
 # The station's loggers (drake_traj.station), by subsystem name: what each records, one column per
 # sample (VectorLogSink.data() has one row per entry below, n = the robot's joint count).
@@ -58,13 +79,14 @@ class Metrics:
     tracking_error_tcp_max_m: float
     peak_torque_nm: list[float]
     peak_torque_over_limit: list[float]
+    time_at_effort_limit_s: list[float]
     simulated_time_s: float
     wall_time_s: float
     real_time_factor: float | None
 
     def to_dict(self) -> dict:
-        """JSON-ready dict with the field names as keys."""
-        return asdict(self)
+        """Strict-JSON-ready dict with the field names as keys (None where a value is not finite)."""
+        return _json_ready(asdict(self))
 
 
 @dataclass
@@ -99,6 +121,36 @@ class SimulationResult:
     def succeeded(self) -> bool:
         return self.failure is None
 
+    @property
+    def log_period(self) -> float:
+        """The logging period [s] (0 with fewer than two samples)."""
+        return float(np.median(np.diff(self.t))) if len(self.t) > 1 else 0.0
+
+    def _saturated(self) -> np.ndarray:
+        """(N, n) booleans: the joint's torque at its effort limit at that sample."""
+        return np.abs(self.tau) >= SATURATION * self.effort_limit
+
+    def execution_failure(self, tracking_tolerance: float) -> Failure | None:
+        """Whether the arm did what was planned: a :class:`Failure` when a joint's torque
+        saturated at its effort limit (cause "saturation": which joint, from when, for how long)
+        or the TCP strayed more than ``tracking_tolerance`` [m] from the reference (cause
+        "tracking"); None otherwise."""
+        saturated = self._saturated()
+        if saturated.any():
+            j = int(np.argmax(saturated.any(axis=0)))
+            first = int(np.argmax(saturated[:, j]))
+            return Failure("saturation", f"joint {j + 1}'s torque reached its effort limit {self.effort_limit[j]:g} "
+                                         f"at t = {self.t[first]:.3f} s and stayed there "
+                                         f"{saturated[:, j].sum() * self.log_period:.3f} s in all: the arm could not "
+                                         "follow the reference", float(self.t[first]), tuple(self.q_meas[first]))
+        error = np.linalg.norm(self.tcp_ref[:, :3] - self.tcp[:, :3], axis=1)
+        if len(error) and error.max() > tracking_tolerance:
+            first = int(np.argmax(error > tracking_tolerance))
+            return Failure("tracking", f"the TCP was {1e3 * error.max():.3f} mm from the reference (tolerance "
+                                       f"{1e3 * tracking_tolerance:g} mm), first over it at t = {self.t[first]:.3f} s",
+                           float(self.t[first]), tuple(self.q_meas[first]))
+        return None
+
     def jerk(self) -> np.ndarray:
         """Reference jerk [rad/s^3] by finite differences of qdd_ref, shape (N-1, 6)."""
         return np.diff(self.qdd_ref, axis=0) / np.diff(self.t)[:, None]
@@ -114,7 +166,7 @@ class SimulationResult:
             failure=None if self.failure is None else self.failure.message,
             duration_s=self.duration,
             samples=int(len(self.t)),
-            log_period_s=float(np.median(np.diff(self.t))) if len(self.t) > 1 else None,
+            log_period_s=self.log_period or None,
             qd_min=self.qd_ref.min(axis=0).tolist(),
             qd_max=self.qd_ref.max(axis=0).tolist(),
             qdd_min=self.qdd_ref.min(axis=0).tolist(),
@@ -126,6 +178,7 @@ class SimulationResult:
             tracking_error_tcp_max_m=float(tcp_error.max()),
             peak_torque_nm=np.abs(self.tau).max(axis=0).tolist(),
             peak_torque_over_limit=(np.abs(self.tau).max(axis=0) / self.effort_limit).tolist(),
+            time_at_effort_limit_s=(self._saturated().sum(axis=0) * self.log_period).tolist(),
             simulated_time_s=simulated,
             wall_time_s=self.wall_time,
             real_time_factor=simulated / self.wall_time if self.wall_time > 0 else None,
@@ -133,11 +186,13 @@ class SimulationResult:
 
     @classmethod
     def from_station(cls, station, station_context, *, name: str = "run", failure: Failure | None = None,
-                     wall_time: float = float("nan")) -> "SimulationResult":
+                     wall_time: float = float("nan"), tracking_tolerance: float | None = DEFAULT_TRACKING_TOLERANCE) -> "SimulationResult":
         """The result of a run of a station (:func:`drake_traj.station.build_station`), from its
         loggers, its planner and its robot. ``station_context`` is the station's context (for a
         station inside a larger diagram: ``station.GetMyContextFromRoot(root_context)``).
-        The TCP poses are computed from the logged joint positions."""
+        The TCP poses are computed from the logged joint positions. A run without ``failure``
+        fails all the same where the arm did not do what was planned
+        (:meth:`execution_failure` with ``tracking_tolerance`` [m]; None skips the check)."""
         planner = station.GetSubsystemByName("planner")
         robot = station.GetSubsystemByName("tcp_pose").robot
         logs = {}
@@ -148,7 +203,7 @@ class SimulationResult:
         data = {key: log.data()[:, :count].T for key, log in logs.items()}
         n = robot.num_joints
         q_ref, q_meas = data["reference_logger"][:, :n], data["measured_logger"][:, :n]
-        return cls(
+        result = cls(
             name=name,
             t=logs["reference_logger"].sample_times()[:count].copy(),
             q_ref=q_ref,
@@ -169,6 +224,9 @@ class SimulationResult:
             wall_time=wall_time,
             joint_types=tuple(robot.joint_types),
         )
+        if result.failure is None and tracking_tolerance is not None:
+            result.failure = result.execution_failure(tracking_tolerance)
+        return result
 
     # --- persistence ---------------------------------------------------------------------------
     def save(self, directory) -> Path:
@@ -179,22 +237,41 @@ class SimulationResult:
         failure = None if self.failure is None else self.failure.to_dict()
         meta = {"name": self.name, "duration": self.duration, "failure": failure, "wall_time": self.wall_time,
                 "joint_types": list(self.joint_types)}
-        np.savez_compressed(directory / "result.npz", meta=json.dumps(meta), **arrays)
-        (directory / "metrics.json").write_text(json.dumps(self.metrics().to_dict(), indent=2))
+        np.savez_compressed(directory / "result.npz", meta=json.dumps(_json_ready(meta), allow_nan=False), **arrays)
+        (directory / "metrics.json").write_text(json.dumps(self.metrics().to_dict(), indent=2, allow_nan=False))
         return directory
 
     @classmethod
     def load(cls, directory) -> "SimulationResult":
-        """Read a result written by :meth:`save`."""
+        """Read a result written by :meth:`save`; raises :class:`ResultFileError` naming the file
+        when it is missing, truncated, corrupted or inconsistent."""
         path = Path(directory) / "result.npz"
         if not path.is_file():
-            raise ValueError(f"no result file at {path}")
-        with np.load(path) as data:
-            meta = json.loads(str(data["meta"]))
-            arrays = {f.name: data[f.name] for f in fields(cls) if f.name in data.files}
-        if meta["failure"] is not None:
-            meta["failure"] = Failure.from_dict(meta["failure"])
-        meta["joint_types"] = tuple(meta.get("joint_types", ()))
+            raise ResultFileError(f"no result file at {path}")
+        names = {f.name for f in fields(cls)}
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                meta = json.loads(str(data["meta"]))
+                arrays = {name: np.array(data[name]) for name in ARRAY_NAMES + _LIMIT_NAMES}
+        except KeyError as error:
+            raise ResultFileError(f"{path} is not a complete result: it has no {error.args[0]!r}") from None
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
+            raise ResultFileError(f"{path} cannot be read (truncated or not a result file): {error}") from None
+        if not isinstance(meta, dict) or not {"name", "duration", "failure", "wall_time"} <= set(meta) or set(meta) - names:
+            raise ResultFileError(f"{path}: its metadata is not a result's: {meta!r}"[:300])
+        samples = len(arrays["t"])
+        for name in ARRAY_NAMES:
+            if len(arrays[name]) != samples or not np.issubdtype(arrays[name].dtype, np.floating):
+                raise ResultFileError(f"{path}: the array {name!r} has {len(arrays[name])} rows of "
+                                      f"{arrays[name].dtype}, the log {samples} rows of numbers")
+        try:
+            if meta["failure"] is not None:
+                meta["failure"] = Failure.from_dict(meta["failure"])
+            meta["joint_types"] = tuple(meta.get("joint_types", ()))
+            meta["duration"] = float("nan") if meta["duration"] is None else float(meta["duration"])
+            meta["wall_time"] = float("nan") if meta["wall_time"] is None else float(meta["wall_time"])
+        except (KeyError, TypeError, ValueError) as error:
+            raise ResultFileError(f"{path}: its metadata is damaged: {error}") from None
         return cls(**meta, **arrays)
 
     # --- figures -------------------------------------------------------------------------------

@@ -12,22 +12,27 @@ from dataclasses import dataclass, field, fields
 from importlib import resources
 from pathlib import Path
 
+import re
+
 import numpy as np
-from pydrake.common.yaml import yaml_load, yaml_load_typed
+from pydrake.common.yaml import yaml_load_typed
 from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
 from drake_traj.station import ControllerGains, SpeedOverride, default_plant_config, default_simulator_config
 from drake_traj.planners import PlannerConfig, PlannerSystem, QuinticConfig
 from drake_traj.planners import make_planner as make_planner_from_config
+from drake_traj.result import DEFAULT_TRACKING_TOLERANCE
 from drake_traj.robots import get_robot
+from drake_traj.yaml_schema import ScenarioError, checked_document, locate
 
 __all__ = [
-    "Scenario", "ShippedScenario", "default_scenario_path", "find_scenario", "load_scenario", "make_planner",
+    "Scenario", "ScenarioError", "ShippedScenario", "default_scenario_path", "find_scenario", "load_scenario", "make_planner",
     "scenario_variants", "shipped_scenarios",
 ]
 
 DEFAULT_SCENARIO = ("pajak.yaml", "sim3")  # what ``drake-traj run`` runs when given no scenario
+_PLAIN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 
 
 @dataclass
@@ -51,6 +56,8 @@ class Scenario:
         log_period: the loggers' period [s].
         speed_override: a speed-override profile (times [s], values in [0, 1]), like a pendant's
             speed slider; empty: none.
+        tracking_tolerance: the run fails if the measured TCP is ever further than this from the
+            reference [m] (default 5 mm: 40x the shipped scenarios' worst, 0.13 mm).
         settle_time: how long the run goes on after the planner finishes [s].
         max_duration: the run stops with a failure if the planner has not finished by then [s].
     """
@@ -65,6 +72,7 @@ class Scenario:
     simulator: SimulatorConfig = field(default_factory=default_simulator_config)
     log_period: float = 0.001
     speed_override: SpeedOverride = field(default_factory=SpeedOverride)
+    tracking_tolerance: float = DEFAULT_TRACKING_TOLERANCE
     settle_time: float = 0.5
     max_duration: float = 120.0
 
@@ -75,8 +83,15 @@ class Scenario:
         return np.asarray(self.q_initial, dtype=float)
 
     def validate(self) -> None:
-        """Raise ValueError naming the first field that is malformed."""
-        robot = get_robot(self.robot)
+        """Raise ValueError naming the first field that is malformed (the message starts with
+        the field's path)."""
+        if not _PLAIN_NAME.fullmatch(self.name) or ".." in self.name:
+            raise ValueError(f"name must be a plain name (letters, digits, _ . -; no path), got {self.name!r}: "
+                             "it names the default output folder out/<name>")
+        try:
+            robot = get_robot(self.robot)
+        except ValueError as error:
+            raise ValueError(f"robot: {error}") from None
         n = robot.num_joints
         q = self.start_configuration()
         if q.shape != (n,):
@@ -93,10 +108,19 @@ class Scenario:
             )
         for label, value in (("plant.time_step", self.plant.time_step), ("log_period", self.log_period),
                              ("max_duration", self.max_duration), ("settle_time", self.settle_time),
-                             ("simulator.max_step_size", self.simulator.max_step_size)):
+                             ("simulator.max_step_size", self.simulator.max_step_size),
+                             ("tracking_tolerance", self.tracking_tolerance)):
             smallest_allowed = 0.0 if label == "settle_time" else np.nextafter(0.0, 1.0)
             if not np.isfinite(value) or value < smallest_allowed:
-                raise ValueError(f"{label} must be a finite, positive number of seconds, got {value}")
+                unit = "metres" if label == "tracking_tolerance" else "seconds"
+                raise ValueError(f"{label} must be a finite, positive number of {unit}, got {value}")
+        steps = self.log_period / self.plant.time_step
+        if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
+            raise ValueError(f"log_period must be a whole multiple of plant.time_step = {self.plant.time_step} s "
+                             f"(the loggers sample the plant's steps), got {self.log_period} s")
+        if self.log_period > self.max_duration:
+            raise ValueError(f"log_period ({self.log_period} s) must not be longer than max_duration "
+                             f"({self.max_duration} s): the run would log one sample")
         if self.simulator.integration_scheme not in GetIntegrationSchemes():
             raise ValueError(f"simulator.integration_scheme must be one of {GetIntegrationSchemes()}, "
                              f"got {self.simulator.integration_scheme!r}")
@@ -163,44 +187,57 @@ def find_scenario(reference: str, variant: str | None = None) -> tuple[Path, str
 
 def scenario_variants(path) -> list[str]:
     """The variant names of a scenario file; empty when the file is one scenario."""
-    data = yaml_load(filename=str(path))
-    if not isinstance(data, dict) or not data:
-        raise ValueError(f"{path}: a scenario file must be a YAML mapping")
-    scenario_keys = {f.name for f in fields(Scenario)}
-    if scenario_keys & set(data):
-        return []
-    return [key for key in data if not key.startswith("_")]
+    return list(checked_document(Path(path), Scenario)[1])
 
 
 def load_scenario(path, variant: str | None = None) -> Scenario:
     """Read and validate a scenario YAML file (``variant``: the named child of a file of
-    variants; it may be left out when the file is one scenario or has a single variant)."""
+    variants; it may be left out when the file is one scenario or has a single variant).
+
+    Raises :class:`ScenarioError` (a ValueError) naming the file, the line and the field.
+    """
     path = Path(path)
     if not path.is_file():
-        raise ValueError(f"scenario file not found: {path}")
-    variants = scenario_variants(path)
+        raise ScenarioError(f"scenario file not found: {path}")
+    root, variants, check = checked_document(path, Scenario)
     if variants:
         if variant is None and len(variants) == 1:
-            variant = variants[0]
+            variant = next(iter(variants))
         if variant not in variants:
             asked = "no variant was given" if variant is None else f"there is no variant {variant!r}"
-            raise ValueError(f"{path}: {asked}; its variants are {variants}")
+            raise ScenarioError(f"{path}: {asked}; its variants are {list(variants)}")
+        marks = check(variants[variant])
     elif variant is not None:
-        raise ValueError(f"{path} holds one scenario, not variants; got variant {variant!r}")
+        raise ScenarioError(f"{path} holds one scenario, not variants; got variant {variant!r}")
+    else:
+        marks = check(root)
     try:
         scenario = yaml_load_typed(schema=Scenario, data=path.read_text(), child_name=variant)
-    except RuntimeError as error:  # unknown keys, wrong types
-        raise ValueError(f"{path}: {error}") from error
+    except RuntimeError as error:  # not expected after the check above; still one clear message
+        raise ScenarioError(f"{path}: {error}") from None
     try:
         scenario.validate()
     except ValueError as error:
-        raise ValueError(f"{path}: {error}") from error
+        raise ScenarioError(locate(marks, path, str(error))) from None
     return scenario
 
 
 def make_planner(scenario: Scenario) -> PlannerSystem:
-    """The planner system the scenario describes (errors name the scenario and its ``planner``)."""
+    """The planner system the scenario describes, its limits checked against the robot's rated
+    joint speeds (errors name the scenario and the ``planner`` field)."""
+    robot = get_robot(scenario.robot)
     try:
-        return make_planner_from_config(scenario.planner, get_robot(scenario.robot), scenario.start_configuration())
+        planner = make_planner_from_config(scenario.planner, robot, scenario.start_configuration())
     except ValueError as error:
-        raise ValueError(f"scenario {scenario.name!r}, planner: {error}") from error
+        field = re.match(r"[A-Za-z_]\w*(\[\d+\])?", str(error))
+        raise type(error)(f"scenario {scenario.name!r}: planner{'.' if field else ': '}{error}") from error
+    velocity = np.broadcast_to(planner.velocity_limit, (robot.num_joints,))
+    above = np.flatnonzero(velocity > robot.velocity_limits * (1 + 1e-9))
+    if len(above):
+        j = int(above[0])
+        unit = robot.joint_unit(j)
+        raise ValueError(
+            f"scenario {scenario.name!r}: planner.velocity_limit[{j}] = {velocity[j]:g} {unit}/s is above the rated "
+            f"speed of the {robot.name}'s joint {j + 1} ({robot.joint_names[j]}), {robot.velocity_limits[j]:g} {unit}/s: "
+            "the arm could not follow")
+    return planner

@@ -66,9 +66,9 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_traj.errors import Failure
 from drake_traj.planners.base import PlannerSystem
-from drake_traj.result import LOGGERS, SimulationResult
+from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
 from drake_traj.robots import UR10E, Robot
-from drake_traj.validation import positive_scalar
+from drake_traj.validation import instance_of, positive_scalar
 
 __all__ = [
     "ControllerGains", "SpeedOverride", "Station", "add_speed_override", "add_station", "build_station",
@@ -217,8 +217,11 @@ def add_station(
         log_period: the loggers' period [s]: they sample at k * log_period from t = 0.
         meshcat: when given, the robot is drawn there.
     """
+    instance_of(planner, PlannerSystem, "planner")
+    instance_of(robot, Robot, "robot")
+    instance_of(gains or ControllerGains(), ControllerGains, "gains")
     gains = (gains or ControllerGains()).for_robot(robot)
-    plant_config = plant_config or default_plant_config()
+    plant_config = instance_of(plant_config or default_plant_config(), MultibodyPlantConfig, "plant_config")
     n = robot.num_joints
     if planner.num_joints != n:
         raise ValueError(f"the planner has {planner.num_joints} joints, robot {robot.name} has {n}")
@@ -352,6 +355,7 @@ def simulate(
     progress=None,
     add_systems=None,
     before_run=None,
+    tracking_tolerance: float | None = DEFAULT_TRACKING_TOLERANCE,
 ) -> SimulationResult:
     """Run ``planner`` in a station until it finishes, plus ``settle_time`` [s].
 
@@ -370,6 +374,9 @@ def simulate(
             diagram is built (e.g. a speed-override source of one's own).
         before_run: ``before_run(simulator)`` is called once the simulator is initialized (the
             robot drawn at its start), before the motion (e.g. to wait for a browser).
+        tracking_tolerance: the run fails if the TCP strays further from the reference [m], or
+            if a joint's torque saturates (None: no such check; see
+            :meth:`SimulationResult.execution_failure`).
     """
     builder = DiagramBuilder()
     station = builder.AddSystem(build_station(planner, robot=robot, gains=gains, plant_config=plant_config,
@@ -393,4 +400,4 @@ def simulate(
         visualizer.StopRecording()
         visualizer.PublishRecording()
     return SimulationResult.from_station(station, station.GetMyContextFromRoot(simulator.get_context()), name=name,
-                                         failure=failure, wall_time=wall_time)
+                                         failure=failure, wall_time=wall_time, tracking_tolerance=tracking_tolerance)

@@ -66,3 +66,10 @@ def limit_or_default(value, default, name: str, n: int) -> np.ndarray:
             raise ValueError(f"{name} must be given: the robot has no default {name.replace('_', ' ')}")
         value = default
     return positive_vector(value, name, n)
+
+
+def instance_of(value, expected: type, name: str):
+    """``value`` if it is an ``expected``, else TypeError naming ``name`` and what was given."""
+    if not isinstance(value, expected):
+        raise TypeError(f"{name} must be a {expected.__name__}, got {type(value).__name__}: {value!r:.80}")
+    return value

@@ -83,9 +83,10 @@ def read_until(stream, text: str, *, timeout: float) -> str:
     raise RuntimeError(f"{text!r} not seen within {timeout} s; got:\n{''.join(seen)}")
 
 
-def screenshot_url(url: str, png_path, **kwargs) -> Path:
-    """:func:`screenshot_html` of a page served at ``url`` (e.g. a live Meshcat)."""
-    return screenshot_html(url, png_path, **kwargs)
+def screenshot_url(url: str, png_path, *, wait_ms: int = 4000, **kwargs) -> Path:
+    """Screenshot of a page served at ``url`` (e.g. a live Meshcat) after ``wait_ms`` of real
+    time: a live page never goes idle, so a virtual-time budget would never run out."""
+    return screenshot_html(url, png_path, real_time_ms=wait_ms, **kwargs)
 
 
 def screenshot_html(
@@ -96,6 +97,7 @@ def screenshot_html(
     height: int = 800,
     timeout: float = 120,
     virtual_time_ms: int = 5000,
+    real_time_ms: int | None = None,
 ) -> Path:
     """Render an HTML file in headless Chromium and save a PNG screenshot.
 
@@ -111,6 +113,8 @@ def screenshot_html(
             budget costs little; a Meshcat recording shorter than the budget is
             captured at its final frame.  Must be positive (a zero budget makes
             Chromium wait forever).
+        real_time_ms: Instead of the virtual-time budget, take the screenshot after this many
+            milliseconds of real time (for a live page).
 
     Returns:
         The absolute path of the PNG.
@@ -135,7 +139,7 @@ def screenshot_html(
             *_CHROMIUM_FLAGS,
             f"--user-data-dir={profile}",
             f"--window-size={width},{height}",
-            f"--virtual-time-budget={virtual_time_ms}",
+            f"--timeout={real_time_ms}" if real_time_ms else f"--virtual-time-budget={virtual_time_ms}",
             f"--screenshot={png}",
             page,
         ]

@@ -8,7 +8,6 @@ red TCP path and of the orange waypoint spheres, against an empty Meshcat scene 
 import os
 import subprocess
 import sys
-import time
 
 import pytest
 from pydrake.geometry import Meshcat
@@ -55,18 +54,18 @@ def test_live_view_shows_the_arm_the_task_and_a_growing_trail(tmp_path):
     assert CHROMIUM is not None, "CI must install chromium"
     port = browser.free_port()
     out = tmp_path / "live"
-    # Half speed: the 6.2 s quintic motion takes 12 s of wall time; no terminal: no prompt after it.
+    # Quarter speed: the 6.2 s quintic motion takes 25 s of wall time; no terminal: no prompt after it.
     process = subprocess.Popen(
         [sys.executable, "-m", "drake_traj.cli", "run", "quintic_ptp", "--out", str(out), "--meshcat",
-         "--port", str(port), "--rate", "0.5", "--wait-timeout", "120"],
+         "--port", str(port), "--rate", "0.25", "--wait-timeout", "120"],
         stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         waiting = browser.read_until(process.stderr, "waiting up to", timeout=120)
         assert f"http://localhost:{port}" in waiting
-        # The first browser to connect starts the motion; two screenshots 4 s apart catch it mid-way.
-        early = browser.screenshot_url(f"http://localhost:{port}", tmp_path / "early.png")
-        time.sleep(4.0)
-        later = browser.screenshot_url(f"http://localhost:{port}", tmp_path / "later.png")
+        # The first browser to connect starts the motion; two more screenshots catch it mid-way.
+        browser.screenshot_url(f"http://localhost:{port}", tmp_path / "start.png", wait_ms=1000)
+        early = browser.screenshot_url(f"http://localhost:{port}", tmp_path / "early.png", wait_ms=6000)
+        later = browser.screenshot_url(f"http://localhost:{port}", tmp_path / "later.png", wait_ms=6000)
         stdout, stderr = process.communicate(timeout=180)
     finally:
         process.kill()
@@ -75,5 +74,5 @@ def test_live_view_shows_the_arm_the_task_and_a_growing_trail(tmp_path):
     for png in (early, later):  # the arm and the task (the goals' neighbourhoods, orange)
         assert browser.blue_pixel_fraction(png) > 0.002
         assert orange_pixels(png) > 100
-    # The trail grows with the motion and is part of the final path (measured: about 300, 900, 1300).
-    assert 50 < red_pixels(early) < red_pixels(later) < red_pixels(final)
+    # The trail grows with the motion and is part of the final path.
+    assert red_pixels(early) < red_pixels(later) < 0.9 * red_pixels(final) and red_pixels(later) > 50

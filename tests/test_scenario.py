@@ -39,7 +39,7 @@ def test_default_scenario_is_shipped_with_the_package():
 @pytest.mark.parametrize(
     "change, message",
     [
-        (("name: quintic_ptp", "name: quintic_ptp\nspeed: 3"), r"\['speed'\]"),
+        (("name: quintic_ptp", "name: quintic_ptp\nspeed: 3"), r"line 5, column 1: speed: unknown field"),
         (("  goals:", "  goalz:"), r"goalz"),
         (("q_initial: [-1.5707963267948966, ", "q_initial: ["), r"q_initial must have 6 entries"),
         (("q_initial: [-1.5707963267948966", "q_initial: [.nan"), r"q_initial must be finite"),

@@ -20,6 +20,7 @@ from drake_traj.planners.li.system import LiConfig
 from drake_traj.planners.pajak import PajakConfig
 from drake_traj.planners.quintic import QuinticConfig
 from drake_traj.robots.base import Robot
+from drake_traj.validation import finite_array, instance_of
 
 __all__ = [
     "BorygaConfig", "LiConfig", "MovejConfig", "PLANNER_CONFIGS", "PajakConfig", "PlannerConfig", "PlannerSystem",
@@ -46,4 +47,5 @@ def make_planner(config: PlannerConfig, robot: Robot, q_initial) -> PlannerSyste
         maker = _MAKERS[type(config)]
     except KeyError:
         raise TypeError(f"config must be one of {[c.__name__ for c in PLANNER_CONFIGS]}, got {type(config).__name__}") from None
-    return maker(config, robot, q_initial)
+    instance_of(robot, Robot, "robot")
+    return maker(config, robot, finite_array(q_initial, "q_initial", "rad or m", shape=(robot.num_joints,)))

@@ -41,9 +41,9 @@ class PlannerSystem(LeafSystem):
 
     def __init__(self, q_initial, *, initial_scaling: float = 1.0):
         super().__init__()
-        q_initial = np.array(q_initial, dtype=float)
-        if q_initial.ndim != 1 or not len(q_initial) or not np.all(np.isfinite(q_initial)):
-            raise ValueError(f"q_initial must be a non-empty vector of finite joint positions, got {q_initial}")
+        q_initial = finite_array(q_initial, "q_initial", "rad or m")
+        if q_initial.ndim != 1 or not len(q_initial):
+            raise ValueError(f"q_initial must be a non-empty vector of joint positions, got shape {q_initial.shape}")
         n = len(q_initial)
         self.num_joints = n
         self._q_initial = q_initial
@@ -191,6 +191,10 @@ class TimeLawPlanner(PlannerSystem):
 
     def __init__(self, law, velocity_limit, acceleration_limit, *, speed_cap: float = 1.0, update_period: float = 0.001,
                  scaling_rate: float = 4.0, clock_jerk: float = 20.0):
+        missing = [name for name in ("q_start", "duration", "rates_at", "sample") if not hasattr(law, name)]
+        if missing:
+            raise TypeError(f"law must be a time law with q_start, duration, rates_at and sample; "
+                            f"a {type(law).__name__} has no {', '.join(missing)}")
         if not np.isfinite(speed_cap) or not 0.0 < speed_cap <= 1.0:
             raise ValueError(f"speed_cap must be in (0, 1], got {speed_cap}")
         for name, value in (("update_period", update_period), ("scaling_rate", scaling_rate), ("clock_jerk", clock_jerk)):

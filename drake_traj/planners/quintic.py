@@ -24,7 +24,7 @@ import numpy as np
 
 from drake_traj.planners.base import TimeLawPlanner
 from drake_traj.robots import UR10E, Robot
-from drake_traj.validation import limit_or_default
+from drake_traj.validation import instance_of, limit_or_default
 
 __all__ = [
     "QuinticPlan",
@@ -591,6 +591,7 @@ class QuinticPtpPlanner(TimeLawPlanner):
 
     def __init__(self, plan: QuinticPlan, velocity_limit, acceleration_limit, *, update_period: float = 0.001,
                  robot: Robot = UR10E):
+        instance_of(plan, QuinticPlan, "plan")
         super().__init__(
             plan,
             _limit_vector(velocity_limit, "velocity_limit", plan.num_joints),

@@ -64,7 +64,10 @@ def model_path() -> Path:
 
 
 def _as_joint_vector(q, name: str = "q") -> np.ndarray:
-    q = np.asarray(q, dtype=float)
+    try:
+        q = np.asarray(q, dtype=float)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{name} must be {NUM_JOINTS} joint positions [rad]: {error}") from None
     if q.shape != (NUM_JOINTS,):
         raise ValueError(f"{name} must have shape ({NUM_JOINTS},), got {q.shape}")
     if not np.all(np.isfinite(q)):

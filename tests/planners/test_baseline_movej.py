@@ -185,5 +185,5 @@ def test_validation_names_the_argument(waypoints, kwargs, name):
 
 
 def test_planner_rejects_other_laws():
-    with pytest.raises(ValueError, match="law"):
+    with pytest.raises(TypeError, match="law must be a MovejBlendLaw"):
         MovejPlanner(object())

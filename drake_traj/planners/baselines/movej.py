@@ -48,7 +48,7 @@ import numpy as np
 
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.robots import UR10E, Robot
-from drake_traj.validation import limit_or_default, positive_vector
+from drake_traj.validation import instance_of, limit_or_default, positive_vector
 
 __all__ = [
     "MovejBlendLaw",
@@ -306,8 +306,7 @@ class MovejPlanner(TimeLawPlanner):
 
     def __init__(self, law: MovejBlendLaw, *, speed_cap: float = 1.0, update_period: float = 0.001,
                  robot: Robot = UR10E):
-        if not isinstance(law, MovejBlendLaw):
-            raise ValueError(f"law must be a MovejBlendLaw, got {type(law).__name__}")
+        instance_of(law, MovejBlendLaw, "law")
         super().__init__(law, law.velocity_limit, law.acceleration_limit, speed_cap=speed_cap, update_period=update_period)
         self.robot = robot
 

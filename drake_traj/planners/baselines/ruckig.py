@@ -30,7 +30,7 @@ import ruckig
 
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.robots import UR10E, Robot
-from drake_traj.validation import limit_or_default, positive_vector
+from drake_traj.validation import instance_of, limit_or_default, positive_vector
 
 __all__ = ["DEFAULT_JERK_FACTOR", "RuckigPlanner", "RuckigStopLaw", "default_jerk_limit"]
 
@@ -223,6 +223,7 @@ class RuckigPlanner(TimeLawPlanner):
 
     def __init__(self, law: RuckigStopLaw, *, speed_cap: float = 1.0, update_period: float = 0.001,
                  robot: Robot = UR10E):
+        instance_of(law, RuckigStopLaw, "law")
         super().__init__(
             law,
             law.velocity_limit,

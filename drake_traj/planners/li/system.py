@@ -10,7 +10,7 @@ from drake_traj.planners.base import TimeLawPlanner
 from drake_traj.planners.li.plan import LiPlan, plan_li_path
 from drake_traj.planners.li.repair import tool_speed_and_acceleration
 from drake_traj.robots import LI_4DOF, Robot
-from drake_traj.validation import limit_or_default
+from drake_traj.validation import instance_of, limit_or_default
 
 __all__ = ["CARTESIAN_ACCELERATION_LIMIT", "CARTESIAN_VELOCITY_LIMIT", "LiConfig", "LiPathPlanner", "li_closed_path",
            "make"]
@@ -102,6 +102,7 @@ class LiPathPlanner(TimeLawPlanner):
     """
 
     def __init__(self, plan: LiPlan, velocity_limit, acceleration_limit, tool_motion, tool_limits):
+        instance_of(plan, LiPlan, "plan")
         super().__init__(plan.law, velocity_limit, acceleration_limit)
         self.li_plan = plan
         self._tool_motion = tool_motion

@@ -1,0 +1,199 @@
+"""Strict reading of scenario YAML, before pydrake's ``yaml_load_typed`` builds the objects.
+
+Every problem is one :class:`ScenarioError` naming the file, the line and column, the field's
+path inside the document (``planner.velocity_limit[2]``), what was expected and what was found:
+YAML syntax errors, duplicate keys (the YAML spec forbids them; loaders keep the last one
+silently), Python object tags, unknown keys, and values of the wrong kind (text where a number is
+expected, a number where a list is expected, ...). Types come from the dataclass annotations of
+the schema (and the ``__fields__`` of pydrake's config classes), so there is one schema, the
+dataclasses.
+"""
+
+import dataclasses
+import re
+import typing
+from pathlib import Path
+
+import yaml
+
+from drake_traj.errors import DrakeTrajError
+
+__all__ = ["ScenarioError", "checked_document"]
+
+_INT, _FLOAT, _BOOL, _STR, _NULL = (f"tag:yaml.org,2002:{name}" for name in ("int", "float", "bool", "str", "null"))
+_FOUND = {_INT: "an integer", _FLOAT: "a number", _BOOL: "true/false", _STR: "text", _NULL: "nothing (null)"}
+
+
+class ScenarioError(DrakeTrajError):
+    """A scenario file is malformed: names the file, the place and the field."""
+
+
+class _Loader(yaml.SafeLoader):
+    """SafeLoader whose mappings refuse duplicate keys (merge keys ``<<`` still merge)."""
+
+
+def _where(path: Path, node) -> str:
+    return f"{path}, line {node.start_mark.line + 1}, column {node.start_mark.column + 1}"
+
+
+def _describe(node) -> str:
+    if isinstance(node, yaml.MappingNode):
+        return f"a mapping with keys {[key.value for key, _ in node.value]}"
+    if isinstance(node, yaml.SequenceNode):
+        return f"a list of {len(node.value)} entries"
+    kind = _FOUND.get(node.tag, f"a value tagged {node.tag}")
+    return f"{kind} {node.value!r}" if node.tag != _NULL else kind
+
+
+def _fields(schema) -> dict:
+    """{field name: type} of a dataclass or of a pydrake config class (``__fields__``)."""
+    if dataclasses.is_dataclass(schema):
+        hints = typing.get_type_hints(schema)
+        return {item.name: hints[item.name] for item in dataclasses.fields(schema)}
+    return {item.name: item.type for item in schema.__fields__}
+
+
+def _is_record(schema) -> bool:
+    return isinstance(schema, type) and (dataclasses.is_dataclass(schema) or hasattr(schema, "__fields__"))
+
+
+class _Checker:
+    def __init__(self, path: Path, loader: _Loader):
+        self.path = path
+        self.loader = loader
+        self.marks: dict[str, object] = {}  # field path -> node, for value errors found later
+
+    def fail(self, node, field: str, message: str) -> typing.NoReturn:
+        where = f"{_where(self.path, node)}: " if node is not None else f"{self.path}: "
+        raise ScenarioError(f"{where}{field + ': ' if field else ''}{message}")
+
+    def mapping_items(self, node, field: str):
+        """The (key, value) nodes of a mapping, merge keys applied, duplicate keys refused."""
+        seen = {}
+        for key, _ in node.value:
+            if key.tag == "tag:yaml.org,2002:merge":
+                continue
+            if key.value in seen:
+                self.fail(key, f"{field}.{key.value}" if field else key.value,
+                          f"duplicate key (first at line {seen[key.value].start_mark.line + 1}); "
+                          "each key may appear once")
+            seen[key.value] = key
+        self.loader.flatten_mapping(node)
+        return node.value
+
+    def check(self, node, schema, field: str) -> None:
+        self.marks[field] = node
+        if node.tag.startswith("tag:yaml.org,2002:python/"):
+            self.fail(node, field, f"the tag {node.tag.split(':', 2)[-1]!r} is not allowed: scenario files hold data, "
+                                   "not Python objects")
+        origin = typing.get_origin(schema)
+        if origin is typing.Union:
+            return self.check_union(node, typing.get_args(schema), field)
+        if origin is list:
+            if not isinstance(node, yaml.SequenceNode):
+                self.fail(node, field, f"expected a list, found {_describe(node)}")
+            (item,) = typing.get_args(schema)
+            for index, child in enumerate(node.value):
+                self.check(child, item, f"{field}[{index}]")
+            return None
+        if _is_record(schema):
+            return self.check_record(node, schema, field)
+        expected = {float: ("a number", (_INT, _FLOAT)), int: ("an integer", (_INT,)), bool: ("true or false", (_BOOL,)),
+                    str: ("text", (_STR,))}
+        if schema in expected:
+            description, tags = expected[schema]
+            if not isinstance(node, yaml.ScalarNode) or node.tag not in tags:
+                self.fail(node, field, f"expected {description}, found {_describe(node)}")
+            return None
+        raise TypeError(f"no YAML check for the type {schema!r} of {field}")  # a schema we did not foresee
+
+    def check_union(self, node, options, field: str) -> None:
+        names = {option.__name__: option for option in options}
+        if not isinstance(node, yaml.MappingNode):
+            self.fail(node, field, f"expected a mapping tagged with one of !{', !'.join(names)}, found {_describe(node)}")
+        tag = node.tag[1:] if node.tag.startswith("!") and not node.tag.startswith("!!") else None
+        if tag is None:  # untagged: pydrake reads the first type
+            keys = {key.value for key, _ in node.value}
+            if not keys <= set(_fields(options[0])) | {"<<"}:
+                self.fail(node, field, f"needs a tag naming its type, one of !{', !'.join(names)} "
+                                       f"(e.g. {field}: !{options[1].__name__}); without one it is read as "
+                                       f"{options[0].__name__}, which has no {sorted(keys - set(_fields(options[0])))}")
+            return self.check_record(node, options[0], field)
+        if tag not in names:
+            self.fail(node, field, f"unknown type !{tag}; expected one of !{', !'.join(names)}")
+        return self.check_record(node, names[tag], field)
+
+    def check_record(self, node, schema, field: str) -> None:
+        if not isinstance(node, yaml.MappingNode):
+            self.fail(node, field, f"expected a mapping of {schema.__name__}'s fields, found {_describe(node)}")
+        fields = _fields(schema)
+        for key, value in self.mapping_items(node, field):
+            name = f"{field}.{key.value}" if field else key.value
+            if key.value not in fields:
+                close = [known for known in fields if known.startswith(key.value[:3])]
+                hint = f" (did you mean {close[0]!r}?)" if close else ""
+                self.fail(key, name, f"unknown field{hint}; {schema.__name__} has {sorted(fields)}")
+            self.check(value, fields[key.value], name)
+
+
+def _mark_message(error: yaml.MarkedYAMLError) -> str:
+    mark = error.problem_mark or error.context_mark
+    where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
+    return f"{where}{error.problem or error.context}"
+
+
+def checked_document(path: Path, schema, variant_keys=None) -> tuple[object, dict, typing.Callable]:
+    """Parse the scenario file ``path`` strictly.
+
+    Returns (top-level mapping node, {variant name: node} (empty for a file of one scenario),
+    ``check(node, field_prefix) -> marks``) where ``check`` validates a scenario node against
+    ``schema`` and returns {field path: node} for locating later value errors.
+    Raises :class:`ScenarioError`.
+    """
+    try:
+        raw = path.read_bytes()
+    except OSError as error:
+        raise ScenarioError(f"{path}: cannot be read: {error.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise ScenarioError(f"{path} is not a text (UTF-8) file: byte {raw[error.start]:#04x} at offset "
+                            f"{error.start} cannot be decoded") from None
+    loader = _Loader(text)
+    try:
+        root = loader.get_single_node()
+    except yaml.MarkedYAMLError as error:
+        raise ScenarioError(f"{path}: YAML syntax error at {_mark_message(error)}") from None
+    except yaml.YAMLError as error:
+        raise ScenarioError(f"{path}: YAML error: {error}") from None
+    finally:
+        loader.dispose()
+    checker = _Checker(path, loader)
+    if root is None:
+        checker.fail(None, "", "the file is empty; a scenario needs at least a planner (see diagrams/)")
+    if not isinstance(root, yaml.MappingNode):
+        checker.fail(root, "", f"a scenario file must be a mapping of fields (or of named variants), found {_describe(root)}")
+    fields = _fields(schema)
+    keys = [key.value for key, _ in root.value]
+    variants = {}
+    if not set(keys) & set(fields):  # a file of variants: top-level keys name them
+        for key, value in checker.mapping_items(root, ""):
+            if not key.value.startswith("_"):
+                variants[key.value] = value
+
+    def check(node, prefix: str = "") -> dict:
+        checker.marks = {}
+        checker.check_record(node, schema, prefix)
+        return dict(checker.marks)
+
+    return root, variants, check
+
+
+def locate(marks: dict, path: Path, message: str) -> str:
+    """``message`` prefixed with the file and the line of the field it starts with, if known."""
+    match = re.match(r"([A-Za-z_][\w.]*(?:\[\d+\])*)", message)
+    node = marks.get(match.group(1)) if match else None
+    if node is None and match:  # a field path with an index the marks hold without it
+        node = marks.get(re.sub(r"\[\d+\]$", "", match.group(1)))
+    where = _where(path, node) if node is not None else str(path)
+    return f"{where}: {message}"
