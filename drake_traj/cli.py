@@ -148,7 +148,7 @@ def run_bench(args) -> int:
     return EXIT_OK
 
 
-def check_options(parser: argparse.ArgumentParser, args) -> None:
+def check_options(args) -> None:
     """Options argparse cannot check by type: an error (exit 2) names the option and the value."""
     checks = []
     if args.command == "run":
@@ -158,7 +158,7 @@ def check_options(parser: argparse.ArgumentParser, args) -> None:
                    "a number of seconds >= 0")]
     for option, ok, value, expected in checks:
         if not ok:
-            parser.error(f"{option} must be {expected}, got {value}")
+            raise ValueError(f"{option} must be {expected}, got {value}")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -196,9 +196,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
     try:
-        check_options(parser, args)
+        args = parser.parse_args(argv)
+    except SystemExit as done:  # --help, --version, or a usage error argparse printed (code 2)
+        return done.code
+    try:
+        check_options(args)
         return args.handler(args)
     except KeyboardInterrupt:
         print("drake-traj: interrupted", file=sys.stderr)

@@ -251,10 +251,13 @@ class SimulationResult:
         names = {f.name for f in fields(cls)}
         try:
             with np.load(path, allow_pickle=False) as data:
+                missing = [name for name in ("meta",) + ARRAY_NAMES + _LIMIT_NAMES if name not in data.files]
+                if missing:
+                    raise ResultFileError(f"{path} is not a complete result: it has no {missing[0]!r}")
                 meta = json.loads(str(data["meta"]))
                 arrays = {name: np.array(data[name]) for name in ARRAY_NAMES + _LIMIT_NAMES}
-        except KeyError as error:
-            raise ResultFileError(f"{path} is not a complete result: it has no {error.args[0]!r}") from None
+        except ResultFileError:
+            raise
         except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
             raise ResultFileError(f"{path} cannot be read (truncated or not a result file): {error}") from None
         if not isinstance(meta, dict) or not {"name", "duration", "failure", "wall_time"} <= set(meta) or set(meta) - names:

@@ -171,8 +171,10 @@ def find_scenario(reference: str, variant: str | None = None) -> tuple[Path, str
     path = Path(reference)
     if path.is_file():
         return path, variant
+    if path.is_dir():
+        raise ScenarioError(f"scenario file {path} is a folder, not a scenario file")
     if path.suffix in (".yaml", ".yml") or len(path.parts) > 1:
-        raise ValueError(f"scenario file not found: {path}")
+        raise ValueError(f"scenario file {path} not found")
     shipped = shipped_scenarios()
     for entry in shipped:
         if entry.name == reference and variant in (None, entry.variant):
@@ -196,9 +198,12 @@ def load_scenario(path, variant: str | None = None) -> Scenario:
 
     Raises :class:`ScenarioError` (a ValueError) naming the file, the line and the field.
     """
+    if not isinstance(path, (str, Path)):
+        raise TypeError(f"path must be a file path (str or Path), got {type(path).__name__}: {path!r:.80}")
     path = Path(path)
     if not path.is_file():
-        raise ScenarioError(f"scenario file not found: {path}")
+        what = "is a folder, not a scenario file" if path.is_dir() else "not found"
+        raise ScenarioError(f"scenario file {path} {what}")
     root, variants, check = checked_document(path, Scenario)
     if variants:
         if variant is None and len(variants) == 1:
@@ -219,6 +224,7 @@ def load_scenario(path, variant: str | None = None) -> Scenario:
         scenario.validate()
     except ValueError as error:
         raise ScenarioError(locate(marks, path, str(error))) from None
+    scenario.source = (path, marks)  # for later messages (make_planner); not a YAML field
     return scenario
 
 
@@ -230,14 +236,20 @@ def make_planner(scenario: Scenario) -> PlannerSystem:
         planner = make_planner_from_config(scenario.planner, robot, scenario.start_configuration())
     except ValueError as error:
         field = re.match(r"[A-Za-z_]\w*(\[\d+\])?", str(error))
-        raise type(error)(f"scenario {scenario.name!r}: planner{'.' if field else ': '}{error}") from error
+        raise type(error)(_where(scenario, f"planner{'.' if field else ': '}{error}")) from error
     velocity = np.broadcast_to(planner.velocity_limit, (robot.num_joints,))
     above = np.flatnonzero(velocity > robot.velocity_limits * (1 + 1e-9))
     if len(above):
         j = int(above[0])
         unit = robot.joint_unit(j)
-        raise ValueError(
-            f"scenario {scenario.name!r}: planner.velocity_limit[{j}] = {velocity[j]:g} {unit}/s is above the rated "
+        raise ValueError(_where(scenario,
+            f"planner.velocity_limit[{j}] = {velocity[j]:g} {unit}/s is above the rated "
             f"speed of the {robot.name}'s joint {j + 1} ({robot.joint_names[j]}), {robot.velocity_limits[j]:g} {unit}/s: "
-            "the arm could not follow")
+            "the arm could not follow"))
     return planner
+
+
+def _where(scenario: Scenario, message: str) -> str:
+    """``message`` located in the scenario's file (and line) when it was loaded from one."""
+    source = getattr(scenario, "source", None)
+    return locate(source[1], source[0], message) if source else f"scenario {scenario.name!r}: {message}"

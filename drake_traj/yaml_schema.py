@@ -103,7 +103,10 @@ class _Checker:
         if schema in expected:
             description, tags = expected[schema]
             if not isinstance(node, yaml.ScalarNode) or node.tag not in tags:
-                self.fail(node, field, f"expected {description}, found {_describe(node)}")
+                hint = ""
+                if node.tag == _STR and re.fullmatch(r"[-+]?\d+[eE][-+]?\d+", str(node.value)):
+                    hint = f" (write {node.value.lower().replace('e', '.0e', 1)}: YAML 1.1 reads a number with an exponent only with a dot)"
+                self.fail(node, field, f"expected {description}, found {_describe(node)}{hint}")
             return None
         raise TypeError(f"no YAML check for the type {schema!r} of {field}")  # a schema we did not foresee
 

@@ -63,7 +63,7 @@ def test_bad_scenarios_name_the_field(tmp_path, change, message):
 
 
 def test_missing_scenario_file_is_named(tmp_path):
-    with pytest.raises(ValueError, match="scenario file not found: .*nowhere.yaml"):
+    with pytest.raises(ValueError, match="scenario file .*nowhere.yaml not found"):
         load_scenario(tmp_path / "nowhere.yaml")
 
 

@@ -1,0 +1,430 @@
+"""Bad input, as a new user would give it: one clean message naming the input, never a traceback,
+nothing of an earlier run touched. Table-driven over scenario YAML, the CLI, the Python API and
+saved results; a property test mutates the shipped scenarios at random."""
+
+import contextlib
+import io
+import json
+import math
+import re
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from drake_traj import (
+    ControllerGains,
+    PajakConfig,
+    QuinticConfig,
+    SimulationResult,
+    cli,
+    get_robot,
+    load_scenario,
+    simulate,
+)
+from drake_traj.planners import make_planner
+from drake_traj.planners.pajak import PajakPlanner, paper_parameters
+from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
+from drake_traj.result import ResultFileError
+from drake_traj.station import SpeedOverride, build_station
+
+DIAGRAMS = Path(__file__).resolve().parents[1] / "diagrams"
+QUINTIC = (DIAGRAMS / "quintic_ptp.yaml").read_text()
+HOME = "[-1.5707963267948966, -1.5707963267948966, -2.356194490192345, -0.7853981633974483, 1.5707963267948966, 0.7853981633974483]"
+
+
+def quintic(old: str, new: str) -> str:
+    """The shipped quintic scenario with one text replaced (which must be there)."""
+    assert old in QUINTIC, old
+    return QUINTIC.replace(old, new, 1)
+
+
+def pajak(planner_lines: str) -> str:
+    """A one-scenario Pająk file with the given planner fields."""
+    return f"name: pajak_case\nrobot: ur10e\nplanner: !PajakConfig\n{planner_lines}"
+
+
+PAJAK_WAYPOINTS = "  waypoints:\n    - [-0.175, -0.525, 0.730, 3.141592653589793, 0.0, 2.356194490192345]\n"
+
+# (case id, scenario text (str) or bytes, regex the message must contain)
+YAML_CASES = [
+    ("empty file", "", r"empty"),
+    ("only comments", "# nothing here\n", r"empty"),
+    ("unclosed bracket", quintic("  goals:", "  goals: [1, 2"), r"YAML syntax error at line \d+, column \d+"),
+    ("bad indentation", quintic("name: quintic_ptp", "name: quintic_ptp\n  robot: ur10e"), r"YAML syntax error at line 5, column 8"),
+    ("top-level list", "- 1\n- 2\n", r"must be a mapping"),
+    ("top-level scalar", "hello\n", r"must be a mapping"),
+    ("unknown top-level key", quintic("name: quintic_ptp", "name: quintic_ptp\nspeed: 3"), r"line 5, column 1: speed: unknown field"),
+    ("unknown planner key", quintic("  goals:", "  goalz:"), r"planner.goalz: unknown field"),
+    ("duplicate top-level key", quintic("name: quintic_ptp", "name: quintic_ptp\nname: again"), r"name: duplicate key \(first at line 4\)"),
+    ("duplicate planner key", quintic("  velocity_limit:", "  acceleration_limit: [1, 1, 1, 1, 1, 1]\n  velocity_limit:"),
+     r"planner.acceleration_limit: duplicate key"),
+    ("python object tag", quintic("name: quintic_ptp", "name: !!python/object:os.system quintic_ptp"),
+     r"name: the tag 'python/object:os.system' is not allowed"),
+    ("python name tag", quintic("settle_time: 0.5", "settle_time: !!python/name:os.system ''"), r"settle_time: the tag"),
+    ("time step as text", quintic("  time_step: 0.001", '  time_step: "fast"'), r"plant.time_step: expected a number, found text 'fast'"),
+    ("q_initial as text", quintic(f"q_initial: {HOME}", 'q_initial: "home"'), r"q_initial: expected a list, found text 'home'"),
+    ("q_initial too short", quintic(f"q_initial: {HOME}", "q_initial: [0, 0, 0]"), r"q_initial must have 6 entries"),
+    ("q_initial NaN", quintic(f"q_initial: {HOME}", "q_initial: [.nan, 0, 0, 0, 0, 0]"), r"q_initial must be finite"),
+    ("q_initial out of range", quintic(f"q_initial: {HOME}", "q_initial: [7, 0, 0, 0, 0, 0]"), r"q_initial\[0\] = 7.0 rad is outside"),
+    ("limit scalar for a list", quintic("  velocity_limit: [1.05, 1.05, 1.05, 1.05, 1.05, 1.05]", "  velocity_limit: 1.05"),
+     r"planner.velocity_limit: expected a list, found a number"),
+    ("limit entry text", quintic("  velocity_limit: [1.05, ", "  velocity_limit: [fast, "), r"planner.velocity_limit\[0\]: expected a number"),
+    ("limit negative", quintic("  velocity_limit: [1.05, ", "  velocity_limit: [-1.05, "), r"planner.velocity_limit\[0\].*> 0"),
+    ("limit zero", quintic("  acceleration_limit: [1.40, ", "  acceleration_limit: [0, "), r"planner.acceleration_limit\[0\].*> 0"),
+    ("limit above rated", quintic("  velocity_limit: [1.05, 1.05, 1.05, 1.05, 1.05, 1.05]", "  velocity_limit: [10, 10, 10, 10, 10, 10]"),
+     r"planner.velocity_limit\[0\] = 10 rad/s is above the rated speed of the ur10e's joint 1 \(shoulder_pan_joint\), 2.094"),
+    ("limit wrong length", quintic("  velocity_limit: [1.05, 1.05, 1.05, 1.05, 1.05, 1.05]", "  velocity_limit: [1, 1, 1, 1, 1]"),
+     r"planner.velocity_limit must be a scalar or have shape \(6,\)"),
+    ("limit infinite", quintic("  acceleration_limit: [1.40, ", "  acceleration_limit: [.inf, "), r"planner.acceleration_limit\[0\].*finite"),
+    ("goal row too short", quintic("    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]", "    - [-0.9, -1.9, -1.9, -0.9, 1.2]"), r"planner.goals"),
+    ("goal out of range", quintic("    - [-0.9, -1.9", "    - [-6.9, -1.9"), r"goals\[0\] joint 0 = -6.9 rad"),
+    ("goals empty", quintic("  goals:\n", "  goals: []\n  goals_removed:\n"), r"planner.goals_removed: unknown field"),
+    ("goals scalar", quintic("  goals:\n    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]\n", "  goals: 3\n  unused:\n    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]\n"),
+     r"planner.goals: expected a list, found an integer"),
+    ("unknown planner tag", quintic("planner: !QuinticConfig", "planner: !FastestConfig"), r"planner: unknown type !FastestConfig; expected one of"),
+    ("untagged pajak planner", pajak(PAJAK_WAYPOINTS).replace(" !PajakConfig", ""), r"planner: needs a tag naming its type"),
+    ("unknown robot", quintic("name: quintic_ptp", "name: quintic_ptp\nrobot: puma"), r"robot: robot must be one of"),
+    ("robot as number", quintic("name: quintic_ptp", "name: quintic_ptp\nrobot: 5"), r"robot: expected text, found an integer"),
+    ("name with ..", quintic("name: quintic_ptp", "name: ../../x"), r"name must be a plain name"),
+    ("name absolute", quintic("name: quintic_ptp", "name: /some/abs/path"), r"name must be a plain name"),
+    ("name with space", quintic("name: quintic_ptp", "name: my run"), r"name must be a plain name"),
+    ("log period tiny", quintic("log_period: 0.001", "log_period: 1.0e-7"), r"log_period must be a whole multiple of plant.time_step"),
+    ("exponent without a dot", quintic("log_period: 0.001", "log_period: 1e-3"), r"log_period: expected a number, found text '1e-3' \(write 1.0e-3"),
+    ("log period huge", quintic("log_period: 0.001", "log_period: 200.0"), r"log_period \(200.0 s\) must not be longer than max_duration"),
+    ("log period off grid", quintic("log_period: 0.001", "log_period: 0.0015"), r"log_period must be a whole multiple"),
+    ("time step zero", quintic("  time_step: 0.001", "  time_step: 0.0"), r"plant.time_step must be a finite, positive"),
+    ("time step negative", quintic("  time_step: 0.001", "  time_step: -0.001"), r"plant.time_step must be a finite, positive"),
+    ("plant unknown key", quintic("  time_step: 0.001", "  time_step: 0.001\n  gravity: 9.81"), r"plant.gravity: unknown field"),
+    ("integration scheme", quintic("log_period: 0.001", "log_period: 0.001\nsimulator:\n  integration_scheme: warp"),
+     r"simulator.integration_scheme must be one of"),
+    ("max step negative", quintic("log_period: 0.001", "log_period: 0.001\nsimulator:\n  max_step_size: -1.0"), r"simulator.max_step_size must be"),
+    ("kp wrong length", quintic("  kp: [4000, 4000, 2000, 500, 500, 300]", "  kp: [4000, 4000]"), r"controller.kp must have 6 entries"),
+    ("kp negative", quintic("  kp: [4000, ", "  kp: [-4000, "), r"controller.kp"),
+    ("feedforward as text", quintic("  feedforward_acceleration: true", '  feedforward_acceleration: "yes"'),
+     r"controller.feedforward_acceleration: expected true or false"),
+    ("settle time negative", quintic("settle_time: 0.5", "settle_time: -1"), r"settle_time must be a finite"),
+    ("max duration zero", quintic("settle_time: 0.5", "settle_time: 0.5\nmax_duration: 0"), r"max_duration must be a finite, positive"),
+    ("tracking tolerance negative", quintic("settle_time: 0.5", "settle_time: 0.5\ntracking_tolerance: -1"), r"tracking_tolerance must be"),
+    ("override above one", quintic("settle_time: 0.5", "settle_time: 0.5\nspeed_override: {times: [1.0], values: [2.0]}"),
+     r"speed_override.values must be in \[0, 1\]"),
+    ("override times backwards", quintic("settle_time: 0.5", "settle_time: 0.5\nspeed_override: {times: [2.0, 1.0], values: [0.5, 1.0]}"),
+     r"speed_override.times must be finite, >= 0 and increasing"),
+    ("override unequal lengths", quintic("settle_time: 0.5", "settle_time: 0.5\nspeed_override: {times: [2.0], values: [0.5, 1.0]}"),
+     r"speed_override.times and speed_override.values must be two lists of equal length"),
+    ("binary file", b"\x89PNG\r\n\x1a\n\x00\x00\xff\xfe", r"is not a text \(UTF-8\) file"),
+    ("pajak waypoint out of reach", pajak("  waypoints:\n    - [1.5, 0, 0.2, 3.14, 0, 0]\n"), r"planner.waypoints\[0\] position .* beyond the UR10e reach"),
+    ("pajak waypoints too close", pajak(PAJAK_WAYPOINTS + "    - [-0.175, -0.535, 0.730, 3.141592653589793, 0.0, 2.356194490192345]\n"),
+     r"waypoints\[0\] and waypoints\[1\] are 0.0100 m apart"),
+    ("pajak vartheta out of range", pajak(PAJAK_WAYPOINTS + "  vartheta: 0.7\n"), r"vartheta must be a number in \(0, 0.5\)"),
+    ("pajak waypoint short row", pajak("  waypoints:\n    - [-0.175, -0.525, 0.730]\n"), r"waypoints must have shape \(w, 6\)"),
+    ("boryga only B", "name: b\nrobot: scara\nplanner: !BorygaConfig\n  B: [0.5, 0.5, 0.265]\n", r"B, M and E must all be 3-vectors"),
+    ("li tool acceleration zero", "name: l\nrobot: li_4dof\nplanner: !LiConfig\n  tool_acceleration_limit: 0.0\n", r"a_max"),
+    ("li on a robot without acceleration limits", "name: l\nrobot: scara\nplanner: !LiConfig {}\n",
+     r"acceleration_limit must be given: the robot has no default"),
+]
+
+
+@pytest.fixture
+def earlier_run(tmp_path):
+    """An output folder holding a sentinel: an earlier run's file that must not change."""
+    folder = tmp_path / "earlier"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine")
+    return folder
+
+
+def folder_state(folder: Path) -> dict:
+    return {path.name: path.read_bytes() for path in sorted(folder.iterdir())} if folder.exists() else {}
+
+
+def assert_clean_exit(code, capsys, pattern, expected_code=cli.EXIT_BAD_INPUT, name=None):
+    captured = capsys.readouterr()
+    if name is not None:
+        assert name in captured.err, captured.err  # the message names the file
+    assert code == expected_code, captured.err
+    assert "Traceback" not in captured.err + captured.out
+    assert captured.err.startswith("drake-traj: ") or captured.err.startswith("usage:"), captured.err
+    if captured.err.startswith("usage:"):  # argparse: its usage, then one line of error
+        assert "error:" in captured.err.strip().splitlines()[-1], captured.err
+    else:
+        assert len(captured.err.strip().splitlines()) == 1, captured.err  # one paragraph
+    assert re.search(pattern, captured.err), captured.err
+
+
+@pytest.mark.parametrize("case, text, pattern", YAML_CASES, ids=[case[0] for case in YAML_CASES])
+def test_bad_scenario_files(case, text, pattern, tmp_path, earlier_run, capsys):
+    path = tmp_path / "scenario.yaml"
+    path.write_bytes(text if isinstance(text, bytes) else text.encode())
+    before = folder_state(earlier_run)
+    code = cli.main(["run", str(path), "--out", str(earlier_run)])
+    assert_clean_exit(code, capsys, pattern, name=str(path))
+    assert folder_state(earlier_run) == before
+
+
+def test_scenario_messages_name_the_file_and_line(tmp_path):
+    path = tmp_path / "scenario.yaml"
+    path.write_text(quintic("  velocity_limit: [1.05, ", "  velocity_limit: [fast, "))
+    with pytest.raises(ValueError, match=rf"{path}, line 12, column 20: planner.velocity_limit\[0\]"):
+        load_scenario(path)
+
+
+CLI_CASES = [
+    ("out is a file", ["run", "quintic_ptp", "--out", "{file}"], r"output folder .* is a file"),
+    ("out below a file", ["run", "quintic_ptp", "--out", "{file}/x"], r"cannot be created: .* is a file"),
+    ("out holds a run", ["run", "quintic_ptp", "--out", "{run}"], r"holds an earlier run .* --overwrite"),
+    ("out not writable", ["run", "quintic_ptp", "--out", "/proc/drake_traj_x"], r"output folder /proc/drake_traj_x"),
+    ("port zero", ["run", "quintic_ptp", "--meshcat", "--port", "0"], r"--port must be a port number"),
+    ("rate negative", ["run", "quintic_ptp", "--meshcat", "--rate", "-1"], r"--rate must be a positive"),
+    ("wait timeout nan", ["run", "quintic_ptp", "--meshcat", "--wait-timeout", "nan"], r"--wait-timeout must be"),
+    ("unknown option", ["run", "quintic_ptp", "--fast"], r"unrecognized arguments: --fast"),
+    ("unknown command", ["fly"], r"invalid choice: 'fly'"),
+    ("port not a number", ["run", "quintic_ptp", "--port", "seven"], r"--port: invalid int value: 'seven'"),
+    ("unknown scenario name", ["run", "nosuch"], r"no scenario file 'nosuch' and no shipped scenario"),
+    ("missing scenario file", ["run", "nowhere/x.yaml"], r"scenario file nowhere/x.yaml not found"),
+    ("scenario is a folder", ["run", "{dir}.yaml"], r"is a folder, not a scenario file"),
+    ("no variant", ["run", str(DIAGRAMS / "pajak.yaml")], r"no variant was given; its variants are \['sim1', 'sim2', 'sim3'\]"),
+    ("unknown variant", ["run", str(DIAGRAMS / "pajak.yaml"), "--variant", "sim4"], r"there is no variant 'sim4'"),
+    ("variant of a single file", ["run", "quintic_ptp", "--variant", "sim3"], r"holds one scenario, not variants"),
+]
+
+
+@pytest.mark.parametrize("case, argv, pattern", CLI_CASES, ids=[case[0] for case in CLI_CASES])
+def test_bad_command_lines(case, argv, pattern, tmp_path, earlier_run, capsys):
+    file = tmp_path / "a_file"
+    file.write_text("x")
+    (earlier_run / "result.npz").write_bytes(b"an earlier run")
+    (tmp_path / "folder.yaml").mkdir()
+    argv = [arg.format(file=file, run=earlier_run, dir=tmp_path / "folder") for arg in argv]
+    before = folder_state(earlier_run)
+    assert_clean_exit(cli.main(argv), capsys, pattern)
+    assert folder_state(earlier_run) == before
+
+
+def quintic_plan():
+    ur10e = get_robot("ur10e")
+    return plan_synchronized_quintic(ur10e.home_configuration, [[-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]], 1.05, 1.40)
+
+
+API_CASES = [
+    ("quintic plan list", lambda: QuinticPtpPlanner(plan=[1, 2], velocity_limit=1, acceleration_limit=1), TypeError, r"plan must be a QuinticPlan"),
+    ("pajak q_initial text", lambda: PajakPlanner(paper_parameters(3), ["a"] * 6), ValueError, r"q_initial"),
+    ("pajak q_initial short", lambda: PajakPlanner(paper_parameters(3), [0.0] * 5), ValueError, r"q_initial must have shape \(6,\)"),
+    ("simulate not a planner", lambda: simulate("planner"), TypeError, r"planner must be a PlannerSystem"),
+    ("robot as text", lambda: make_planner(QuinticConfig(goals=[[0.0] * 6]), "ur10e", [0.0] * 6), TypeError, r"robot must be a Robot"),
+    ("q_initial wrong shape", lambda: make_planner(QuinticConfig(goals=[[0.0] * 6]), get_robot("ur10e"), [0.0] * 4), ValueError,
+     r"q_initial must have shape \(6,\)"),
+    ("config not a config", lambda: make_planner({"goals": []}, get_robot("ur10e"), [0.0] * 6), TypeError, r"config must be one of"),
+    ("unknown robot", lambda: get_robot("puma"), ValueError, r"robot must be one of"),
+    ("override out of range", lambda: SpeedOverride([0.0], [1.5]).validate(), ValueError, r"speed_override.values must be in \[0, 1\]"),
+    ("override constant out of range", lambda: simulate(QuinticPtpPlanner(quintic_plan(), 1.05, 1.4), speed_override=2.0), ValueError,
+     r"speed_override must be in \[0, 1\]"),
+    ("load_scenario a number", lambda: load_scenario(123), TypeError, r"path must be a file path"),
+    ("pajak waypoints five values", lambda: PajakConfig(waypoints=[[0.1, 0.2, 0.3, 0.0, 0.0]]).validate(), ValueError,
+     r"waypoints must have shape \(w, 6\)"),
+    ("quintic limits negative", lambda: plan_synchronized_quintic([0.0] * 6, [[0.1] * 6], -1.0, 1.4), ValueError, r"velocity_limit"),
+    ("gains too short", lambda: ControllerGains(kp=[1.0, 2.0]).for_robot(get_robot("ur10e")), ValueError, r"controller.kp must have 6"),
+    ("plant config text", lambda: build_station(QuinticPtpPlanner(quintic_plan(), 1.05, 1.4), plant_config="fast"), TypeError,
+     r"plant_config must be a MultibodyPlantConfig"),
+    ("station robot mismatch", lambda: build_station(QuinticPtpPlanner(quintic_plan(), 1.05, 1.4), robot=get_robot("scara")), ValueError,
+     r"the planner has 6 joints, robot scara has 3"),
+    ("pajak on another robot", lambda: make_planner(paper_parameters(3), get_robot("li_4dof"), [0.0] * 4), ValueError,
+     r"the Pająk planner runs on the UR10e"),
+]
+
+
+@pytest.mark.parametrize("case, call, error, pattern", API_CASES, ids=[case[0] for case in API_CASES])
+def test_bad_python_arguments(case, call, error, pattern):
+    with pytest.raises(error, match=pattern):
+        call()
+
+
+@pytest.fixture(scope="module")
+def saved_run(tmp_path_factory):
+    """A real result folder (a short quintic move that times out: failure and NaN duration)."""
+    result = simulate(QuinticPtpPlanner(quintic_plan(), 1.05, 1.4), max_duration=0.2)
+    return result.save(tmp_path_factory.mktemp("saved"))
+
+
+def damaged(folder: Path, tmp_path: Path, how: str) -> Path:
+    target = tmp_path / how
+    target.mkdir()
+    data = (folder / "result.npz").read_bytes()
+    if how == "truncated":
+        (target / "result.npz").write_bytes(data[: len(data) // 2])
+    elif how == "random bytes":
+        (target / "result.npz").write_bytes(np.random.default_rng(0).bytes(2000))
+    elif how == "empty":
+        (target / "result.npz").write_bytes(b"")
+    else:
+        with np.load(folder / "result.npz") as archive:
+            arrays = {name: archive[name] for name in archive.files}
+        if how == "missing array":
+            del arrays["q_ref"]
+        elif how == "unequal lengths":
+            arrays["q_meas"] = arrays["q_meas"][:-3]
+        elif how == "bad metadata":
+            arrays["meta"] = np.array("{not json")
+        elif how == "text array":
+            arrays["tau"] = np.array(["x"] * len(arrays["t"]))
+        elif how == "foreign metadata":
+            arrays["meta"] = np.array(json.dumps({"name": "x", "color": "red"}))
+        np.savez(target / "result.npz", **arrays)
+    return target
+
+
+@pytest.mark.parametrize("how, pattern", [
+    ("truncated", r"cannot be read"), ("random bytes", r"cannot be read"), ("empty", r"cannot be read"),
+    ("missing array", r"is not a complete result: it has no 'q_ref'"),
+    ("unequal lengths", r"the array 'q_meas' has \d+ rows"), ("bad metadata", r"cannot be read|metadata"),
+    ("text array", r"the array 'tau'"), ("foreign metadata", r"its metadata is not a result's"),
+])
+def test_damaged_result_files_name_the_file(saved_run, tmp_path, how, pattern):
+    folder = damaged(saved_run, tmp_path, how)
+    with pytest.raises(ResultFileError, match=pattern) as info:
+        SimulationResult.load(folder)
+    assert str(folder / "result.npz") in str(info.value)
+
+
+def test_missing_result_file_is_named(tmp_path):
+    with pytest.raises(ResultFileError, match=f"no result file at {tmp_path / 'result.npz'}"):
+        SimulationResult.load(tmp_path)
+
+
+def test_a_failed_runs_metrics_are_strict_json(saved_run):
+    def refuse(constant):
+        raise AssertionError(f"non-standard JSON constant {constant}")
+
+    metrics = json.loads((saved_run / "metrics.json").read_text(), parse_constant=refuse)
+    assert metrics["succeeded"] is False and metrics["duration_s"] is None
+    assert SimulationResult.load(saved_run).failure.cause == "timeout"
+
+
+def test_an_impossible_run_is_refused_before_it_starts(tmp_path, capsys):
+    # The issue's reproduction: 10 rad/s and 200 rad/s^2 on the quintic scenario.
+    path = tmp_path / "fast.yaml"
+    path.write_text(quintic("  velocity_limit: [1.05, 1.05, 1.05, 1.05, 1.05, 1.05]", "  velocity_limit: [10, 10, 10, 10, 10, 10]"))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out")]) == cli.EXIT_BAD_INPUT
+    assert "rated speed" in capsys.readouterr().err
+    assert not (tmp_path / "out" / "result.npz").exists()
+
+
+def test_a_run_the_arm_cannot_follow_is_a_failure():
+    # Within the rated speeds, but an acceleration no drive can deliver (0.05 rad in 38 ms at
+    # 200 rad/s²): the drives saturate.
+    ur10e = get_robot("ur10e")
+    planner = make_planner(QuinticConfig(goals=[ur10e.home_configuration + 0.05], velocity_limit=[2.0, 2.0, 3.0, 3.0, 3.0, 3.0],
+                                         acceleration_limit=[200.0] * 6), ur10e, ur10e.home_configuration)
+    result = simulate(planner, settle_time=0.1)
+    assert not result.succeeded and result.failure.cause in ("saturation", "tracking")
+    assert "joint" in result.failure.message or "TCP" in result.failure.message
+    assert max(result.metrics().time_at_effort_limit_s) > 0.0
+
+
+# ---- property test: the shipped scenarios mutated at random ------------------------------------
+
+def _scalar(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return ".nan" if math.isnan(value) else (".inf" if value == math.inf else "-.inf" if value == -math.inf else repr(value))
+    if isinstance(value, str):
+        return json.dumps(value)
+    return repr(value)
+
+
+def emit(value, indent: int = 0) -> str:
+    """YAML of nested dicts (a ``_tag`` key becomes the mapping's tag), lists and scalars."""
+    pad = " " * indent
+    if isinstance(value, dict):
+        lines = []
+        for key, item in value.items():
+            if key == "_tag":
+                continue
+            if isinstance(item, dict):
+                lines.append(f"{pad}{key}: {item.get('_tag', '')}{' {}' if len(item) <= ('_tag' in item) else ''}")
+                if len(item) > ("_tag" in item):
+                    lines.append(emit(item, indent + 2))
+            else:
+                lines.append(f"{pad}{key}: {emit(item)}")
+        return "\n".join(lines)
+    if isinstance(value, list):
+        return "[" + ", ".join(emit(item) for item in value) + "]"
+    return _scalar(value)
+
+
+class _TagKeeper(yaml.SafeLoader):
+    pass
+
+
+_TagKeeper.add_multi_constructor("!", lambda loader, suffix, node: {"_tag": "!" + suffix, **loader.construct_mapping(node, deep=True)})
+
+SHIPPED = {
+    "quintic_ptp": yaml.load(QUINTIC, Loader=_TagKeeper),
+    "boryga_loop_scara": yaml.load((DIAGRAMS / "boryga_loop.yaml").read_text(), Loader=_TagKeeper)["scara"],
+}
+WEIRD = st.sampled_from([math.nan, math.inf, -math.inf, -1.0, 0.0, 1e9, -1e9, "text", True, [], [1.0], None])
+
+
+def paths_of(value, prefix=()):
+    """Every (path, leaf or list) in a nested dict/list."""
+    if isinstance(value, dict):
+        for key, item in value.items():
+            if key != "_tag":
+                yield from paths_of(item, prefix + (key,))
+    elif isinstance(value, list):
+        yield prefix, value
+        for index, item in enumerate(value):
+            yield from paths_of(item, prefix + (index,))
+    else:
+        yield prefix, value
+
+
+@st.composite
+def mutated_scenario(draw):
+    name = draw(st.sampled_from(sorted(SHIPPED)))
+    document = json.loads(json.dumps(SHIPPED[name]))
+    paths = [path for path, _ in paths_of(document) if path]
+    path = draw(st.sampled_from(paths))
+    parent = document
+    for key in path[:-1]:
+        parent = parent[key]
+    action = draw(st.sampled_from(["delete", "weird", "shorten", "lengthen"]))
+    leaf = path[-1]
+    if action == "delete" and isinstance(parent, dict):
+        del parent[leaf]
+    elif action in ("shorten", "lengthen") and isinstance(parent[leaf], list) and parent[leaf]:
+        parent[leaf] = parent[leaf][:-1] if action == "shorten" else parent[leaf] + [parent[leaf][-1]]
+    else:
+        parent[leaf] = draw(WEIRD)
+    document["settle_time"] = 0.05
+    return document
+
+
+@settings(max_examples=40, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(mutated_scenario())
+def test_mutated_scenarios_fail_cleanly_or_run_within_their_limits(tmp_path_factory, document):
+    folder = tmp_path_factory.mktemp("mutated")
+    path = folder / "scenario.yaml"
+    path.write_text(emit({key: value for key, value in document.items() if value is not None}) + "\n")
+    stderr = io.StringIO()
+    with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+        code = cli.main(["run", str(path), "--out", str(folder / "out"), "--no-preflight"])
+    err = stderr.getvalue()
+    assert "Traceback" not in err and "internal error" not in err, err
+    if code == cli.EXIT_BAD_INPUT:
+        assert err.startswith("drake-traj: ") and str(path) in err or "scenario" in err, err
+        return
+    result = SimulationResult.load(folder / "out")
+    for name in ("q_ref", "qd_ref", "qdd_ref", "q_meas", "tau"):
+        assert np.all(np.isfinite(getattr(result, name))), name
+    if code == cli.EXIT_OK:
+        metrics = result.metrics()
+        assert result.succeeded
+        assert metrics.max_velocity_over_limit <= 1 + 1e-6 and metrics.max_acceleration_over_limit <= 1 + 1e-6
+    else:
+        assert code == cli.EXIT_RUN_FAILED and result.failure is not None
