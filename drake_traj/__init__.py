@@ -24,8 +24,8 @@ from drake_traj.planners import (
 from drake_traj.result import Metrics, SimulationResult
 from drake_traj.robots import Robot, get_robot
 from drake_traj.scenario import Scenario, load_scenario, make_planner
+from drake_traj.version import __version__
 
-__version__ = "0.1.0"
 
 __all__ = [
     "BorygaConfig", "ControllerGains", "add_station", "build_station", "make_station", "run_station", "add_station", "build_station", "make_station", "run_station", "DrakeTrajError", "Failure", "LiConfig", "Metrics", "MovejConfig",

@@ -3,10 +3,12 @@
     drake-traj run [SCENARIO] [--variant NAME] [--out DIR] [--overwrite] [--no-preflight]
                    [--meshcat [--port P] [--rate R] [--no-wait] [--wait-timeout S]]
     drake-traj list
+    drake-traj export RUN_DIR --format csv|urscript|ros2 [--period 0.002] [--out FILE]
     drake-traj bench [--out DIR] [--count N] [--seed S] [--repeats R]
 
 ``run`` writes DIR/result.npz, metrics.json, *.png, meshcat.html and run.json (the manifest);
-SCENARIO is a YAML file or the name of a shipped scenario (``drake-traj list``). ``bench`` runs
+SCENARIO is a YAML file or the name of a shipped scenario (``drake-traj list``). ``export``
+writes a run's reference for a robot or another tool (drake_traj.export). ``bench`` runs
 every planner and baseline on Pająk 2024's task and N seeded tasks and writes DIR/bench.csv,
 bench.md and bench.png.
 
@@ -24,10 +26,12 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from drake_traj import __version__
+from drake_traj.version import __version__
 from drake_traj.bench import bench
 from drake_traj.errors import DrakeTrajError, PlanningError
+from drake_traj.export import FORMATS, UR_CYCLE, ExportError
 from drake_traj.meshcat import add_live_view, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
+from drake_traj.result import SimulationResult
 from drake_traj.rundir import prepare_output, write_manifest
 from drake_traj.scenario import DEFAULT_SCENARIO, default_scenario_path, find_scenario, load_scenario, shipped_scenarios
 from drake_traj.station import simulate
@@ -142,6 +146,18 @@ def list_scenarios(args) -> int:
     return EXIT_OK
 
 
+def export_run(args) -> int:
+    """``drake-traj export``: a run's reference as CSV, URScript or a ROS 2 JointTrajectory."""
+    result = SimulationResult.load(args.run_dir)
+    out = Path(args.out) if args.out else Path(args.run_dir) / f"reference{FORMATS[args.format]}"
+    if out.exists() and not args.overwrite:
+        raise ExportError(f"--out {out} exists; pass --overwrite to replace it")
+    path = result.export(out, args.format, period=args.period, lookahead_time=args.lookahead_time, gain=args.gain,
+                         approach_speed=args.approach_speed)
+    print(f"wrote {path}")
+    return EXIT_OK
+
+
 def run_bench(args) -> int:
     """``drake-traj bench``."""
     bench(args.out, count=args.count, seed=args.seed, repeats=args.repeats)
@@ -185,6 +201,17 @@ def build_parser() -> argparse.ArgumentParser:
     live.add_argument("--wait-timeout", type=float, default=60.0, help="how long to wait for a browser [s] (default 60)")
     list_parser = commands.add_parser("list", help="list the shipped scenarios")
     list_parser.set_defaults(handler=list_scenarios)
+    export_parser = commands.add_parser("export", help="write a run's reference as CSV, URScript or ROS 2")
+    export_parser.set_defaults(handler=export_run)
+    export_parser.add_argument("run_dir", help="a run's output folder (drake-traj run --out)")
+    export_parser.add_argument("--format", required=True, choices=sorted(FORMATS))
+    export_parser.add_argument("--period", type=float, default=UR_CYCLE, help="sampling period [s] (default 0.002)")
+    export_parser.add_argument("--out", default=None, help="the file to write (default: RUN_DIR/reference.<ext>)")
+    export_parser.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
+    export_parser.add_argument("--lookahead-time", type=float, default=0.1, help="URScript servoj lookahead [s], 0.03-0.2")
+    export_parser.add_argument("--gain", type=float, default=300.0, help="URScript servoj gain, 100-2000")
+    export_parser.add_argument("--approach-speed", type=float, default=0.3,
+                               help="URScript movej to the start [rad/s, rad/s^2] (default 0.3)")
     bench_parser = commands.add_parser("bench", help="compare every planner and baseline on UR10e tasks")
     bench_parser.set_defaults(handler=run_bench)
     bench_parser.add_argument("--out", default="out/bench", help="output directory (default: out/bench)")

@@ -18,6 +18,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from drake_traj.errors import DrakeTrajError, Failure
+from drake_traj.export import export, reference_trajectory
 
 __all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult"]
 
@@ -112,6 +113,7 @@ class SimulationResult:
     failure: Failure | None = None
     wall_time: float = float("nan")
     joint_types: tuple[str, ...] = ()  # "revolute" or "prismatic" per joint; empty: all revolute
+    robot: str = ""  # the robot's name (drake_traj.robots.get_robot), where known
 
     def joint_unit(self, j: int) -> str:
         """"rad" or "m", the position unit of joint ``j``."""
@@ -223,6 +225,7 @@ class SimulationResult:
             failure=failure,
             wall_time=wall_time,
             joint_types=tuple(robot.joint_types),
+            robot=robot.name,
         )
         if result.failure is None and tracking_tolerance is not None:
             result.failure = result.execution_failure(tracking_tolerance)
@@ -236,7 +239,7 @@ class SimulationResult:
         arrays = {name: getattr(self, name) for name in ARRAY_NAMES + _LIMIT_NAMES}
         failure = None if self.failure is None else self.failure.to_dict()
         meta = {"name": self.name, "duration": self.duration, "failure": failure, "wall_time": self.wall_time,
-                "joint_types": list(self.joint_types)}
+                "joint_types": list(self.joint_types), "robot": self.robot}
         np.savez_compressed(directory / "result.npz", meta=json.dumps(_json_ready(meta), allow_nan=False), **arrays)
         (directory / "metrics.json").write_text(json.dumps(self.metrics().to_dict(), indent=2, allow_nan=False))
         return directory
@@ -276,6 +279,16 @@ class SimulationResult:
         except (KeyError, TypeError, ValueError) as error:
             raise ResultFileError(f"{path}: its metadata is damaged: {error}") from None
         return cls(**meta, **arrays)
+
+    def reference_trajectory(self):
+        """The reference as a Drake ``PiecewisePolynomial``: the cubic Hermite spline through the
+        logged q_ref with the logged q̇_ref as its derivatives (it equals the log at the log times)."""
+        return reference_trajectory(self)
+
+    def export(self, path, format: str, **options) -> Path:
+        """Write the reference for a robot or another tool (:mod:`drake_traj.export`): ``format``
+        "csv", "urscript" or "ros2"; ``options`` as :func:`drake_traj.export.export`."""
+        return export(self, path, format, **options)
 
     # --- figures -------------------------------------------------------------------------------
     def _finish_line(self, axes) -> None:

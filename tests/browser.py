@@ -14,12 +14,13 @@ with a shorter budget it shows an intermediate frame.
 from __future__ import annotations
 
 import os
-import select
+import queue
 import shutil
 import signal
 import socket
 import subprocess
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -67,15 +68,20 @@ def free_port() -> int:
 
 
 def read_until(stream, text: str, *, timeout: float) -> str:
-    """Read ``stream`` line by line until a line contains ``text``; returns what was read.
-    Raises RuntimeError (with what was read) at EOF or after ``timeout`` [s]."""
+    """Read ``stream`` line by line (in a thread: a buffered pipe and select() do not mix) until a
+    line contains ``text``; returns what was read. Raises RuntimeError (with what was read) at EOF
+    or after ``timeout`` [s]."""
+    lines: queue.Queue = queue.Queue()
+    threading.Thread(target=lambda: [lines.put(line) for line in iter(stream.readline, "")] + [lines.put(None)],
+                     daemon=True).start()
     deadline = time.monotonic() + timeout
     seen = []
-    while time.monotonic() < deadline:
-        if not select.select([stream], [], [], 0.5)[0]:
-            continue
-        line = stream.readline()
-        if not line:
+    while (remaining := deadline - time.monotonic()) > 0:
+        try:
+            line = lines.get(timeout=remaining)
+        except queue.Empty:
+            break
+        if line is None:
             break
         seen.append(line)
         if text in line:

@@ -1,0 +1,159 @@
+"""Take a planned motion out of the project: a Drake trajectory, CSV, a URScript program for a
+UR10e controller, a ROS 2 ``trajectory_msgs/JointTrajectory``.
+
+The exported motion is the run's reference (what the planner asked for, not what the simulated
+arm did), resampled every ``period`` [s] from t = 0 to the end of the log: q and q̇ from the cubic
+Hermite spline through the logged (q_ref, q̇_ref), which passes through every logged sample with
+its logged velocity; q̈ linearly interpolated between the logged q̈_ref samples.
+
+Every writer checks its options and the reference first and writes nothing when something is
+wrong (:class:`ExportError`, naming the option or the joint, time and value).
+"""
+
+from pathlib import Path
+
+import numpy as np
+import yaml
+from pydrake.trajectories import PiecewisePolynomial
+
+from drake_traj.version import __version__
+from drake_traj.errors import DrakeTrajError
+from drake_traj.robots import UR10E
+
+__all__ = ["FORMATS", "ExportError", "export", "reference_trajectory", "resample"]
+
+FORMATS = {"csv": ".csv", "urscript": ".script", "ros2": ".yaml"}
+UR_CYCLE = 0.002  # [s], the UR controller's servo cycle (500 Hz)
+LOOKAHEAD_RANGE = (0.03, 0.2)  # [s], servoj lookahead_time (UR script manual)
+GAIN_RANGE = (100.0, 2000.0)  # servoj gain (UR script manual)
+
+
+class ExportError(DrakeTrajError):
+    """A reference cannot be exported as asked: names the option, or the joint, time and value."""
+
+
+def reference_trajectory(result) -> PiecewisePolynomial:
+    """The cubic Hermite spline through the logged reference (t, q_ref, q̇_ref) of ``result``."""
+    if len(result.t) < 2:
+        raise ExportError(f"the run {result.name!r} logged {len(result.t)} sample(s); a trajectory needs two")
+    return PiecewisePolynomial.CubicHermite(result.t, result.q_ref.T, result.qd_ref.T)
+
+
+def resample(result, period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(t, q, q̇, q̈) every ``period`` [s] from 0 to the end of the log (see the module docstring)."""
+    if not np.isfinite(period) or period <= 0:
+        raise ExportError(f"--period must be a positive number of seconds, got {period}")
+    trajectory = reference_trajectory(result)
+    times = np.arange(0, int(np.floor(result.t[-1] / period + 1e-9)) + 1) * period
+    derivative = trajectory.MakeDerivative()
+    q = np.array([trajectory.value(t).ravel() for t in times])
+    qd = np.array([derivative.value(t).ravel() for t in times])
+    qdd = np.column_stack([np.interp(times, result.t, column) for column in result.qdd_ref.T])
+    return times, q, qd, qdd
+
+
+def _units(result) -> list[str]:
+    return [result.joint_unit(j) for j in range(result.q_ref.shape[1])]
+
+
+def _csv(result, t, q, qd, qdd, period) -> str:
+    n = q.shape[1]
+    units = _units(result)
+    header = (["t [s]"] + [f"q{j + 1} [{units[j]}]" for j in range(n)] + [f"qd{j + 1} [{units[j]}/s]" for j in range(n)]
+              + [f"qdd{j + 1} [{units[j]}/s^2]" for j in range(n)])
+    lines = [f"# drake-traj {__version__}: reference of the run {result.name!r} on the {result.robot or 'robot'}, "
+             f"every {period:g} s; q and qd from the cubic Hermite spline through the logged (q_ref, qd_ref), "
+             "qdd linearly interpolated", ",".join(header)]
+    lines += [",".join(f"{value + 0.0:.10g}" for value in row) for row in np.column_stack([t, q, qd, qdd])]  # no -0
+    return "\n".join(lines) + "\n"
+
+
+def _check_ur10e(result, t, q, qd) -> None:
+    """Refuse a reference a UR10e controller would refuse: another robot, a joint outside its
+    position range or faster than its rated speed."""
+    if result.robot != UR10E.name:
+        raise ExportError(f"URScript runs on a UR10e controller; the run {result.name!r} is on "
+                          f"{result.robot or 'an unknown robot'}")
+    for values, limit, what, unit in ((q, UR10E.upper_limits, "position", "rad"), (qd, UR10E.velocity_limits, "speed", "rad/s")):
+        over = np.abs(values) > limit
+        if over.any():
+            k, j = np.argwhere(over)[0]
+            raise ExportError(f"joint {j + 1} ({UR10E.joint_names[j]}) {what} {values[k, j]:.4f} {unit} at t = {t[k]:.3f} s "
+                              f"is beyond the UR10e's {limit[j]:.4f} {unit}: the controller would stop the program")
+
+
+def _urscript(result, t, q, period, lookahead_time, gain, approach_speed) -> str:
+    program = "drake_traj_" + "".join(c if c.isalnum() else "_" for c in result.name)
+    lines = [
+        f"def {program}():",
+        f"  # drake-traj {__version__}: the reference of the run {result.name!r}, {len(t)} points every {period:g} s",
+        "  # (q from the cubic Hermite spline through the logged reference). Try it at reduced speed first.",
+        f"  movej({_ur_list(q[0])}, a={approach_speed:g}, v={approach_speed:g})  # to the start, slowly",
+    ]
+    lines += [f"  servoj({_ur_list(row)}, t={period:g}, lookahead_time={lookahead_time:g}, gain={gain:g})" for row in q]
+    lines += ["  stopj(2.0)", "end", f"{program}()"]
+    return "\n".join(lines) + "\n"
+
+
+def _ur_list(values) -> str:
+    return "[" + ", ".join(f"{value:.8f}" for value in values) + "]"
+
+
+def _ros2(result, t, q, qd, qdd, joint_names) -> str:
+    points = []
+    for time, position, velocity, acceleration in zip(t, q, qd, qdd):
+        sec = int(np.floor(time + 1e-12))
+        nanosec = int(round((time - sec) * 1e9))
+        if nanosec >= 1_000_000_000:
+            sec, nanosec = sec + 1, nanosec - 1_000_000_000
+        points.append({"positions": position.tolist(), "velocities": velocity.tolist(),
+                       "accelerations": acceleration.tolist(), "effort": [],
+                       "time_from_start": {"sec": sec, "nanosec": nanosec}})
+    message = {"header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}, "joint_names": list(joint_names),
+               "points": points}
+    comment = (f"# trajectory_msgs/JointTrajectory from drake-traj {__version__}: the reference of the run {result.name!r}\n"
+               "# (ros2 topic pub --once /scaled_joint_trajectory_controller/joint_trajectory "
+               "trajectory_msgs/msg/JointTrajectory \"$(cat FILE)\")\n")
+    return comment + yaml.safe_dump(message, sort_keys=False, default_flow_style=None, width=1000)
+
+
+def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_time: float = 0.1, gain: float = 300.0,
+           approach_speed: float = 0.3) -> Path:
+    """Write ``result``'s reference to ``path`` as ``format`` ("csv", "urscript" or "ros2").
+
+    Args:
+        period: the sampling period [s] (URScript: at least the controller's 2 ms cycle).
+        lookahead_time: servoj's lookahead time [s], in UR's range 0.03-0.2 (URScript only).
+        gain: servoj's gain, in UR's range 100-2000 (URScript only).
+        approach_speed: the movej to the start configuration, [rad/s] and [rad/s²] (URScript only).
+
+    Returns the path written. Raises :class:`ExportError`, writing nothing, when an option is out
+    of range or the reference is not fit for the format.
+    """
+    if format not in FORMATS:
+        raise ExportError(f"--format must be one of {sorted(FORMATS)}, got {format!r}")
+    if format == "urscript":
+        if not period >= UR_CYCLE - 1e-12:
+            raise ExportError(f"--period must be at least the UR controller's cycle {UR_CYCLE} s, got {period}")
+        for name, value, (low, high) in (("--lookahead-time", lookahead_time, LOOKAHEAD_RANGE), ("--gain", gain, GAIN_RANGE)):
+            if not low <= value <= high:
+                raise ExportError(f"{name} must be in UR's range [{low:g}, {high:g}], got {value}")
+        if not 0 < approach_speed <= 1.0:
+            raise ExportError(f"--approach-speed must be in (0, 1] rad/s, got {approach_speed}")
+    t, q, qd, qdd = resample(result, period)
+    if format == "csv":
+        text = _csv(result, t, q, qd, qdd, period)
+    elif format == "urscript":
+        _check_ur10e(result, t, q, qd)
+        text = _urscript(result, t, q, period, lookahead_time, gain, approach_speed)
+    else:
+        names = UR10E.joint_names if result.robot == UR10E.name else [f"joint_{j + 1}" for j in range(q.shape[1])]
+        text = _ros2(result, t, q, qd, qdd, names)
+    path = Path(path)
+    if path.is_dir():
+        raise ExportError(f"--out {path} is a folder; give a file name")
+    try:
+        path.write_text(text)
+    except OSError as error:
+        raise ExportError(f"--out {path} cannot be written: {error.strerror}") from None
+    return path

@@ -1,0 +1,116 @@
+"""Exports of a run's reference: a Drake trajectory, CSV, URScript and a ROS 2 JointTrajectory,
+each read back and compared with the reference; refusals write nothing."""
+
+import csv
+import runpy
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from drake_traj import SimulationResult, cli
+from drake_traj.export import ExportError, resample
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+@pytest.fixture(scope="module")
+def result(quintic_run_dir):
+    return SimulationResult.load(quintic_run_dir)
+
+
+def test_the_drake_trajectory_is_the_logged_reference(result):
+    trajectory = result.reference_trajectory()
+    values = np.array([trajectory.value(t).ravel() for t in result.t])
+    rates = np.array([trajectory.EvalDerivative(t, 1).ravel() for t in result.t])
+    np.testing.assert_allclose(values, result.q_ref, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(rates, result.qd_ref, rtol=0, atol=1e-9)
+
+
+def test_the_example_replays_it_in_another_diagram(quintic_run_dir, capsys):
+    error = runpy.run_path(str(EXAMPLES / "replay_reference.py"), run_name="example")["replay"](quintic_run_dir)
+    assert "replayed 'quintic_ptp'" in capsys.readouterr().out
+    assert error < 5e-3  # PD with gravity compensation only (measured 1 mrad); the station's feed-forward does 3.5e-5
+
+
+def test_csv_reads_back_with_units_and_the_period(result, tmp_path):
+    path = result.export(tmp_path / "reference.csv", "csv", period=0.002)
+    comment, *rows = path.read_text().splitlines()
+    assert comment.startswith("# drake-traj") and "cubic Hermite" in comment
+    table = list(csv.reader(rows))
+    header, data = table[0], np.array(table[1:], dtype=float)
+    assert header[:2] == ["t [s]", "q1 [rad]"] and header[7] == "qd1 [rad/s]" and header[13] == "qdd1 [rad/s^2]"
+    np.testing.assert_allclose(np.diff(data[:, 0]), 0.002, atol=1e-12)
+    assert data[0, 0] == 0.0 and data[-1, 0] <= result.t[-1] < data[-1, 0] + 0.002
+    every_other = slice(None, None, 2)  # each 2 ms sample is a logged 1 ms sample (10 significant digits)
+    np.testing.assert_allclose(data[:, 1:7], result.q_ref[every_other][: len(data)], atol=2e-9)
+    np.testing.assert_allclose(data[:, 7:13], result.qd_ref[every_other][: len(data)], atol=2e-9)
+    np.testing.assert_allclose(data[:, 13:19], result.qdd_ref[every_other][: len(data)], atol=2e-9)
+
+
+def test_urscript_streams_every_sample_with_servoj(result, tmp_path):
+    path = result.export(tmp_path / "reference.script", "urscript", period=0.002, lookahead_time=0.05, gain=500)
+    lines = path.read_text().splitlines()
+    t, q, _, _ = resample(result, 0.002)
+    servoj = [line for line in lines if line.strip().startswith("servoj(")]
+    assert len(servoj) == round(t[-1] / 0.002) + 1 == len(q)  # duration / period + 1
+    assert lines[0].startswith("def drake_traj_quintic_ptp():") and lines[-1] == "drake_traj_quintic_ptp()"
+    assert lines[3].strip().startswith("movej(") and "stopj" in lines[-3]
+    first = np.array(servoj[0].split("[")[1].split("]")[0].split(","), dtype=float)
+    last = np.array(servoj[-1].split("[")[1].split("]")[0].split(","), dtype=float)
+    np.testing.assert_allclose(first, result.q_ref[0], atol=1e-8)
+    np.testing.assert_allclose(last, q[-1], atol=1e-8)
+    assert all("t=0.002, lookahead_time=0.05, gain=500)" in line for line in servoj)
+
+
+def test_ros2_joint_trajectory_structure(result, tmp_path):
+    path = result.export(tmp_path / "trajectory.yaml", "ros2", period=0.01)
+    message = yaml.safe_load(path.read_text())
+    assert message["joint_names"] == ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
+                                      "wrist_2_joint", "wrist_3_joint"]
+    points = message["points"]
+    t, q, qd, qdd = resample(result, 0.01)
+    assert len(points) == len(t)
+    for k in (0, 1, len(points) // 2, len(points) - 1):
+        stamp = points[k]["time_from_start"]
+        assert stamp["sec"] + 1e-9 * stamp["nanosec"] == pytest.approx(t[k], abs=1e-9)
+        assert 0 <= stamp["nanosec"] < 1_000_000_000
+        np.testing.assert_allclose(points[k]["positions"], q[k], atol=1e-12)
+        np.testing.assert_allclose(points[k]["velocities"], qd[k], atol=1e-12)
+        np.testing.assert_allclose(points[k]["accelerations"], qdd[k], atol=1e-12)
+
+
+@pytest.mark.parametrize("change, pattern", [
+    (dict(period=0.001), r"--period must be at least the UR controller's cycle"),
+    (dict(lookahead_time=0.5), r"--lookahead-time must be in UR's range \[0.03, 0.2\]"),
+    (dict(gain=50), r"--gain must be in UR's range \[100, 2000\]"),
+    (dict(approach_speed=3.0), r"--approach-speed must be in \(0, 1\]"),
+])
+def test_urscript_options_out_of_range_are_refused(result, tmp_path, change, pattern):
+    with pytest.raises(ExportError, match=pattern):
+        result.export(tmp_path / "x.script", "urscript", **change)
+    assert not (tmp_path / "x.script").exists()
+
+
+def test_urscript_refuses_a_reference_beyond_the_ur10e(result, tmp_path):
+    fast = SimulationResult(**{**vars(result), "qd_ref": result.qd_ref * 3.0})  # 3.2 rad/s on joint 1 > 2.094
+    with pytest.raises(ExportError, match=r"joint \d \(\w+\) speed .* beyond the UR10e's"):
+        fast.export(tmp_path / "x.script", "urscript")
+    other = SimulationResult(**{**vars(result), "robot": "scara"})
+    with pytest.raises(ExportError, match="URScript runs on a UR10e controller; the run 'quintic_ptp' is on scara"):
+        other.export(tmp_path / "x.script", "urscript")
+    assert not (tmp_path / "x.script").exists()
+
+
+def test_export_command(quintic_run_dir, tmp_path, capsys):
+    out = tmp_path / "ref.csv"
+    assert cli.main(["export", str(quintic_run_dir), "--format", "csv", "--out", str(out)]) == 0
+    assert out.stat().st_size > 100_000
+    before = out.read_bytes()
+    assert cli.main(["export", str(quintic_run_dir), "--format", "csv", "--out", str(out)]) == 2
+    assert "exists; pass --overwrite" in capsys.readouterr().err and out.read_bytes() == before
+    assert cli.main(["export", str(tmp_path / "nowhere"), "--format", "ros2"]) == 2
+    assert "no result file at" in capsys.readouterr().err
+    assert cli.main(["export", str(quintic_run_dir), "--format", "urscript", "--gain", "5000", "--out", str(tmp_path / "x")]) == 2
+    assert "--gain must be in UR's range" in capsys.readouterr().err and not (tmp_path / "x").exists()

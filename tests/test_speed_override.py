@@ -1,0 +1,52 @@
+"""The speed override (a pendant's speed slider) on every planner: stepping to 0.5 mid-motion
+slows it, keeps its limits and its q̈ continuity, and it still reaches its goal."""
+
+import numpy as np
+import pytest
+
+from drake_traj import BorygaConfig, LiConfig, MovejConfig, QuinticConfig, RuckigConfig, ToppraConfig, get_robot, simulate
+from drake_traj.bench import joint_waypoints, paper_task
+from drake_traj.planners import make_planner
+from drake_traj.station import SpeedOverride
+
+UR10E = get_robot("ur10e")
+JOINTS = joint_waypoints(*paper_task())
+CASES = {
+    "quintic": (QuinticConfig(goals=JOINTS[1:3].tolist()), True),
+    "ruckig": (RuckigConfig(goals=JOINTS[1:3].tolist()), True),
+    "movej": (MovejConfig(goals=JOINTS[1:3].tolist(), blend_radius=0.05), False),  # its blends jump by design
+    "toppra": (ToppraConfig(path=np.linspace(JOINTS[0], JOINTS[1], 50)[1:].tolist(), grid_points=1000), False),
+    "boryga": (BorygaConfig(velocity_limit=[1.05] * 6, acceleration_limit=[1.40] * 6), False),  # v²/R jumps at the arc
+    "li": (LiConfig(points=(np.array([[0.0, 0.0, 0.0], [0.04, 0.0, 0.0], [0.04, 0.03, 0.0]])
+                            + UR10E.tool_position(UR10E.home_configuration)).tolist()), True),
+}
+
+
+def largest_step(result) -> float:
+    return float(np.abs(np.diff(result.qdd_ref[1:], axis=0)).max())
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_override_to_half_speed_mid_motion(name):
+    config, continuous = CASES[name]
+    free = simulate(make_planner(config, UR10E, UR10E.home_configuration), settle_time=0.1)
+    planner = make_planner(config, UR10E, UR10E.home_configuration)
+    step = 0.3 * free.duration
+    slowed = simulate(planner, settle_time=0.1, speed_override=SpeedOverride([step], [0.5]))
+    assert free.succeeded and slowed.succeeded, slowed.failure
+    # Measured T [s] without -> with: boryga 2.691 -> 4.311 (c to 0.151, half its cap), li 2.594 -> 4.116,
+    # movej 2.416 -> 3.749, quintic 3.307 -> 5.309, ruckig 2.962 -> 4.428, toppra 1.623 -> 2.465.
+    # c goes towards half the planner's speed cap as fast as the acceleration limits allow (a
+    # time-optimal law can slow down only where no joint is braking at its limit), and stays there.
+    goal = 0.5 * getattr(planner, "speed_cap", 1.0)
+    assert slowed.scaling.min() == pytest.approx(goal, abs=0.02)
+    assert np.all(slowed.scaling[slowed.t > step] <= slowed.scaling[np.searchsorted(slowed.t, step)] + 1e-9)
+    assert slowed.duration > free.duration + 0.3 * (free.duration - step)
+    for metric in ("max_velocity_over_limit", "max_acceleration_over_limit"):
+        assert getattr(slowed.metrics(), metric) <= max(1.0, getattr(free.metrics(), metric)) + 1e-6, metric
+    if continuous:
+        assert largest_step(slowed) < 0.1
+    else:  # no new jumps: the law's own stay the largest
+        assert largest_step(slowed) <= largest_step(free) + 0.05
+    end = planner.law.sample(planner.law.duration)[0]
+    np.testing.assert_allclose(slowed.q_ref[-1], end, atol=1e-6)  # reached its goal
