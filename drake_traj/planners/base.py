@@ -18,9 +18,11 @@ per context, so the derivatives and the output ports at one context share a sing
 
 from __future__ import annotations
 
+from bisect import bisect_right
+
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.systems.framework import BasicVector, LeafSystem, ValueProducer
+from pydrake.systems.framework import BasicVector, ContinuousStateIndex, EventStatus, LeafSystem, ValueProducer
 
 from drake_traj.planners.scaling import admissible_clock_rate, clock_at, next_clock_rate
 from drake_traj.validation import finite_array
@@ -53,7 +55,7 @@ class PlannerSystem(LeafSystem):
         )
         self.finish_state_index = self.DeclareDiscreteState(np.array([np.nan]))
         self.speed_override_port = self.DeclareVectorInputPort("speed_override", 1)
-        self.DeclareVectorOutputPort("desired_state", 2 * n, self._calc_desired_state)
+        self.DeclareStateOutputPort("desired_state", ContinuousStateIndex(0))  # [q; q̇], no Python call
         self.DeclareVectorOutputPort("desired_acceleration", n, self._calc_desired_acceleration)
         self.DeclareVectorOutputPort("scaling", 1, self._calc_scaling_output)
         self._evaluation = self.DeclareCacheEntry(
@@ -137,14 +139,12 @@ class PlannerSystem(LeafSystem):
 
     def _calc_evaluation(self, context, value):
         acceleration, scaling = self.evaluate(context)
-        value.get_mutable_value().SetFromVector(np.append(acceleration, scaling))
+        vector = value.get_mutable_value()
+        vector.SetFromVector(np.concatenate((acceleration, (scaling,))))
 
     def DoCalcTimeDerivatives(self, context, derivatives):
         qd = self.reference_state(context)[self.num_joints :]
         derivatives.get_mutable_vector().SetFromVector(np.concatenate([qd, self.acceleration(context)]))
-
-    def _calc_desired_state(self, context, output):
-        output.SetFromVector(self.reference_state(context))
 
     def _calc_desired_acceleration(self, context, output):
         output.SetFromVector(self.acceleration(context))
@@ -168,10 +168,13 @@ class TimeLawPlanner(PlannerSystem):
     :mod:`drake_traj.planners.scaling`), and never faster than the joint acceleration limits
     allow at that point of the law (checked at both ends of the period).
 
-    The Simulator integrates the reference [q; qd] from qdd; every ``update_period`` the update
-    sets it back on the law, (q_law(tau), q_law'(tau) c), so the integrator's error, which a fixed
-    step makes large where the law's acceleration jumps (Boryga's arc, trapezoids, Toppra's
-    bang-bang), never accumulates. The same update records the exact finish time.
+    The Simulator integrates the reference [q; qd] from qdd. Where the law's acceleration jumps
+    (its ``acceleration_jumps``, law times; a law without that attribute is taken to jump
+    anywhere), a fixed step integrates the jump with an error that would stay: the update after
+    it sets the reference back on the law, (q_law(tau), q_law'(tau) c), as does every update that
+    changes the clock, and the one that records the exact finish time (so the motion ends exactly
+    at the law's end). While c is at its goal and nothing jumps, the update changes nothing (no
+    write, so the evaluation cache stays valid).
 
     Discrete state: ``scaling`` = [c, t0, c0] (c at the last update t0, c0 = c there), ``clock``
     = [tau at t0, ċ] and ``finish``.
@@ -242,21 +245,87 @@ class TimeLawPlanner(PlannerSystem):
         return min(max(candidate, max(low, low_end)), min(high, high_end))  # both intervals contain 0
 
     def _update(self, context, state):
-        t = context.get_time()
+        t, h = context.get_time(), self.update_period
         c0, t0, _ = context.get_discrete_state(self.scaling_state_index).get_value()
         tau0, c_rate = context.get_discrete_state(self.clock_state_index).get_value()
         tau, c = clock_at(t - t0, tau0, c0, c_rate)
-        if tau >= self.law.duration > tau0:  # finished in (t0, t]: tau0 + c0 s + ċ s² / 2 = duration
-            s = np.roots([0.5 * c_rate, c0, tau0 - self.law.duration]) if c_rate else [(self.law.duration - tau0) / c0]
-            s = min(float(np.real(r)) for r in np.atleast_1d(s) if abs(np.imag(r)) < 1e-12 and np.real(r) >= -1e-12)
-            discrete = state.get_mutable_discrete_state()
-            self._record_finish(discrete.get_mutable_vector(self.finish_state_index), t0 + max(s, 0.0))
-        c_rate = self._next_clock_rate(tau, c, c_rate, self.speed_cap * self.speed_override(context))
+        goal = self.speed_cap * self.speed_override(context)
+        finishing = tau >= self.law.duration and np.isnan(self.finish_time(context))
+        tau_before = clock_at(max(t - h, t0) - t0, tau0, c0, c_rate)[0]
+        jumps = getattr(self.law, "acceleration_jumps", None)  # law times where q_law'' jumps
+        jumped = jumps is None or np.searchsorted(jumps, tau, "right") > np.searchsorted(jumps, tau_before, "right")
+        if c_rate == 0.0 and c == goal and not (jumped or finishing):
+            return EventStatus.DidNothing()  # the clock runs on as it is: no write, the cache stays valid
         discrete = state.get_mutable_discrete_state()
+        if finishing:  # finished in (t0, t]: tau0 + c0 s + ċ s² / 2 = duration
+            roots = np.roots([0.5 * c_rate, c0, tau0 - self.law.duration]) if c_rate else [(self.law.duration - tau0) / c0]
+            s = min(float(np.real(r)) for r in np.atleast_1d(roots) if abs(np.imag(r)) < 1e-12 and np.real(r) >= -1e-12)
+            self._record_finish(discrete.get_mutable_vector(self.finish_state_index), t0 + max(s, 0.0))
+        if abs(goal - c) <= 1e-9 and abs(c_rate) <= self.clock_jerk * h:
+            c, c_rate = goal, 0.0  # arrived: hold c exactly (a step of q̈ below one period's change)
+        else:
+            c_rate = self._next_clock_rate(tau, c, c_rate, goal)
         discrete.get_mutable_vector(self.scaling_state_index).SetFromVector([c, t, c])
         discrete.get_mutable_vector(self.clock_state_index).SetFromVector([tau, c_rate])
         q_law, qd_law, _ = self.law.sample(tau)
         state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(np.concatenate([q_law, qd_law * c]))
+        return EventStatus.Succeeded()
+
+
+class HermiteLaw:
+    """A joint time law tabulated at knots, between them the quintic Hermite polynomial that meets
+    q, q̇ and q̈ at both ends (so q̈ is continuous except where the samples on both sides of a
+    knot differ, the law's ``acceleration_jumps``). ``rates_at`` costs a bisection and two small
+    polynomial evaluations, whatever the tabulated law cost.
+
+    Args:
+        knots: increasing law times [s], (K,), from 0 to the law's duration.
+        right: (q, q̇, q̈) just after each knot, (K, 3, n); row K-1 is not used.
+        left: (q, q̇, q̈) just before each knot, (K, 3, n); row 0 is not used. Where the law is
+            continuous it equals ``right``.
+        acceleration_jumps: the knots where q̈ jumps (for :class:`TimeLawPlanner`).
+    """
+
+    def __init__(self, knots, right, left, acceleration_jumps=()):
+        knots = np.asarray(knots, dtype=float)
+        right, left = np.asarray(right, dtype=float), np.asarray(left, dtype=float)
+        if knots.ndim != 1 or len(knots) < 2 or np.any(np.diff(knots) <= 0) or knots[0] != 0.0:
+            raise ValueError(f"knots must increase from 0, got {len(knots)} knots")
+        self.knots = knots
+        self.duration = float(knots[-1])
+        self.q_start = right[0, 0].copy()
+        self.acceleration_jumps = np.asarray(acceleration_jumps, dtype=float)
+        h = np.diff(knots)[:, None]
+        (q0, v0, a0), (q1, v1, a1) = np.moveaxis(right[:-1], 1, 0), np.moveaxis(left[1:], 1, 0)
+        delta = q1 - q0
+        # quintic Hermite in s = tau - knot, monomial coefficients c0..c5, (K-1, 6, n)
+        self._coefficients = np.stack([
+            q0, v0, 0.5 * a0,
+            (20 * delta - (8 * v1 + 12 * v0) * h - (3 * a0 - a1) * h**2) / (2 * h**3),
+            (-30 * delta + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h**2) / (2 * h**4),
+            (12 * delta - 6 * (v1 + v0) * h + (a1 - a0) * h**2) / (2 * h**5),
+        ], axis=1)
+        self._end = left[-1].copy()
+
+    def _interval(self, tau: float) -> tuple[int, float]:
+        k = min(max(bisect_right(self.knots, tau) - 1, 0), len(self.knots) - 2)
+        return k, tau - self.knots[k]
+
+    def sample(self, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q, q̇, q̈) at law time ``tau`` [s]; at rest at the ends outside [0, duration]."""
+        if tau >= self.duration:
+            return self._end[0].copy(), np.zeros_like(self._end[0]), np.zeros_like(self._end[0])
+        k, s = self._interval(max(tau, 0.0))
+        c = self._coefficients[k]
+        powers = s ** np.arange(6)
+        q = powers @ c
+        if tau < 0.0:
+            return q, np.zeros_like(q), np.zeros_like(q)
+        return q, (np.arange(1, 6) * powers[:5]) @ c[1:], (np.array([2, 6, 12, 20]) * powers[:4]) @ c[2:]
+
+    def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """(q̇, q̈) at law time ``tau`` [s]."""
+        return self.sample(tau)[1:]
 
 
 def start_and_goals(q_initial, goals, num_joints: int) -> np.ndarray:

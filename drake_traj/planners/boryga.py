@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from drake_traj.planners.base import TimeLawPlanner
+from drake_traj.planners.base import HermiteLaw, TimeLawPlanner
 from drake_traj.robots import Robot
 from drake_traj.validation import finite_array, limit_or_default, positive_scalar
 
@@ -705,36 +705,42 @@ def plan_loop_path(B, M, E, v_max, delta=None, radius=None) -> LoopPathPlan:
 # --------------------------------------------------------------------------------------------
 
 
-class RobotLoopLaw:
+class RobotLoopLaw(HermiteLaw):
     """The loop path's joint motion on a robot: the time law a :class:`TimeLawPlanner` follows.
 
     q(tau) is the robot's inverse kinematics of the path point (:meth:`Robot.point_ik`: the
     closed-form IK of Boryga's robots, eq. 15-32; the UR10e's keeps the flange orientation and IK
-    branch of ``reference``) and the rates come from its Jacobian (:meth:`Robot.joint_rates`).
+    branch of ``reference``) and the rates come from its Jacobian (:meth:`Robot.joint_rates`):
+    :meth:`exact`. That is computed at knots every ``knot_step`` [s] of law time and at the path's
+    junctions (both sides: the acceleration jumps by v²/R where the arc begins and ends) and
+    interpolated between them (:class:`HermiteLaw`), so the planner's hot path costs microseconds,
+    not an IK.
 
     Args:
         plan: the loop path (:func:`plan_loop_path`), in the robot's base frame.
         robot: the robot.
         reference: a configuration of the robot giving the tool orientation and IK branch.
+        knot_step: the largest law-time step between knots [s].
     """
 
-    def __init__(self, plan: LoopPathPlan, robot: Robot, reference):
+    def __init__(self, plan: LoopPathPlan, robot: Robot, reference, *, knot_step: float = 2e-3):
         self.plan = plan
         self.robot = robot
         self.reference = np.asarray(reference, dtype=float)
-        self.duration = plan.duration
-        self.q_start = self.sample(0.0)[0]
+        knots = np.union1d(np.linspace(0.0, plan.duration, int(np.ceil(plan.duration / knot_step)) + 1),
+                           plan.breakpoints)
+        right = np.array([self.exact(tau, "right") for tau in knots])
+        left = np.array([self.exact(tau, "left") if np.isin(tau, plan.breakpoints) else row
+                         for tau, row in zip(knots, right)])
+        super().__init__(knots, right, left, acceleration_jumps=plan.breakpoints)
 
-    def sample(self, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(q, qd, qdd) at law time tau [s]: the tool on the path, moving along it."""
-        position, velocity, acceleration = self.plan.sample(tau)[:3]
+    def exact(self, tau: float, side: str = "right") -> np.ndarray:
+        """(q, q̇, q̈) at law time tau [s], (3, n): the tool on the path, moving along it (at a
+        junction, the value on ``side``)."""
+        position, velocity, acceleration = (value.reshape(3) for value in self.plan.sample(tau, side=side)[:3])
         q = self.robot.point_ik(position[None], self.reference)[0]
         qd, qdd = self.robot.joint_rates(q, velocity, acceleration)
-        return q, np.reshape(qd, -1), np.reshape(qdd, -1)
-
-    def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
-        """(qd, qdd) at law time tau [s]."""
-        return self.sample(tau)[1:]
+        return np.array([q, np.reshape(qd, -1), np.reshape(qdd, -1)])
 
 
 def joint_speed_cap(law, velocity_limit, acceleration_limit, *, samples: int = 4001) -> tuple[float, dict]:
@@ -747,8 +753,8 @@ def joint_speed_cap(law, velocity_limit, acceleration_limit, *, samples: int = 4
     Returns:
         (c, peaks) with peaks = {"qd": per-joint peak |qd|, "qdd": per-joint peak |qdd|} at c = 1.
     """
-    times = np.union1d(np.linspace(0.0, law.duration, samples), law.plan.breakpoints)
-    times = np.union1d(times, np.clip(law.plan.breakpoints - 1e-9, 0.0, law.duration))
+    times = np.union1d(np.linspace(0.0, law.duration, samples), law.acceleration_jumps)
+    times = np.union1d(times, np.clip(law.acceleration_jumps - 1e-9, 0.0, law.duration))
     rates = [law.rates_at(float(t)) for t in times]
     peak_qd = np.max(np.abs([r[0] for r in rates]), axis=0)
     peak_qdd = np.max(np.abs([r[1] for r in rates]), axis=0)

@@ -19,6 +19,7 @@ planner system is a thin shell around them.
 
 from bisect import bisect_right
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -340,6 +341,8 @@ class QuinticPlan:
     """
 
     segments: tuple[QuinticSegment, ...]
+    # q̈ is continuous (zero at both ends of each segment): no law time where it jumps.
+    acceleration_jumps: ClassVar[np.ndarray] = np.empty(0)
     _t_starts: np.ndarray = field(init=False, repr=False, compare=False)
     _durations: np.ndarray = field(init=False, repr=False, compare=False)
     _q_starts: np.ndarray = field(init=False, repr=False, compare=False)

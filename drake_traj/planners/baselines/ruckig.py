@@ -67,6 +67,9 @@ class RuckigStopLaw:
             (the message names the segment).
     """
 
+    # jerk-limited, so q̈ is continuous: no law time where it jumps.
+    acceleration_jumps = np.empty(0)
+
     def __init__(self, q_waypoints, velocity_limit, acceleration_limit, jerk_limit=None):
         try:
             q = np.array(q_waypoints, dtype=float)

@@ -269,6 +269,9 @@ class JointSplineLaw:
         samples: the joint samples [rad], shape (N, n).
     """
 
+    # a quintic B-spline: q̈ is continuous, no law time where it jumps.
+    acceleration_jumps = np.empty(0)
+
     def __init__(self, times, q):
         t, joints = _samples(times, q)
         knots = t - t[0]
