@@ -17,7 +17,7 @@ from pathlib import Path
 
 from pydrake.geometry import Meshcat
 
-from drake_traj.bench import bench
+from drake_traj.bench import BenchSetupError, bench
 from drake_traj.diagram import simulate
 from drake_traj.meshcat import draw_task, export_html
 from drake_traj.robots import get_robot
@@ -61,6 +61,18 @@ def run(scenario_path, out_dir, *, variant: str | None = None, live_meshcat: boo
     return 0 if result.succeeded else 1
 
 
+def run_bench(args) -> int:
+    """``drake-traj bench``; exit code 2, with the reason, on an argument, ``--out`` or
+    ``--scheduler`` that cannot work (checked before any run)."""
+    try:
+        bench(args.out, count=args.count, seed=args.seed, repeats=args.repeats, workers=args.workers,
+              scheduler=args.scheduler)
+    except BenchSetupError as error:
+        print(f"drake-traj bench: error: {error}", file=sys.stderr)
+        return 2
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="drake-traj", description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True)
@@ -75,10 +87,13 @@ def main(argv=None) -> int:
     bench_parser.add_argument("--count", type=int, default=20, help="seeded random tasks besides the paper's")
     bench_parser.add_argument("--seed", type=int, default=0)
     bench_parser.add_argument("--repeats", type=int, default=5, help="planning-time repeats on the paper task")
+    bench_parser.add_argument("--workers", type=int, default=None,
+                              help="processes of the local Dask cluster (default: one per core; 1: no Dask, in order)")
+    bench_parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                              help="run on the existing Dask cluster of this scheduler (e.g. tcp://host:8786)")
     args = parser.parse_args(argv)
     if args.command == "bench":
-        bench(args.out, count=args.count, seed=args.seed, repeats=args.repeats)
-        return 0
+        return run_bench(args)
     try:
         if args.scenario is None:
             return run(default_scenario_path(), args.out, variant=args.variant or DEFAULT_SCENARIO[1],

@@ -1,13 +1,14 @@
 """The benchmark on a tiny set: its table is consistent, the same serially and on a Dask cluster,
-and a failing run is a row (not a timing test)."""
+a failing run is a row, and bad arguments stop it before any run (not a timing test)."""
 
 import csv
 import math
 
+import dask
 import numpy as np
 import pytest
 
-from drake_traj import bench
+from drake_traj import bench, cli
 from drake_traj.planners import QuinticConfig
 
 
@@ -102,3 +103,34 @@ def test_random_tasks_are_reachable_and_seeded():
         for q, pose in zip(joints[1:], poses):
             np.testing.assert_allclose(bench.robot.task_pose(q)[:3], pose[:3], atol=1e-9)
 
+
+@pytest.mark.parametrize("arguments, option", [
+    (["--count", "-3"], "--count"), (["--repeats", "0"], "--repeats"), (["--seed", "-1"], "--seed"),
+    (["--workers", "0"], "--workers"), (["--scheduler", "not-an-address:xyz"], "--scheduler"),
+    (["--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"], "--workers"),
+])
+def test_bad_arguments_stop_before_any_run(tmp_path, capsys, arguments, option):
+    out = tmp_path / "out"
+    assert cli.main(["bench", "--out", str(out), *arguments]) == 2
+    error = capsys.readouterr().err
+    assert error.startswith("drake-traj bench: error: ") and option in error and "Traceback" not in error
+    assert len(error.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_an_unreachable_scheduler_is_an_error_naming_the_option(tmp_path, capsys):
+    out = tmp_path / "out"
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        assert cli.main(["bench", "--out", str(out), "--scheduler", "tcp://127.0.0.1:1"]) == 2
+    error = capsys.readouterr().err
+    assert "--scheduler tcp://127.0.0.1:1: cannot reach a Dask scheduler" in error
+    assert not out.exists()
+
+
+def test_an_output_that_is_or_lies_below_a_file_is_refused(tmp_path, capsys):
+    afile = tmp_path / "bench.csv"
+    afile.write_text("keep me")
+    for out in (afile, afile / "below"):
+        assert cli.main(["bench", "--out", str(out), "--count", "0"]) == 2
+        assert f"--out {out}" in capsys.readouterr().err
+    assert afile.read_text() == "keep me"
