@@ -370,6 +370,8 @@ def _connect(scheduler: str) -> Client:
             f"--scheduler {scheduler}: that cluster's workers have drake_traj {sorted(theirs)}, this is {ours}; "
             "install the same version on every worker."
         )
+    if not theirs:
+        print(f"--scheduler {scheduler}: the cluster has no workers yet; the runs wait for them", file=sys.stderr)
     return client
 
 
