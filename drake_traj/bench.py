@@ -451,7 +451,8 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers:
         seed: seed of the random tasks (>= 0).
         repeats: planning-time repeats on the paper task (>= 1).
         workers: processes of the local Dask cluster (>= 1; default one per core); 1 runs every
-            unit in this process, in order, without Dask.
+            unit in this process, in order, without Dask. The cluster's processes are spawned and
+            import the main module: from a script, call ``bench`` under ``if __name__ == "__main__":``.
         scheduler: address of an existing Dask scheduler (e.g. ``tcp://host:8786``) to run the
             units on instead of a local cluster; its workers need the same drake_traj.
         planners: the names of :data:`PLANNERS` to run (toppra needs pajak_blend).
