@@ -14,17 +14,44 @@ Columns: T; T over Toppra's time-optimal T on the planner's own path; max |qd| a
 the limit; max jerk; whether qdd is continuous (no step between 1 ms samples larger than
 ``JUMP`` rad/s^2); PD tracking error (joint, TCP); peak torque over the effort limit; planning
 compute time (median of ``repeats`` constructions; for the online Pająk planner, the wall time of
-its law integrated alone); real-time factor of the closed loop.
+its law integrated alone); real-time factor of the closed loop; ``failure``, empty or why the run
+failed. Only ``planning_s`` and ``real_time_factor`` are timings: every other column is the same
+however the runs are spread over processes and machines.
+
+Work units and the engine. One unit is one (planner, task) run: :func:`run_planner` for the
+planners a config describes, :func:`run_toppra` for Toppra. Both are top-level functions of
+picklable arguments (a :class:`Task`, a planner name, a config builder) returning a plain dict
+(the row and, for ``pajak_blend``, its planned joint path as an array), so Dask can ship them to
+any worker. Toppra's row parameterises ``pajak_blend``'s path, so its unit takes that run's
+output as an argument: on Dask, the ``pajak_blend`` future itself, which makes the dependency
+explicit to the scheduler (Toppra starts as soon as that one run ends, on whichever worker is
+free, while the task's other runs go on elsewhere). We chose runs over whole tasks as the unit
+because the runs of a task differ in cost by 10-50x (Pająk's law against a quintic), so
+small units keep every worker busy to the end of a sweep, and a failure stays the failure of
+one run. ``workers=1`` calls the same functions in this process, in order; otherwise the
+runs go to a Dask ``LocalCluster`` of ``workers`` processes, or to the existing cluster whose
+scheduler is at ``scheduler`` (its workers need the same drake_traj installed). A run that
+raises, or whose worker dies, is a row with ``succeeded`` false, NaN metrics and the reason in
+``failure``, never a lost task.
 """
 
+import contextlib
 import csv
+import importlib.metadata
+import logging
+import numbers
+import os
 import statistics
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from distributed import Client, LocalCluster, as_completed
+from tqdm import tqdm
 
+from drake_traj.errors import DrakeTrajError
 from drake_traj.station import simulate
 from drake_traj.planners import (
     MovejConfig,
@@ -39,16 +66,43 @@ from drake_traj.planners.baselines.toppra import geometric_path_from_samples, ti
 from drake_traj.robots import UR10E
 from drake_traj.robots import ur10e as robot
 
+__all__ = [
+    "COLUMNS", "CONFIG_BUILDERS", "PLANNERS", "BenchSetupError", "Task", "bench", "medians", "paper_task",
+    "random_tasks", "run_planner", "run_toppra", "tasks",
+]
+
 VELOCITY, ACCELERATION = robot.DEFAULT_JOINT_MOVE_VELOCITY, robot.DEFAULT_JOINT_MOVE_ACCELERATION
 BLEND_RADIUS = 0.05  # [m], the paper's experiment 1
 JUMP = 0.07  # [rad/s^2] between 1 ms samples: a jerk of 70 rad/s^3, above every continuous planner here
 TOPPRA_GRID_POINTS = 2000
-PLANNERS = ("pajak_blend", "pajak_stop", "movej_blend", "quintic_stop", "ruckig_stop", "toppra")
+SETTLE_TIME, MAX_DURATION = 0.2, 30.0  # [s] of every run
+REFERENCE = "pajak_blend"  # the planner whose path Toppra parameterises
 COLUMNS = (
     "task", "planner", "succeeded", "T_s", "T_over_optimal", "max_qd_over_limit", "max_qdd_over_limit",
     "max_jerk", "qdd_continuous", "tracking_joint_rad", "tracking_tcp_m", "peak_torque_over_limit",
-    "planning_s", "real_time_factor",
+    "planning_s", "real_time_factor", "failure",
 )
+TIMING_COLUMNS = ("planning_s", "real_time_factor")
+
+
+class BenchSetupError(DrakeTrajError):
+    """A bench argument, output directory or scheduler that cannot work, found before any run."""
+
+
+# --------------------------------------------------------------------------------------------
+# Tasks and planner configs.
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class Task:
+    """A bench task: start configuration q0 [rad] (6,), task poses (m, 6) [m, rad], and how many
+    times to repeat the planning-time measurement."""
+
+    label: str
+    q0: np.ndarray
+    poses: np.ndarray
+    repeats: int = 1
 
 
 def paper_task():
@@ -75,22 +129,92 @@ def random_tasks(count: int, seed: int = 0):
     return tasks
 
 
+def tasks(count: int, seed: int = 0, repeats: int = 5) -> list[Task]:
+    """The paper task (planning timed ``repeats`` times) and ``count`` seeded random tasks (once)."""
+    return [Task("paper", *paper_task(), repeats)] + [
+        Task(f"random_{k}", q0, poses) for k, (q0, poses) in enumerate(random_tasks(count, seed))]
+
+
 def joint_waypoints(q0, poses) -> np.ndarray:
     """q0 and the IK of each pose, each nearest the previous configuration, shape (m + 1, 6)."""
     return np.vstack([q0, robot.inverse_kinematics_path(poses, q0, max_step=np.inf)])
 
 
-def _configs(poses, joints) -> dict:
-    """Planner configs by name, all with the UR10e's joint-move limits (Toppra needs
-    pajak_blend's path, built later)."""
-    goals = joints[1:].tolist()
-    return {
-        "pajak_blend": PajakConfig(waypoints=poses, blend_waypoints=True),
-        "pajak_stop": PajakConfig(waypoints=poses, blend_waypoints=False),
-        "movej_blend": MovejConfig(goals=goals, blend_radius=BLEND_RADIUS),
-        "quintic_stop": QuinticConfig(goals=goals),
-        "ruckig_stop": RuckigConfig(goals=goals),
-    }
+# Config builders: (task poses, joint waypoints) -> planner config, all with the UR10e's joint-move
+# limits. Top-level functions, so that Dask can send them to its workers.
+def pajak_blend_config(poses, joints):
+    return PajakConfig(waypoints=poses, blend_waypoints=True)
+
+
+def pajak_stop_config(poses, joints):
+    return PajakConfig(waypoints=poses, blend_waypoints=False)
+
+
+def movej_blend_config(poses, joints):
+    return MovejConfig(goals=joints[1:].tolist(), blend_radius=BLEND_RADIUS)
+
+
+def quintic_stop_config(poses, joints):
+    return QuinticConfig(goals=joints[1:].tolist())
+
+
+def ruckig_stop_config(poses, joints):
+    return RuckigConfig(goals=joints[1:].tolist())
+
+
+CONFIG_BUILDERS = {
+    "pajak_blend": pajak_blend_config,
+    "pajak_stop": pajak_stop_config,
+    "movej_blend": movej_blend_config,
+    "quintic_stop": quintic_stop_config,
+    "ruckig_stop": ruckig_stop_config,
+}
+PLANNERS = (*CONFIG_BUILDERS, "toppra")
+
+
+# --------------------------------------------------------------------------------------------
+# One run: the work unit.
+# --------------------------------------------------------------------------------------------
+
+
+def run_planner(task: Task, name: str, build, keep_path: bool = False) -> dict:
+    """The run of planner ``name`` (config from ``build(poses, joints)``) on ``task``.
+
+    Returns ``{"row": row, "path": path}``: the row of :data:`COLUMNS`, and with ``keep_path``
+    the planned joint path [rad] (the reference from t = 0 to the planner's finish, (N, 6)) when
+    the run succeeded, else None. Whatever goes wrong gives a failed row with its reason.
+    """
+    try:
+        config = build(task.poses, joint_waypoints(task.q0, task.poses))
+    except Exception as error:  # a run's failure is a row, not a lost task
+        return {"row": failed_row(task.label, name, _reason(error)), "path": None}
+    return _run(task.label, name, config, task.q0, task.repeats, keep_path)
+
+
+def run_toppra(task: Task, reference: dict) -> dict:
+    """Toppra's run on ``task``: time-optimal along the path of the reference run's output
+    ``reference`` (:func:`run_planner` of ``pajak_blend`` with ``keep_path``)."""
+    path = reference["path"]
+    if path is None:
+        reason = reference["row"]["failure"] or "no path"
+        return {"row": failed_row(task.label, "toppra", f"no {REFERENCE} path to parameterise ({reason})"),
+                "path": None}
+    # A dense grid: Toppra keeps the limits at its grid points only (2.2 % over between them on
+    # the paper task's path with the default grid, 0.08 % with 2000 points).
+    config = ToppraConfig(path=path[1:].tolist(), grid_points=TOPPRA_GRID_POINTS)
+    return _run(task.label, "toppra", config, path[0], task.repeats, keep_path=False)
+
+
+def _run(label, name, config, q0, repeats, keep_path) -> dict:
+    try:
+        planning = _planning_time(config, q0, repeats)
+        result = simulate(make_planner(config, UR10E, q0), name=name, settle_time=SETTLE_TIME,
+                          max_duration=MAX_DURATION)
+        row = _row(label, name, result, planning, _optimal_duration(result))
+    except Exception as error:  # a run's failure is a row, not a lost task
+        return {"row": failed_row(label, name, _reason(error)), "path": None}
+    path = result.q_ref[: np.searchsorted(result.t, result.duration) + 1] if keep_path and result.succeeded else None
+    return {"row": row, "path": path}
 
 
 def _planning_time(config, q0, repeats):
@@ -133,86 +257,240 @@ def _row(task, name, result, planning, optimal) -> dict:
     steps = np.abs(np.diff(result.qdd_ref[1:], axis=0))  # after t = 0 (Pająk sims start with a step)
     return {
         "task": task, "planner": name, "succeeded": result.succeeded, "T_s": result.duration,
-        "T_over_optimal": result.duration / optimal, "max_qd_over_limit": metrics.max_velocity_over_limit,
+        "T_over_optimal": result.duration / optimal if optimal > 0 else float("nan"),
+        "max_qd_over_limit": metrics.max_velocity_over_limit,
         "max_qdd_over_limit": metrics.max_acceleration_over_limit, "max_jerk": metrics.max_jerk,
-        "qdd_continuous": bool(steps.max() <= JUMP), "tracking_joint_rad": metrics.tracking_error_joint_max_rad,
+        "qdd_continuous": bool(steps.max() <= JUMP) if steps.size else float("nan"),
+        "tracking_joint_rad": metrics.tracking_error_joint_max_rad,
         "tracking_tcp_m": metrics.tracking_error_tcp_max_m,
         "peak_torque_over_limit": max(metrics.peak_torque_over_limit), "planning_s": planning,
-        "real_time_factor": metrics.real_time_factor,
+        "real_time_factor": metrics.real_time_factor, "failure": metrics.failure or "",
     }
 
 
-def run_task(label, q0, poses, repeats=1) -> list[dict]:
-    """All planners on one task; returns one row per planner."""
-    joints = joint_waypoints(q0, poses)
-    rows, results = [], {}
-    for name, config in _configs(poses, joints).items():
-        planning = _planning_time(config, q0, repeats)
-        results[name] = simulate(make_planner(config, UR10E, q0), name=name, settle_time=0.2, max_duration=30.0)
-        rows.append((name, results[name], planning))
-    start = time.perf_counter()
-    reference = results["pajak_blend"]
-    end = np.searchsorted(reference.t, reference.duration) + 1
-    table = [_row(label, name, result, planning, _optimal_duration(result)) for name, result, planning in rows]
-    # A dense grid: Toppra keeps the limits at its grid points only (2.2 % over between them on
-    # the paper task's path with the default grid, 0.08 % with 2000 points).
-    config = ToppraConfig(path=reference.q_ref[1:end].tolist(), grid_points=TOPPRA_GRID_POINTS)
+def failed_row(task: str, planner: str, reason: str) -> dict:
+    """The row of a run that produced no log: NaN metrics and the reason."""
+    return {column: float("nan") for column in COLUMNS} | {
+        "task": task, "planner": planner, "succeeded": False, "failure": reason}
+
+
+def _reason(error: BaseException) -> str:
+    return " ".join(f"{type(error).__name__}: {error}".split())
+
+
+# --------------------------------------------------------------------------------------------
+# Running the units: in this process, or on Dask.
+# --------------------------------------------------------------------------------------------
+
+
+def _run_serial(work, builders, toppra, bar) -> dict:
+    rows = {}
+    for task in work:
+        for name, build in builders.items():
+            output = run_planner(task, name, build, keep_path=toppra and name == REFERENCE)
+            rows[task.label, name] = bar.done(output["row"])
+            if name == REFERENCE:
+                reference = output
+        if toppra:
+            rows[task.label, "toppra"] = bar.done(run_toppra(task, reference)["row"])
+    return rows
+
+
+def _run_on(client, work, builders, toppra, bar) -> dict:
+    runs = {}  # future -> (task, planner name)
+    for task in work:
+        for name, build in builders.items():
+            future = client.submit(run_planner, task, name, build, toppra and name == REFERENCE, pure=False)
+            runs[future] = (task, name)
+            if name == REFERENCE:
+                reference = future
+        if toppra:
+            runs[client.submit(run_toppra, task, reference, pure=False)] = (task, "toppra")
+    rows = {}
+    for future in as_completed(runs):
+        task, name = runs.pop(future)
+        try:
+            row = future.result()["row"]
+        except Exception as error:  # the worker died, or could not load the unit
+            row = failed_row(task.label, name, _reason(error))
+        rows[task.label, name] = bar.done(row)
+        future.release()
+    return rows
+
+
+class _Progress:
+    """Runs done, failed and the time left (tqdm), on a terminal only."""
+
+    def __init__(self, total, stream):
+        quiet = stream is None or not getattr(stream, "isatty", lambda: False)()
+        self._bar = tqdm(total=total, unit="run", desc="bench", file=stream or sys.stderr, disable=quiet,
+                         dynamic_ncols=True)
+        self.failed = 0
+
+    def done(self, row) -> dict:
+        """Count ``row``'s run; returns the row."""
+        self.failed += not row["succeeded"]
+        self._bar.set_postfix(failed=self.failed, refresh=False)
+        self._bar.update()
+        return row
+
+    def close(self):
+        self._bar.close()
+
+
+def _default_workers() -> int:
     try:
-        planner = make_planner(config, UR10E, reference.q_ref[0])
-    except ValueError:  # no parameterisation of this path: the row says so
-        table.append({column: float("nan") for column in COLUMNS} | {"task": label, "planner": "toppra", "succeeded": False})
-        return table
-    result = simulate(planner, name="toppra", settle_time=0.2)
-    table.append(_row(label, "toppra", result, time.perf_counter() - start, _optimal_duration(result)))
-    return table
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
 
 
-def _markdown(rows) -> str:
-    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
-    for row in rows:
-        lines.append("| " + " | ".join(_format(row[column]) for column in COLUMNS) + " |")
-    return "\n".join(lines) + "\n"
+def _connect(scheduler: str) -> Client:
+    """A client of the Dask scheduler at ``scheduler`` whose workers have our drake_traj."""
+    try:
+        client = Client(scheduler)
+    except Exception as error:  # OSError (unreachable, timed out), ValueError (malformed), ...
+        raise BenchSetupError(
+            f"--scheduler {scheduler}: cannot reach a Dask scheduler at that address ({_reason(error)}). "
+            "Give the address a running scheduler prints (e.g. tcp://host:8786), or leave --scheduler out "
+            "to run on this machine; the connect timeout is Dask's distributed.comm.timeouts.connect."
+        ) from None
+    ours = importlib.metadata.version("drake_traj")
+    try:
+        theirs = set(client.run(importlib.metadata.version, "drake_traj").values())
+    except Exception as error:
+        client.close()
+        raise BenchSetupError(
+            f"--scheduler {scheduler}: a worker of that cluster cannot load drake_traj ({_reason(error)}); "
+            f"install drake_traj {ours} on every worker."
+        ) from None
+    if theirs - {ours}:
+        client.close()
+        raise BenchSetupError(
+            f"--scheduler {scheduler}: that cluster's workers have drake_traj {sorted(theirs)}, this is {ours}; "
+            "install the same version on every worker."
+        )
+    if not theirs:
+        print(f"--scheduler {scheduler}: the cluster has no workers yet; the runs wait for them", file=sys.stderr)
+    return client
 
 
-def _format(value) -> str:
-    if isinstance(value, (bool, np.bool_)):
-        return "yes" if value else "no"
-    if isinstance(value, float):
-        return f"{value:.4g}"
-    return str(value)
+@contextlib.contextmanager
+def _engine(workers, scheduler):
+    """A Dask client of the cluster at ``scheduler`` or of a new local cluster of ``workers``
+    processes; None (run in this process) for one local worker."""
+    if scheduler is None and workers == 1:
+        yield None
+        return
+    if scheduler is not None:
+        with _connect(scheduler) as client:
+            yield client
+        return
+    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                      silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+        yield client
 
 
-def medians(rows) -> list[dict]:
-    """Per planner, the median of each numeric column over the tasks (share for booleans)."""
-    summary = []
-    for name in PLANNERS:
-        mine = [row for row in rows if row["planner"] == name]
-        entry = {"task": "median", "planner": name}
-        for column in COLUMNS[2:]:
-            values = [float(row[column]) for row in mine]
-            finite = [value for value in values if np.isfinite(value)]
-            if column == "succeeded":
-                entry[column] = float(np.mean(values))
-            elif column == "qdd_continuous":  # share of the runs that have a log
-                entry[column] = float(np.mean(finite)) if finite else float("nan")
-            else:
-                entry[column] = float(np.median(finite)) if finite else float("nan")
-        summary.append(entry)
-    return summary
+# --------------------------------------------------------------------------------------------
+# Arguments, tables and the plot.
+# --------------------------------------------------------------------------------------------
 
 
-def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, progress=sys.stderr) -> list[dict]:
-    """Run the benchmark; writes bench.csv, bench.md and bench.png into ``out_dir``."""
+def _check_arguments(count, seed, repeats, workers, scheduler, planners, extra_planners) -> None:
+    def whole(value, name, option, least):
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < least:
+            raise BenchSetupError(f"{name} ({option}) must be a whole number >= {least}, got {value!r}")
+
+    whole(count, "count", "--count", 0)
+    whole(seed, "seed", "--seed", 0)
+    whole(repeats, "repeats", "--repeats", 1)
+    if workers is not None:
+        whole(workers, "workers", "--workers", 1)
+        if scheduler is not None:
+            raise BenchSetupError(
+                f"workers (--workers {workers}) sizes the local cluster; with --scheduler {scheduler} the runs go "
+                "to that cluster's workers: give one of the two")
+    if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
+        raise BenchSetupError(f"scheduler (--scheduler) must be an address such as tcp://host:8786, got {scheduler!r}")
+    unknown = [name for name in planners if name not in PLANNERS]
+    if unknown or not planners:
+        raise BenchSetupError(f"planners must be some of {list(PLANNERS)}, got {list(planners)}")
+    if "toppra" in planners and REFERENCE not in planners:
+        raise BenchSetupError(f"planners: toppra parameterises the path of {REFERENCE}; select both")
+    for name, build in extra_planners.items():
+        if name in PLANNERS or not callable(build):
+            raise BenchSetupError(
+                f"extra_planners[{name!r}] must be a new planner name with a config builder, got {build!r}")
+
+
+def _check_output_directory(out_dir) -> Path:
+    """``out_dir`` as a Path; BenchSetupError if it is a file or lies below one."""
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    tasks = [("paper", *paper_task(), repeats)] + [
-        (f"random_{k}", q0, poses, 1) for k, (q0, poses) in enumerate(random_tasks(count, seed))]
-    rows = []
-    for index, (label, q0, poses, task_repeats) in enumerate(tasks):
-        done = int(30 * index / len(tasks))
-        print(f"\r[{'#' * done}{'.' * (30 - done)}] {index}/{len(tasks)} {label:10s}", end="", file=progress, flush=True)
-        rows.extend(run_task(label, q0, poses, task_repeats))
-    print(f"\r[{'#' * 30}] {len(tasks)}/{len(tasks)} done      ", file=progress)
+    for path in (out_dir, *out_dir.parents):
+        if path.exists() and not path.is_dir():
+            where = "is a file" if path == out_dir else f"lies below the file {path}"
+            raise BenchSetupError(f"--out {out_dir} {where}; give a directory (it is created if missing)")
+    return out_dir
+
+
+def _make_output_directory(out_dir: Path) -> None:
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise BenchSetupError(f"--out {out_dir}: cannot create the directory ({_reason(error)})") from None
+
+
+def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers: int | None = None,
+          scheduler: str | None = None, planners=PLANNERS, extra_planners: dict | None = None,
+          progress=sys.stderr) -> list[dict]:
+    """Run the benchmark; writes bench.csv, bench.md and bench.png into ``out_dir``.
+
+    Args:
+        out_dir: output directory (created; must not be or lie below a file).
+        count: seeded random tasks besides the paper task (>= 0).
+        seed: seed of the random tasks (>= 0).
+        repeats: planning-time repeats on the paper task (>= 1).
+        workers: processes of the local Dask cluster (>= 1; default one per core); 1 runs every
+            unit in this process, in order, without Dask. The cluster's processes are spawned and
+            import the main module: from a script, call ``bench`` under ``if __name__ == "__main__":``.
+        scheduler: address of an existing Dask scheduler (e.g. ``tcp://host:8786``) to run the
+            units on instead of a local cluster; its workers need the same drake_traj.
+        planners: the names of :data:`PLANNERS` to run (toppra needs pajak_blend).
+        extra_planners: more planners to run on every task: name -> ``build(poses, joints)``
+            returning a planner config (poses (m, 6) [m, rad], joint waypoints (m + 1, 6)
+            [rad]). On Dask, ``build`` must be a top-level function of a module the workers
+            can import. A build or planner that raises gives failed rows.
+        progress: stream of the progress bar (shown only if it is a terminal), or None.
+
+    Returns:
+        The rows (one per run, tasks in order, planners in the order of ``planners``, then the
+        extra ones) followed by the medians over the random tasks.
+
+    Raises:
+        BenchSetupError: a bad argument, output directory or scheduler, before any run.
+    """
+    planners, extra_planners = tuple(planners), dict(extra_planners or {})
+    _check_arguments(count, seed, repeats, workers, scheduler, planners, extra_planners)
+    out_dir = _check_output_directory(out_dir)
+    if workers is None and scheduler is None:
+        workers = _default_workers()
+    builders = {name: CONFIG_BUILDERS[name] for name in planners if name != "toppra"} | extra_planners
+    toppra = "toppra" in planners
+    with _engine(workers, scheduler) as client:
+        _make_output_directory(out_dir)
+        work = tasks(count, seed, repeats)
+        bar = _Progress(len(work) * (len(builders) + toppra), progress)
+        try:
+            if client is None:
+                by_run = _run_serial(work, builders, toppra, bar)
+            else:
+                by_run = _run_on(client, work, builders, toppra, bar)
+        finally:
+            bar.close()
+    rows = [by_run[task.label, name] for task in work for name in (*planners, *extra_planners)]
+    failed = sum(not row["succeeded"] for row in rows)
+    if failed:
+        print(f"{failed} of {len(rows)} runs failed (see the failure column)", file=sys.stderr)
     table = rows + (medians([row for row in rows if row["task"] != "paper"]) if count else [])
     with open(out_dir / "bench.csv", "w", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=COLUMNS)
@@ -228,15 +506,57 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, progress
     return table
 
 
+def _markdown(rows) -> str:
+    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    for row in rows:
+        lines.append("| " + " | ".join(_format(row[column]) for column in COLUMNS) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def _format(value) -> str:
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    return str(value).replace("|", "/")
+
+
+def _planner_names(rows) -> list[str]:
+    return list(dict.fromkeys(row["planner"] for row in rows))
+
+
+def medians(rows) -> list[dict]:
+    """Per planner, the median of each numeric column over the tasks (share for booleans; for
+    ``failure``, how many runs failed)."""
+    summary = []
+    for name in _planner_names(rows):
+        mine = [row for row in rows if row["planner"] == name]
+        failed = sum(bool(row["failure"]) for row in mine)
+        entry = {"task": "median", "planner": name, "failure": f"{failed} of {len(mine)} failed" if failed else ""}
+        for column in COLUMNS[2:-1]:
+            values = [float(row[column]) for row in mine]
+            finite = [value for value in values if np.isfinite(value)]
+            if column == "succeeded":
+                entry[column] = float(np.mean(values))
+            elif column == "qdd_continuous":  # share of the runs that have a log
+                entry[column] = float(np.mean(finite)) if finite else float("nan")
+            else:
+                entry[column] = float(np.median(finite)) if finite else float("nan")
+        summary.append(entry)
+    return summary
+
+
 def _plot(rows, path) -> None:
     from matplotlib.figure import Figure
 
+    names = _planner_names(rows)
     figure = Figure(figsize=(9, 4), layout="constrained")
     duration_ax, acceleration_ax = figure.subplots(1, 2)
     for ax, column, label in ((duration_ax, "T_over_optimal", "T / time-optimal T on the same path"),
                               (acceleration_ax, "max_qdd_over_limit", "max |qdd| / limit")):
-        data = [[row[column] for row in rows if row["planner"] == name] for name in PLANNERS]
-        ax.boxplot(data, tick_labels=PLANNERS)
+        data = [[row[column] for row in rows if row["planner"] == name and np.isfinite(row[column])]
+                for name in names]
+        ax.boxplot(data, tick_labels=names)
         ax.axhline(1.0, color="grey", linestyle="--")
         ax.set_ylabel(label)
         ax.tick_params(axis="x", rotation=45)

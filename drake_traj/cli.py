@@ -27,7 +27,7 @@ import numpy as np
 from tqdm import tqdm
 
 from drake_traj.version import __version__
-from drake_traj.bench import bench
+from drake_traj.bench import BenchSetupError, bench
 from drake_traj.errors import DrakeTrajError, PlanningError
 from drake_traj.export import FORMATS, UR_CYCLE, ExportError
 from drake_traj.meshcat import add_live_view, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
@@ -159,8 +159,9 @@ def export_run(args) -> int:
 
 
 def run_bench(args) -> int:
-    """``drake-traj bench``."""
-    bench(args.out, count=args.count, seed=args.seed, repeats=args.repeats)
+    """``drake-traj bench``; bad arguments, ``--out`` or ``--scheduler`` are refused before any run."""
+    bench(args.out, count=args.count, seed=args.seed, repeats=args.repeats, workers=args.workers,
+          scheduler=args.scheduler)
     return EXIT_OK
 
 
@@ -218,6 +219,10 @@ def build_parser() -> argparse.ArgumentParser:
     bench_parser.add_argument("--count", type=int, default=20, help="seeded random tasks besides the paper's")
     bench_parser.add_argument("--seed", type=int, default=0)
     bench_parser.add_argument("--repeats", type=int, default=5, help="planning-time repeats on the paper task")
+    bench_parser.add_argument("--workers", type=int, default=None,
+                              help="processes of the local Dask cluster (default: one per core; 1: no Dask, in order)")
+    bench_parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                              help="run on the existing Dask cluster of this scheduler (e.g. tcp://host:8786)")
     return parser
 
 

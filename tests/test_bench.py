@@ -1,22 +1,67 @@
-"""The benchmark on a tiny set: its table is consistent (not a timing test)."""
+"""The benchmark on a tiny set: its table is consistent, the same serially and on a Dask cluster,
+a failing run is a row, and bad arguments stop it before any run (not a timing test)."""
 
 import csv
+import math
 
+import dask
 import numpy as np
 import pytest
 
-from drake_traj import bench
+from drake_traj import bench, cli
+from drake_traj.planners import QuinticConfig
+
+
+def broken_config(poses, joints):
+    """An extra planner whose config cannot make a planner (a negative velocity limit)."""
+    return QuinticConfig(goals=joints[1:].tolist(), velocity_limit=[-1.0] * 6)
 
 
 @pytest.fixture(scope="module")
 def rows(tmp_path_factory):
+    """Serial run (``--workers 1``): the paper task and one random task."""
     out = tmp_path_factory.mktemp("bench")
-    table = bench.bench(out, count=1, repeats=1)
+    table = bench.bench(out, count=1, repeats=1, workers=1)
     with open(out / "bench.csv") as handle:
         assert len(list(csv.DictReader(handle))) == len(table)
     assert (out / "bench.md").read_text().startswith("## Paper task")
     assert (out / "bench.png").stat().st_size > 10_000
     return [row for row in table if row["task"] != "median"]
+
+
+@pytest.fixture(scope="module")
+def cluster_rows(tmp_path_factory):
+    """The same two tasks on a two-worker Dask LocalCluster (Toppra, the Pająk run it depends on
+    and a quick planner, to keep it short), with a planner that cannot be made."""
+    out = tmp_path_factory.mktemp("bench_cluster")
+    table = bench.bench(out, count=1, repeats=1, workers=2, planners=("pajak_blend", "quintic_stop", "toppra"),
+                        extra_planners={"broken": broken_config})
+    with open(out / "bench.csv") as handle:
+        assert [row["failure"] for row in csv.DictReader(handle)] == [row["failure"] for row in table]
+    return [row for row in table if row["task"] != "median"]
+
+
+def same(a, b) -> bool:
+    return a == b or (isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b))
+
+
+def test_a_cluster_run_equals_the_serial_run_apart_from_timings(rows, cluster_rows):
+    ours = [row for row in cluster_rows if row["planner"] != "broken"]
+    serial_rows = [row for row in rows if row["planner"] in ("pajak_blend", "quintic_stop", "toppra")]
+    assert [(row["task"], row["planner"]) for row in ours] == [(row["task"], row["planner"]) for row in serial_rows]
+    for serial, parallel in zip(serial_rows, ours):
+        different = [column for column in bench.COLUMNS
+                     if column not in bench.TIMING_COLUMNS and not same(serial[column], parallel[column])]
+        assert not different, (serial, parallel)
+
+
+def test_a_run_that_raises_is_a_failed_row_with_its_reason(cluster_rows):
+    broken = [row for row in cluster_rows if row["planner"] == "broken"]
+    assert [row["task"] for row in broken] == ["paper", "random_0"]
+    for row in broken:
+        assert not row["succeeded"] and math.isnan(row["T_s"]), row
+        assert row["failure"].startswith("ValueError: velocity_limit"), row
+    assert all(row["failure"] == "" for row in cluster_rows if row["planner"] != "broken")
 
 
 def test_every_planner_ran_on_every_task(rows):
@@ -57,3 +102,35 @@ def test_random_tasks_are_reachable_and_seeded():
         joints = bench.joint_waypoints(q0, poses)
         for q, pose in zip(joints[1:], poses):
             np.testing.assert_allclose(bench.robot.task_pose(q)[:3], pose[:3], atol=1e-9)
+
+
+@pytest.mark.parametrize("arguments, option", [
+    (["--count", "-3"], "--count"), (["--repeats", "0"], "--repeats"), (["--seed", "-1"], "--seed"),
+    (["--workers", "0"], "--workers"), (["--scheduler", "not-an-address:xyz"], "--scheduler"),
+    (["--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"], "--workers"),
+])
+def test_bad_arguments_stop_before_any_run(tmp_path, capsys, arguments, option):
+    out = tmp_path / "out"
+    assert cli.main(["bench", "--out", str(out), *arguments]) == 2
+    error = capsys.readouterr().err
+    assert error.startswith("drake-traj: error: ") and option in error and "Traceback" not in error
+    assert len(error.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_an_unreachable_scheduler_is_an_error_naming_the_option(tmp_path, capsys):
+    out = tmp_path / "out"
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        assert cli.main(["bench", "--out", str(out), "--scheduler", "tcp://127.0.0.1:1"]) == 2
+    error = capsys.readouterr().err
+    assert "--scheduler tcp://127.0.0.1:1: cannot reach a Dask scheduler" in error
+    assert not out.exists()
+
+
+def test_an_output_that_is_or_lies_below_a_file_is_refused(tmp_path, capsys):
+    afile = tmp_path / "bench.csv"
+    afile.write_text("keep me")
+    for out in (afile, afile / "below"):
+        assert cli.main(["bench", "--out", str(out), "--count", "0"]) == 2
+        assert f"--out {out}" in capsys.readouterr().err
+    assert afile.read_text() == "keep me"

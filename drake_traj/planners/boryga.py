@@ -727,6 +727,8 @@ class RobotLoopLaw(HermiteLaw):
         self.plan = plan
         self.robot = robot
         self.reference = np.asarray(reference, dtype=float)
+        coarse = np.union1d(np.linspace(0.0, plan.duration, 201), plan.breakpoints)
+        robot.point_ik(plan.sample(coarse)[0].reshape(-1, 3), self.reference)  # out of reach: a ValueError now
         knots = np.union1d(np.linspace(0.0, plan.duration, int(np.ceil(plan.duration / knot_step)) + 1),
                            plan.breakpoints)
         right = np.array([self.exact(tau, "right") for tau in knots])

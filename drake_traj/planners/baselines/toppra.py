@@ -210,62 +210,103 @@ def time_optimal_along_path(
 
 
 class ToppraLaw:
-    """A Toppra trajectory as a time law for :class:`TimeLawPlanner` (law time tau in [0, T*]).
+    """A Toppra trajectory as a time law for :class:`TimeLawPlanner` (law time tau in [0, T* + h]).
 
-    ``rates_at`` is the simulator's hot path (~4000 calls per simulated second), so the
-    trajectory's velocity is sampled once, every ``sample_period`` [s], and ``rates_at`` returns
-    its linear interpolation and, as acceleration, the slope of the current table cell (a few
-    microseconds per call, no pybind round trip). Velocity and acceleration are thus mutually
-    consistent: integrating the law's qdd reproduces its qd at every table point exactly, and
-    the simulated q ends within O(sample_period^2) of the path's end. (Toppra's s_ddot is
-    piecewise constant, so qdd jumps; the cell slope is the mean over the cell.) Outside [0, T*]
-    the law rests (zero rates).
+    The trajectory's joint velocity is sampled once into a table V at t_k = k h (h =
+    ``sample_period``; V = 0 at t = 0 and from the first node at or after T* on: rest to rest),
+    and the law is that table, linearly interpolated, averaged over the last period::
+
+        qd(tau) = (1/h) integral of V over [tau - h, tau],    qdd(tau) = (V(tau) - V(tau - h)) / h.
+
+    Why the average: Toppra's s_ddot is piecewise constant, so the trajectory's qdd jumps at each
+    of its grid points (by 1e-3 to 2.7 rad/s^2 on the paper task's path). The simulator's
+    error-controlled integrator shrinks its step around every jump: replaying the trajectory's
+    qdd as a step function cost 57 000 derivative evaluations per simulated second (real-time
+    factor 0.4, against 4 500 for the smooth planners). The averaged law's qdd is continuous and
+    linear between nodes; with h the closed loop's 1 ms step (the default) the nodes fall on the
+    integrator's step boundaries, so every step integrates a polynomial exactly (4 700
+    evaluations per simulated second). What it costs: the law is the trajectory delayed by h/2
+    and smoothed over h. It lasts T* + h to T* + 2 h (T* rounded up to a node, plus h); its
+    |qd| and |qdd| never exceed the table's (an average does not overshoot), a step of Toppra's
+    qdd becomes a ramp over h, and q ends within O(h^2) of the path's end. ``rates_at`` is the
+    simulator's hot path: a table look-up, no pybind round trip. Outside [0, duration] the law
+    rests (zero rates).
 
     Args:
-        trajectory: q(t) on [t0, t0 + T*] (e.g. from :func:`time_optimal_along_path`).
-        sample_period: spacing of the precomputed rate table [s].
+        trajectory: q(t) on [t0, t0 + T*] (e.g. from :func:`time_optimal_along_path`), starting
+            and ending at rest.
+        sample_period: h, the table's spacing [s]; keep it the closed loop's plant step.
     """
 
-    def __init__(self, trajectory, *, sample_period: float = 5e-4):
+    # the average's q̈ is continuous (linear between nodes): no law time where it jumps
+    acceleration_jumps = np.empty(0)
+
+    def __init__(self, trajectory, *, sample_period: float = 1e-3):
         if not sample_period > 0:
             raise ValueError(f"sample_period must be > 0 s, got {sample_period}")
         self.trajectory = trajectory
-        self._t0 = float(trajectory.start_time())
-        self.duration = float(trajectory.end_time()) - self._t0
-        if not self.duration > 0:
-            raise ValueError(f"trajectory must have a positive duration, got {self.duration} s")
-        self.q_start = np.asarray(trajectory.value(self._t0), dtype=float).ravel()
-        self.q_end = np.asarray(trajectory.value(self._t0 + self.duration), dtype=float).ravel()
+        t0 = float(trajectory.start_time())
+        optimal = float(trajectory.end_time()) - t0
+        if not optimal > 0:
+            raise ValueError(f"trajectory must have a positive duration, got {optimal} s")
+        self.q_start = np.asarray(trajectory.value(t0), dtype=float).ravel()
+        self.q_end = np.asarray(trajectory.value(t0 + optimal), dtype=float).ravel()
         self.num_joints = len(self.q_start)
-        count = max(2, int(np.ceil(self.duration / sample_period)) + 1)
-        self._tau = np.linspace(0.0, self.duration, count)
-        self._dt = self._tau[1] - self._tau[0]
-        self._qd = np.array([trajectory.EvalDerivative(self._t0 + t, 1).ravel() for t in self._tau])
-        self._qd[0] = self._qd[-1] = 0.0  # rest to rest
-        self._qdd = np.diff(self._qd, axis=0) / self._dt  # cell k: the slope from qd[k] to qd[k+1]
+        self.sample_period = h = float(sample_period)
+        last = max(1, int(np.ceil(optimal / h - 1e-9)))  # the first node at or after T*
+        self.duration = (last + 1) * h
+        velocity = np.zeros((last + 1, self.num_joints))
+        velocity[1:last] = [trajectory.EvalDerivative(t0 + k * h, 1).ravel() for k in range(1, last)]
+        step = np.diff(velocity, axis=0)
+        # Q (displacement) = integral of V, R (swept) = integral of Q, at the nodes (V linear per cell).
+        displacement = np.zeros_like(velocity)
+        displacement[1:] = np.cumsum(h * (velocity[:-1] + step / 2), axis=0)
+        swept = np.zeros_like(velocity)
+        swept[1:] = np.cumsum(h * (displacement[:-1] + h * (velocity[:-1] / 2 + step / 6)), axis=0)
+        self._velocity, self._step, self._displacement, self._swept = velocity, step, displacement, swept
         self._zero = np.zeros(self.num_joints)
 
+    def _table(self, u: float):
+        """(V, Q, R) at table time u [s]: V interpolated, Q and R its first and second integrals."""
+        if u <= 0.0:
+            return self._zero, self._zero, self._zero
+        h = self.sample_period
+        x = u / h
+        k = int(x)
+        last = len(self._step)
+        if k >= last:  # at rest from the last node on
+            return self._zero, self._displacement[-1], self._swept[-1] + self._displacement[-1] * (u - last * h)
+        w = x - k
+        v, dv, q = self._velocity[k], self._step[k], self._displacement[k]
+        return (v + w * dv, q + h * (w * v + w * w / 2 * dv),
+                self._swept[k] + h * (w * q + h * (w * w / 2 * v + w**3 / 6 * dv)))
+
     def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
-        """(qd [rad/s], qdd [rad/s^2]) at law time ``tau`` [s] (interpolated table; rest outside)."""
+        """(qd [rad/s], qdd [rad/s^2]) of the law at law time ``tau`` [s] (rest outside)."""
         if not 0.0 <= tau <= self.duration:
             return self._zero.copy(), self._zero.copy()
-        x = tau / self._dt
-        k = min(int(x), len(self._tau) - 2)
-        w = x - k
-        return self._qd[k] + w * (self._qd[k + 1] - self._qd[k]), self._qdd[k].copy()
+        h = self.sample_period
+        v1, q1, _ = self._table(tau)
+        v0, q0, _ = self._table(tau - h)
+        return (q1 - q0) / h, (v1 - v0) / h
 
     def sample(self, t):
-        """Exact (q, qd, qdd) of the trajectory at law times ``t`` [s] (clipped to [0, T*]).
+        """(q, qd, qdd) of the law at law times ``t`` [s] (clipped to [0, duration]): what the
+        planner integrates. The trajectory itself is ``trajectory`` (at t - h/2, approximately).
 
         Returns arrays of shape t.shape + (n,).
         """
         t_arr = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
-        flat = t_arr.ravel()
-        q = np.array([self.trajectory.value(self._t0 + x).ravel() for x in flat])
-        qd = np.array([self.trajectory.EvalDerivative(self._t0 + x, 1).ravel() for x in flat])
-        qdd = np.array([self.trajectory.EvalDerivative(self._t0 + x, 2).ravel() for x in flat])
+        h = self.sample_period
+        q, qd, qdd = [], [], []
+        for tau in t_arr.ravel():
+            v1, q1, r1 = self._table(tau)
+            v0, q0, r0 = self._table(tau - h)
+            q.append(self.q_start + (r1 - r0) / h)
+            qd.append((q1 - q0) / h)
+            qdd.append((v1 - v0) / h)
         shape = t_arr.shape + (self.num_joints,)
-        return q.reshape(shape), qd.reshape(shape), qdd.reshape(shape)
+        return tuple(np.reshape(x, shape) for x in (q, qd, qdd))
 
 
 class ToppraPlanner(TimeLawPlanner):
