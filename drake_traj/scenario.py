@@ -53,7 +53,8 @@ class Scenario:
             SAP); ``plant: {time_step: 0.002}`` runs at the UR controller's 500 Hz.
         simulator: Drake's ``SimulatorConfig`` (integration scheme, step, accuracy, real-time
             rate; default fixed-step RK2 at 1 ms, see ``station.default_simulator_config``).
-        log_period: the loggers' period [s].
+        log_period: the loggers' period [s], a whole multiple of ``plant.time_step``; 0 (the
+            default): the plant's time step.
         speed_override: a speed-override profile (times [s], values in [0, 1]), like a pendant's
             speed slider; empty: none.
         tracking_tolerance: the run fails if the measured TCP is ever further than this from the
@@ -70,7 +71,7 @@ class Scenario:
     controller: ControllerGains = field(default_factory=ControllerGains)
     plant: MultibodyPlantConfig = field(default_factory=default_plant_config)
     simulator: SimulatorConfig = field(default_factory=default_simulator_config)
-    log_period: float = 0.001
+    log_period: float = 0.0
     speed_override: SpeedOverride = field(default_factory=SpeedOverride)
     tracking_tolerance: float = DEFAULT_TRACKING_TOLERANCE
     settle_time: float = 0.5
@@ -106,7 +107,7 @@ class Scenario:
             raise ValueError(
                 f"q_initial[{j}] = {q[j]} {unit} is outside the joint range [{lower[j]:.6f}, {upper[j]:.6f}] {unit}"
             )
-        for label, value in (("plant.time_step", self.plant.time_step), ("log_period", self.log_period),
+        for label, value in (("plant.time_step", self.plant.time_step), ("log_period", self.logging_period()),
                              ("max_duration", self.max_duration), ("settle_time", self.settle_time),
                              ("simulator.max_step_size", self.simulator.max_step_size),
                              ("tracking_tolerance", self.tracking_tolerance)):
@@ -114,11 +115,11 @@ class Scenario:
             if not np.isfinite(value) or value < smallest_allowed:
                 unit = "metres" if label == "tracking_tolerance" else "seconds"
                 raise ValueError(f"{label} must be a finite, positive number of {unit}, got {value}")
-        steps = self.log_period / self.plant.time_step
+        steps = self.logging_period() / self.plant.time_step
         if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
             raise ValueError(f"log_period must be a whole multiple of plant.time_step = {self.plant.time_step} s "
                              f"(the loggers sample the plant's steps), got {self.log_period} s")
-        if self.log_period > self.max_duration:
+        if self.logging_period() > self.max_duration:
             raise ValueError(f"log_period ({self.log_period} s) must not be longer than max_duration "
                              f"({self.max_duration} s): the run would log one sample")
         if self.simulator.integration_scheme not in GetIntegrationSchemes():
@@ -131,7 +132,11 @@ class Scenario:
         """The keyword arguments of :func:`drake_traj.station.build_station` for this scenario
         (its planner made by :func:`make_planner`)."""
         return dict(planner=make_planner(self), robot=get_robot(self.robot), gains=self.controller,
-                    plant_config=self.plant, log_period=self.log_period)
+                    plant_config=self.plant, log_period=self.logging_period())
+
+    def logging_period(self) -> float:
+        """``log_period``, or the plant's time step where it is 0 [s]."""
+        return self.log_period if self.log_period != 0 else self.plant.time_step
 
 
 def shipped_directory() -> Path:
