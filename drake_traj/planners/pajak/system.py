@@ -6,7 +6,8 @@ import numpy as np
 
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.planners.pajak.integration import integrate
-from drake_traj.planners.pajak.law import C, C0, PajakLaw
+from drake_traj.planners.pajak.kernel import Discrete
+from drake_traj.planners.pajak.law import PajakLaw
 from drake_traj.planners.pajak.parameters import PajakConfig
 from drake_traj.robots import ur10e
 from drake_traj.robots.base import Robot
@@ -34,10 +35,10 @@ class PajakPlanner(PlannerSystem):
         self.law = PajakLaw(parameters)
         update_period = self.law.parameters.update_period
         initial = self.law.initial_discrete()
-        super().__init__(ur10e._as_joint_vector(q_initial, "q_initial"), initial_scaling=float(initial[C]))
-        self.task_state_index = self.DeclareDiscreteState(initial[C0 + 1 :])
-        self.velocity_limit = self.law.qd_max[0]
-        self.acceleration_limit = self.law.qdd_max[0]
+        super().__init__(ur10e._as_joint_vector(q_initial, "q_initial"), initial_scaling=float(initial[Discrete.C]))
+        self.task_state_index = self.DeclareDiscreteState(initial[Discrete.C0 + 1 :])
+        self.velocity_limit = self.law.qd_max
+        self.acceleration_limit = self.law.qdd_max
         self.DeclarePeriodicDiscreteUpdateEvent(update_period, 0.0, self._update)
 
     def _law_arguments(self, context):
@@ -74,8 +75,8 @@ class PajakPlanner(PlannerSystem):
     def _update(self, context, discrete_state):
         t, q, qd, discrete = self._law_arguments(context)
         updated = self.law.update(t, q, qd, discrete)
-        discrete_state.get_mutable_vector(self.scaling_state_index).SetFromVector(updated[: C0 + 1])
-        discrete_state.get_mutable_vector(self.task_state_index).SetFromVector(updated[C0 + 1 :])
+        discrete_state.get_mutable_vector(self.scaling_state_index).SetFromVector(updated[: Discrete.C0 + 1])
+        discrete_state.get_mutable_vector(self.task_state_index).SetFromVector(updated[Discrete.C0 + 1 :])
         if self.law.finished(q, qd, updated):
             self._record_finish(discrete_state.get_mutable_vector(self.finish_state_index), t)
 

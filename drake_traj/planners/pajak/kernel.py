@@ -1,0 +1,701 @@
+"""The Pająk 2024 law, compiled: every equation of the planner and its fixed-step integrator.
+
+This module is the one implementation of the law. :mod:`.law` wraps it for Python callers (the
+Drake system, tests) and :mod:`.integration` for whole runs; the functions here take flat float
+vectors whose layouts are the enums below, so that a call from Python costs no conversion:
+
+- :class:`Parameter`: the task's settings (from :class:`~.parameters.PajakConfig`), with the
+  waypoints (w, 6) and the remaining path after each waypoint (w,) as separate arrays;
+- :class:`Discrete`: the discrete state of the law (the Drake system's ``scaling`` group is its
+  first three entries, c, t0 and c0);
+- :class:`Evaluation`: what one evaluation computes (q̈, c, the pose, the target, ...);
+- :class:`Log`: one sample of :func:`integrate_kernel`'s log.
+
+Equation numbers in comments are Pająk 2024's; docs/papers.md explains the corrections and our
+improvements (each a flag of the parameters).
+"""
+
+import hashlib
+import math
+from enum import IntEnum
+from pathlib import Path
+
+import numpy as np
+
+from drake_traj import compiled as compiled_module
+from drake_traj.compiled import compiled
+from drake_traj.planners import scaling
+from drake_traj.planners.scaling import relaxed_scaling
+from drake_traj.robots import ur10e
+from drake_traj.robots.ur10e import kinematics_into, wrapped
+
+__all__ = [
+    "Discrete", "Evaluation", "Log", "Parameter", "Status", "acceleration_terms", "approach_damping",
+    "blend_progress", "blended_target", "choose_scaling", "damping_factor", "evaluate_kernel", "integrate_kernel",
+    "scaling_interval", "update_kernel", "velocity_penalty",
+]
+
+
+def _layout(name: str, fields) -> type[IntEnum]:
+    """An IntEnum of the start index of each (field, size) in a flat vector, and SIZE."""
+    offsets, start = {}, 0
+    for field, size in fields:
+        offsets[field] = start
+        start += size
+    offsets["SIZE"] = start
+    return IntEnum(name, offsets)
+
+
+Parameter = _layout("Parameter", [
+    ("KP", 6), ("KV", 6),  # Λ_P [1/s²], Λ_V [1/s] per task component (eq. 9)
+    ("QD_MAX", 6), ("QDD_MAX", 6),  # joint limits [rad/s], [rad/s²] (eq. 4-5)
+    ("VIABILITY_GAIN", 6),  # K of the velocity-viability bound q̈_i <= K (q̇_max - q̇_i) [1/s]
+    ("VIABILITY_ONSET", 6),  # |q̇_i| above which that bound can bind [rad/s]
+    ("PENALTY_ONSET", 6),  # |q̇_i| above which the penalty of eq. 14 is active [rad/s]
+    ("APPROACH_DELTA", 6),  # δ of the approach rate per task component [m, rad]
+    ("VARTHETA", 1), ("RHO", 1),  # ϑ, ρ of eq. 14
+    ("ACCURACY", 1),  # ε [m]
+    ("NEIGHBOURHOOD", 1),  # ϵ [m] (eq. 19)
+    ("BLEND_DISTANCE", 1),  # path length through the ball at which σ = 1 [m]
+    ("SCALING_RATE", 1),  # rate of eq. 18 [1/s]
+    ("SINGULARITY_THRESHOLD", 1), ("MAX_DAMPING", 1),  # damped least squares (improvement 3)
+    ("STOP_SPEED", 1),  # stop mode: TCP speed below which a waypoint is reached [m/s]
+    ("STALL_TIME", 1),  # no progress for this long is a stall [s]
+    ("NUM_WAYPOINTS", 1),
+    # switches (1.0 on, 0.0 off): PajakConfig's flags
+    ("LIMIT_VELOCITY", 1), ("LIMIT_ACCELERATION", 1), ("BLEND_WAYPOINTS", 1), ("SMOOTH_PENALTY", 1),
+    ("CONTINUOUS_SWITCHING", 1), ("BOUNDED_SCALING", 1), ("DAMPED_INVERSE", 1), ("PRESERVE_DAMPING", 1),
+])
+
+Discrete = _layout("Discrete", [
+    ("C", 1),  # c at the last update
+    ("T0", 1), ("C0", 1),  # eq. 18 anchor: c was C0 at time T0 [s]
+    ("WAYPOINT", 1),  # index i of the active waypoint p_i (an integer)
+    ("BLENDING", 1),  # 1 while the TCP passes the neighbourhood of p_i (eq. 19, second case)
+    ("SIGMA", 1),  # σ of eq. 19 at the last update (σ never decreases)
+    ("TRAVEL", 1),  # TCP path length since it entered the ball, up to the last update [m]
+    ("X_REF", 3),  # TCP position at the last update [m]
+    ("BEST", 1),  # smallest remaining path so far (progress monitor) [m]
+    ("T_BEST", 1),  # when BEST last improved [s]
+    ("SATURATED", 1),  # updates at which no c in [0, 1] kept the limits (improvement 2)
+])
+
+Evaluation = _layout("Evaluation", [
+    ("QDD", 6),  # q̈ [rad/s²]
+    ("C", 1), ("C_RELAXED", 1),  # c and the eq. 18 value c_r
+    ("SATURATED", 1),  # 1 where no c in [0, 1] keeps the limits (the fallback acts)
+    ("SIGMA", 1), ("MEASURE", 1), ("COS_PITCH", 1),  # σ, singularity measure, cos φ_Y
+    ("POSE", 6), ("TARGET", 6),  # k(q) and the target of eq. 6 / eq. 19 [m, rad]
+    ("REMAINING", 1),  # remaining path to p_w (filled by update_kernel) [m]
+])
+
+Log = _layout("Log", [
+    ("T", 1), ("Q", 6), ("QD", 6), ("QDD", 6), ("C", 1), ("TCP", 6), ("SATURATED", 1),
+    ("DISCRETE", int(Discrete.SIZE)),
+])
+
+
+class Status(IntEnum):
+    """What :func:`update_kernel` and :func:`integrate_kernel` report."""
+
+    RUNNING = 0
+    FINISHED = 1
+    STALL = -1
+    SINGULAR = -2  # Euler gimbal lock
+    NON_FINITE = -3
+    TIMEOUT = -4
+
+
+ORIENTATION_LENGTH = 0.1  # [m/rad], weight of orientation in the progress measure
+MIN_COS_PITCH = 1e-6  # Euler gimbal lock (as ur10e.analytic_jacobian_and_bias)
+BRAKE_TIME = 0.05  # [s], time constant of the fallback braking at low speed (improvement 2)
+BRAKE_GAP = 0.1  # emptiness of the c interval at which the fallback is pure braking
+
+
+# --------------------------------------------------------------------------------------------
+# The law's pieces (scalar functions, tested one by one)
+# --------------------------------------------------------------------------------------------
+
+
+@compiled
+def velocity_penalty(qd: float, qd_max: float, rho: float, vartheta: float, smooth: bool) -> float:
+    """Δq̈_i = -∂κ(q̇_i)/∂q̇_i (eq. 15) for the interior penalty κ of eq. 14 [rad/s²], limits ±q̇_max.
+
+    d(q̇_i) = min(q̇_i - q̇_min, q̇_max - q̇_i) / (q̇_max - q̇_min) (eq. 14). Literal (``smooth``
+    False): κ = ρ (1/d - 1/ϑ) for d < ϑ, whose slope -ρ/ϑ² at d = ϑ makes q̈ jump by
+    ρ/((q̇_max - q̇_min) ϑ²) when the penalty switches on. Smooth (improvement 1): κ minus its
+    tangent at ϑ, κ = ρ (1/d - 1/ϑ + (d - ϑ)/ϑ²), zero value and slope at the threshold, the
+    same 1/d growth at the limit. d is floored at 1e-3 beyond the limits.
+    """
+    span = 2.0 * qd_max
+    to_min = qd + qd_max
+    to_max = qd_max - qd
+    d = max(min(to_min, to_max) / span, 1e-3)  # eq. 14
+    if d >= vartheta:
+        return 0.0
+    magnitude = rho / (d * d * span)
+    if smooth:
+        magnitude -= rho / (vartheta * vartheta * span)
+    # ∂κ/∂q̇_i = κ'(d) ∂d/∂q̇_i, ∂d/∂q̇_i = -1/span near q̇_max: eq. 15 pushes from the nearer limit
+    return -magnitude if to_max < to_min else magnitude
+
+
+@compiled
+def approach_damping(error: float, error_rate: float, stiffness: float, damping: float, delta: float) -> float:
+    """Damping [1/s] of one error component that keeps it from changing sign (improvement 4).
+
+    For ë = -D ė - K e, the approach rate r = -ė/e obeys dr/dt = r² - D r + K. With D = r + K/r
+    it is constant: ė = -r e is invariant and e decays as exp(-r t) without crossing 0. Returned:
+    the given ``damping`` for r <= sqrt(K) (the literal law), ramped (smoothstep in r) up to
+    λ + K/λ at r = λ = 2 sqrt(K), and r + K/r above λ; never below ``damping``. Continuous in
+    the state. r = -ė e / (e² + δ²): δ only keeps r finite at e = 0.
+    """
+    rate = -(error * error_rate) / (error * error + delta * delta)
+    root = math.sqrt(stiffness)
+    held = max(rate, 2.0 * root)
+    hold = held + stiffness / held
+    x = min(max(rate / root - 1.0, 0.0), 1.0)
+    return max(damping, damping + (hold - damping) * (x * x * (3.0 - 2.0 * x)))
+
+
+@compiled
+def damping_factor(measure: float, threshold: float, max_damping: float) -> float:
+    """λ² of the damped least-squares inverse (improvement 3): 0 for measure >= threshold,
+    rising to max_damping² at a singular J: λ² = λ_max² (1 - (measure/threshold)²)."""
+    ratio = min(measure / threshold, 1.0)
+    return max_damping * max_damping * (1.0 - ratio * ratio)
+
+
+@compiled
+def _factor(jac, lam2, use_damped, matrix, pivots):
+    """LU factors (partial pivoting) of J, or of JᵀJ + λ²I for the damped inverse, into
+    ``matrix`` (6, 6) and ``pivots`` (6,)."""
+    for i in range(6):
+        for j in range(6):
+            if use_damped:
+                total = 0.0
+                for k in range(6):
+                    total += jac[k, i] * jac[k, j]
+                matrix[i, j] = total + (lam2 if i == j else 0.0)
+            else:
+                matrix[i, j] = jac[i, j]
+    for k in range(6):
+        pivot = k
+        for i in range(k + 1, 6):
+            if abs(matrix[i, k]) > abs(matrix[pivot, k]):
+                pivot = i
+        pivots[k] = pivot
+        if pivot != k:
+            for j in range(6):
+                matrix[k, j], matrix[pivot, j] = matrix[pivot, j], matrix[k, j]
+        for i in range(k + 1, 6):
+            factor = matrix[i, k] / matrix[k, k]
+            matrix[i, k] = factor
+            for j in range(k + 1, 6):
+                matrix[i, j] -= factor * matrix[k, j]
+
+
+@compiled
+def _solve(jac, use_damped, matrix, pivots, rhs, out):
+    """J⁻¹ rhs (eq. 13), or (JᵀJ + λ²I)⁻¹ Jᵀ rhs (damped least squares), into ``out`` (6,),
+    from the factors of :func:`_factor`."""
+    for i in range(6):
+        if use_damped:
+            total = 0.0
+            for k in range(6):
+                total += jac[k, i] * rhs[k]
+            out[i] = total
+        else:
+            out[i] = rhs[i]
+    for k in range(6):
+        pivot = pivots[k]
+        if pivot != k:
+            out[k], out[pivot] = out[pivot], out[k]
+    for i in range(6):
+        for k in range(i):
+            out[i] -= matrix[i, k] * out[k]
+    for i in range(5, -1, -1):
+        for k in range(i + 1, 6):
+            out[i] -= matrix[i, k] * out[k]
+        out[i] /= matrix[i, i]
+
+
+@compiled
+def acceleration_terms(jac, bias, error, qd, kp, kv, penalty, lam2, use_damped, a, b):
+    """a and b = b_V + b_P of eq. 17 into ``a``, ``b`` (6,):
+
+    a = -J⁻¹ J̇q̇, b_V = -J⁻¹ Λ_V J q̇ + Δq̈, b_P = -J⁻¹ Λ_P e (e of eq. 6 or eq. 19).
+    q̈ = a + c b is eq. 17; with c = 1 it is eq. 16 (eq. 13 without Δq̈). With ``use_damped``
+    J⁻¹ is the damped least-squares inverse with λ² = ``lam2`` (:func:`damping_factor`).
+    """
+    matrix = np.empty((6, 6))
+    pivots = np.empty(6, dtype=np.int64)
+    _factor(jac, lam2, use_damped, matrix, pivots)
+    rhs = np.empty(6)
+    out = np.empty(6)
+    _solve(jac, use_damped, matrix, pivots, bias, out)
+    for i in range(6):
+        a[i] = -out[i]
+    for i in range(6):
+        rate = 0.0
+        for j in range(6):
+            rate += jac[i, j] * qd[j]
+        rhs[i] = kv[i] * rate + kp[i] * error[i]
+    _solve(jac, use_damped, matrix, pivots, rhs, out)
+    for i in range(6):
+        b[i] = penalty[i] - out[i]
+
+
+@compiled
+def _fmin(x: float, y: float) -> float:
+    """min ignoring NaN (numpy's fmin)."""
+    if x != x:
+        return y
+    if y != y:
+        return x
+    return min(x, y)
+
+
+@compiled
+def _fmax(x: float, y: float) -> float:
+    """max ignoring NaN (numpy's fmax)."""
+    if x != x:
+        return y
+    if y != y:
+        return x
+    return max(x, y)
+
+
+@compiled
+def scaling_interval(a, b, lower, upper):
+    """(c_lo, c_hi): the interval of c with lower <= a + c b <= upper on every joint.
+
+    Each joint gives the bound of cases (1)-(4) (Corrected (docs/papers.md): (2) and (4) use q̈_min):
+    b_i > 0: (q̈_min - a_i)/b_i <= c <= (q̈_max - a_i)/b_i; b_i < 0: the same with the roles
+    of q̈_min and q̈_max swapped; b_i = 0: no bound if a_i is inside the box, else empty.
+    Upper bounds (cases 1, 2) combine by min (case a), lower bounds (3, 4) by max (case b).
+    The interval is empty where c_lo > c_hi.
+    """
+    c_lo = -np.inf
+    c_hi = np.inf
+    for i in range(a.shape[0]):
+        to_max = (upper[i] - a[i]) / b[i]
+        to_min = (lower[i] - a[i]) / b[i]
+        c_lo = max(c_lo, _fmin(to_max, to_min))
+        c_hi = min(c_hi, _fmax(to_max, to_min))
+    return c_lo, c_hi
+
+
+@compiled
+def choose_scaling(c_relaxed: float, c_lo: float, c_hi: float, bounded: bool = True):
+    """(c, feasible) from the relaxed value c_r (eq. 18) and the admissible interval (case a-c).
+
+    c = c_r when it is admissible; otherwise the admissible value closest to c_r (case a: the
+    smallest upper bound, case b: the largest lower bound, case c: the point of
+    [ĉ_min, ĉ_max] closest to c_r, which is the previous c when the anchor was just recorded).
+    ``bounded`` (improvement 2) restricts the interval to [0, 1]. feasible is False where the
+    interval is empty (then c is the clip of c_r to it, and the caller must keep the limits
+    some other way).
+    """
+    if bounded:
+        c_lo = max(c_lo, 0.0)
+        c_hi = min(c_hi, 1.0)
+    c = min(max(c_relaxed, c_lo), c_hi)
+    if bounded:
+        c = min(max(c, 0.0), 1.0)
+    return c, c_lo <= c_hi
+
+
+@compiled
+def blend_progress(position, reference, travel: float, length: float):
+    """(σ of eq. 19 before the monotone max, step): σ = the TCP path length through the ball /
+    ``length``, clipped to [0, 1].
+
+    σ = (ℓ + |x - x_ref|) / length, where ℓ is the path length accumulated at the updates since
+    the TCP entered the ball and x_ref the TCP position at the last update (step = |x - x_ref|).
+    It is 0 on entry, continuous in x and grows whenever the TCP moves, so the target always
+    leads (a projection on p_i -> p_{i+1} does not grow while the TCP is still heading for p_i,
+    and 1 - δ/ϵ is not monotone: both stall, docs/papers.md). ``length`` = ``blend_length`` · ϵ.
+    """
+    step = math.sqrt((position[0] - reference[0]) ** 2 + (position[1] - reference[1]) ** 2
+                     + (position[2] - reference[2]) ** 2)
+    return min(max((travel + step) / length, 0.0), 1.0), step
+
+
+# --------------------------------------------------------------------------------------------
+# The law
+# --------------------------------------------------------------------------------------------
+#
+# numba caches a compiled function under its own source file only (numba issue #1833): after an
+# edit of the UR10e kinematics or of eq. 18 in their modules, the cached law would go on using the
+# old code. Numba does hash a function's closure into its cache key, so each function below that
+# reaches compiled code of another module is made in a closure over the digest of those modules'
+# sources (``dependencies``, unused otherwise); they call each other through the module's globals.
+
+
+def _sources_digest(*modules) -> str:
+    """sha256 of the source files of ``modules``."""
+    digest = hashlib.sha256()
+    for module in modules:
+        digest.update(Path(module.__file__).read_bytes())
+    return digest.hexdigest()
+
+
+_DEPENDENCIES = _sources_digest(ur10e, scaling, compiled_module)
+
+
+@compiled
+def _position_distance(pose, waypoints, i):
+    """|x - p_i| of the TCP position [m]."""
+    return math.sqrt((pose[0] - waypoints[i, 0]) ** 2 + (pose[1] - waypoints[i, 1]) ** 2
+                     + (pose[2] - waypoints[i, 2]) ** 2)
+
+
+@compiled
+def _finite(values) -> bool:
+    for value in values:
+        if not math.isfinite(value):
+            return False
+    return True
+
+
+def _blended_target(dependencies):
+    @compiled
+    def blended_target(p_i, p_next, sigma):
+        """σ p_{i+1} + (1 - σ) p_i of eq. 19, the orientation part along the wrapped difference."""
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        target = np.empty(6)
+        for k in range(6):
+            step = p_next[k] - p_i[k]
+            if k >= 3:
+                step = wrapped(step)
+            target[k] = p_i[k] + sigma * step
+        return target
+
+    return blended_target
+
+
+blended_target = _blended_target(_DEPENDENCIES)
+
+
+def _evaluate_kernel(dependencies):
+    @compiled
+    def evaluate_kernel(t, q, qd, d, p, waypoints, out):
+        """One evaluation of the law at time t for (q, q̇) and the discrete state ``d`` into
+        ``out`` (layout :class:`Evaluation`): q̈ of eq. 17 with c = min(eq. 18 relaxation, the
+        admissible ĉ).
+
+        No exception: gimbal lock shows in out[COS_PITCH], a failure as non-finite out[QDD].
+        """
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        pose = out[Evaluation.POSE:Evaluation.POSE + 6]
+        qdd = out[Evaluation.QDD:Evaluation.QDD + 6]
+        target = out[Evaluation.TARGET:Evaluation.TARGET + 6]
+        jac = np.empty((6, 6))
+        bias = np.empty(6)
+        cos_pitch, measure = kinematics_into(q, qd, pose, jac, bias)
+        out[Evaluation.COS_PITCH] = cos_pitch
+        out[Evaluation.MEASURE] = measure
+        out[Evaluation.SATURATED] = 0.0
+        i = int(d[Discrete.WAYPOINT])
+        last = int(p[Parameter.NUM_WAYPOINTS]) - 1
+        sigma = 0.0
+        if p[Parameter.BLEND_WAYPOINTS] > 0.0 and d[Discrete.BLENDING] > 0.5:
+            raw, _ = blend_progress(pose, d[Discrete.X_REF:Discrete.X_REF + 3], d[Discrete.TRAVEL],
+                                    p[Parameter.BLEND_DISTANCE])
+            sigma = max(raw, d[Discrete.SIGMA])  # σ never decreases
+            target[:] = blended_target(waypoints[i], waypoints[min(i + 1, last)], sigma)  # eq. 19
+        else:
+            target[:] = waypoints[i]  # eq. 6
+        out[Evaluation.SIGMA] = sigma
+        error = np.empty(6)
+        for k in range(6):
+            error[k] = pose[k] - target[k]  # eq. 6
+            if k >= 3:
+                error[k] = wrapped(error[k])  # orientation wrapped (docs/papers.md)
+        penalty = np.zeros(6)
+        if p[Parameter.LIMIT_VELOCITY] > 0.0:
+            smooth = p[Parameter.SMOOTH_PENALTY] > 0.0
+            for k in range(6):
+                if abs(qd[k]) > p[Parameter.PENALTY_ONSET + k]:
+                    penalty[k] = velocity_penalty(qd[k], p[Parameter.QD_MAX + k], p[Parameter.RHO],
+                                                  p[Parameter.VARTHETA], smooth)  # eq. 14-15
+        use_damped = p[Parameter.DAMPED_INVERSE] > 0.0 and measure < p[Parameter.SINGULARITY_THRESHOLD]
+        lam2 = 0.0
+        if use_damped:
+            lam2 = damping_factor(measure, p[Parameter.SINGULARITY_THRESHOLD], p[Parameter.MAX_DAMPING])
+        kp = p[Parameter.KP:Parameter.KP + 6]
+        kv = p[Parameter.KV:Parameter.KV + 6]
+        a = np.empty(6)
+        b = np.empty(6)
+        acceleration_terms(jac, bias, error, qd, kp, kv, penalty, lam2, use_damped, a, b)  # eq. 17
+        if p[Parameter.LIMIT_ACCELERATION] == 0.0:
+            out[Evaluation.C] = 1.0
+            out[Evaluation.C_RELAXED] = 1.0
+            for k in range(6):
+                qdd[k] = a[k] + b[k]  # eq. 16 (eq. 13 without the penalty)
+            return
+        c_r = relaxed_scaling(t, d[Discrete.T0], d[Discrete.C0], 1.0, p[Parameter.SCALING_RATE])[0]  # eq. 18
+        out[Evaluation.C_RELAXED] = c_r
+        if p[Parameter.PRESERVE_DAMPING] > 0.0:
+            # improvement 4: per error component, the damping that keeps it from changing sign
+            # (approach_damping), with the gains scaled by c_r so that q̈ stays linear in c.
+            # Applied while converging to a fixed target (p_w; every waypoint in stop mode),
+            # ramped in with σ during the last blend so that q̈ stays continuous.
+            weight = -1.0
+            if p[Parameter.BLEND_WAYPOINTS] == 0.0 or i >= last:
+                weight = 1.0
+            elif i == last - 1:
+                weight = sigma
+            if weight >= 0.0:
+                scale = min(max(c_r, 1e-3), 1.0)
+                added = np.empty(6)
+                any_added = False
+                for k in range(6):
+                    rate = 0.0
+                    for j in range(6):
+                        rate += jac[k, j] * qd[j]  # ė = J q̇
+                    damping = approach_damping(error[k], rate, scale * kp[k], scale * kv[k],
+                                               p[Parameter.APPROACH_DELTA + k])
+                    extra = weight * (damping / scale - kv[k])  # per unit of c
+                    added[k] = extra * rate
+                    any_added = any_added or extra > 0.0
+                if any_added:
+                    matrix = np.empty((6, 6))
+                    pivots = np.empty(6, dtype=np.int64)
+                    _factor(jac, lam2, use_damped, matrix, pivots)
+                    solved = np.empty(6)
+                    _solve(jac, use_damped, matrix, pivots, added, solved)
+                    for k in range(6):
+                        b[k] -= solved[k]
+        lower = np.empty(6)
+        upper = np.empty(6)
+        near_limit = False
+        for k in range(6):
+            upper[k] = p[Parameter.QDD_MAX + k]
+            lower[k] = -upper[k]
+            near_limit = near_limit or abs(qd[k]) > p[Parameter.VIABILITY_ONSET + k]
+        bounded = p[Parameter.BOUNDED_SCALING] > 0.0
+        if bounded and p[Parameter.LIMIT_VELOCITY] > 0.0 and near_limit:
+            # improvement 2: the box also keeps q̇ viable: q̈_i <= K (q̇_max - q̇_i) (and the mirror
+            # bound), so q̇ can only approach its limit exponentially even when c is held small by
+            # another joint and the penalty (scaled by c) cannot act. K puts the bound's onset at
+            # d = ϑ/4, inside the penalty zone.
+            for k in range(6):
+                limit = p[Parameter.QDD_MAX + k]
+                gain = p[Parameter.VIABILITY_GAIN + k]
+                speed = p[Parameter.QD_MAX + k]
+                upper[k] = min(max(gain * (speed - qd[k]), -limit), limit)
+                lower[k] = min(max(gain * (-speed - qd[k]), -limit), limit)
+        c_lo, c_hi = scaling_interval(a, b, lower, upper)  # cases 1-4
+        c, feasible = choose_scaling(c_r, c_lo, c_hi, bounded)  # cases a-c
+        out[Evaluation.C] = c
+        for k in range(6):
+            qdd[k] = a[k] + c * b[k]  # eq. 17
+        if bounded and not feasible:
+            # improvement 2: no c in [0, 1] keeps the limits (then a = -J⁻¹J̇q̇ alone breaks
+            # them: the joints move too fast for the curvature of the path). Blend, by how
+            # empty the interval is, from q̈ clipped to the box to braking all joints
+            # proportionally at the largest admissible rate; both stay in the box (braking only
+            # lowers |q̇|), and the blend is continuous.
+            out[Evaluation.SATURATED] = 1.0
+            rate = 1.0 / BRAKE_TIME
+            for k in range(6):
+                rate = min(rate, p[Parameter.QDD_MAX + k] / abs(qd[k]))
+            gap = max(c_lo, 0.0) - min(c_hi, 1.0)
+            weight = min(max(gap / BRAKE_GAP, 0.0), 1.0)
+            for k in range(6):
+                clipped = min(max(qdd[k], lower[k]), upper[k])
+                qdd[k] = clipped + weight * (-qd[k] * rate - clipped)
+
+    return evaluate_kernel
+
+
+evaluate_kernel = _evaluate_kernel(_DEPENDENCIES)
+
+
+def _update_kernel(dependencies):
+    @compiled
+    def update_kernel(t, q, qd, d, p, waypoints, remaining, out):
+        """The discrete update at time t, in place on ``d``; returns a :class:`Status`.
+
+        Evaluates the law first (into ``out``, with the discrete state before the update);
+        records the eq. 18 anchor (t0, c0) = (t, c) when the limits set c; switches waypoints
+        (eq. 19 blending, or stop-and-go with c restarting from 0 when the acceleration is
+        limited); tracks progress (out[REMAINING]) and reports a finish, a stall, gimbal lock or
+        non-finite values.
+        """
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        evaluate_kernel(t, q, qd, d, p, waypoints, out)
+        pose = out[Evaluation.POSE:Evaluation.POSE + 6]
+        bad = not (_finite(out[Evaluation.QDD:Evaluation.QDD + 6]) and _finite(q) and _finite(qd))
+        c = out[Evaluation.C]
+        if p[Parameter.LIMIT_ACCELERATION] > 0.0:
+            if abs(c - out[Evaluation.C_RELAXED]) > 1e-12:  # the limits moved c off eq. 18: new anchor
+                d[Discrete.T0] = t
+                d[Discrete.C0] = c
+            d[Discrete.SATURATED] += out[Evaluation.SATURATED]
+        d[Discrete.C] = c
+        i = int(d[Discrete.WAYPOINT])
+        last = int(p[Parameter.NUM_WAYPOINTS]) - 1
+        if p[Parameter.BLEND_WAYPOINTS] > 0.0:
+            blending = d[Discrete.BLENDING] > 0.5
+            _, step = blend_progress(pose, d[Discrete.X_REF:Discrete.X_REF + 3], d[Discrete.TRAVEL],
+                                     p[Parameter.BLEND_DISTANCE])
+            d[Discrete.TRAVEL] = d[Discrete.TRAVEL] + step if blending else 0.0
+            d[Discrete.X_REF:Discrete.X_REF + 3] = pose[:3]
+            d[Discrete.SIGMA] = out[Evaluation.SIGMA] if blending else 0.0
+            if p[Parameter.CONTINUOUS_SWITCHING] > 0.0:
+                switch = blending and out[Evaluation.SIGMA] >= 1.0  # the target is p_{i+1} already
+            else:  # literal: when the TCP leaves the ball
+                switch = blending and _position_distance(pose, waypoints, i) >= p[Parameter.NEIGHBOURHOOD]
+            if switch:
+                i += 1
+                d[Discrete.WAYPOINT] = i
+                d[Discrete.BLENDING] = 0.0
+                d[Discrete.SIGMA] = 0.0
+            # entering the ball of p_i (i < w): blend towards p_{i+1} from σ = 0
+            if d[Discrete.BLENDING] < 0.5 and i < last and \
+                    _position_distance(pose, waypoints, i) < p[Parameter.NEIGHBOURHOOD]:
+                d[Discrete.BLENDING] = 1.0
+                d[Discrete.TRAVEL] = 0.0
+                d[Discrete.SIGMA] = 0.0
+        elif i < last and _position_distance(pose, waypoints, i) < p[Parameter.ACCURACY]:
+            # stop at each waypoint: reached within ε at low TCP speed, then the next task starts
+            # from rest (with c from 0 again when the acceleration is limited)
+            jac = np.empty((6, 6))
+            kinematics_into(q, qd, np.empty(6), jac, np.empty(6))
+            speed = 0.0
+            for k in range(3):
+                rate = 0.0
+                for j in range(6):
+                    rate += jac[k, j] * qd[j]
+                speed += rate * rate
+            if math.sqrt(speed) < p[Parameter.STOP_SPEED]:
+                i += 1
+                d[Discrete.WAYPOINT] = i
+                if p[Parameter.LIMIT_ACCELERATION] > 0.0:
+                    d[Discrete.T0] = t
+                    d[Discrete.C0] = 0.0
+                    d[Discrete.C] = 0.0
+        distance = _position_distance(pose, waypoints, i)
+        finished = i >= last and distance < p[Parameter.ACCURACY]
+        # progress monitor: remaining path = distance to p_i (+ weighted orientation) + the rest
+        turn = 0.0
+        for k in range(3, 6):
+            turn += wrapped(pose[k] - waypoints[i, k]) ** 2
+        left = distance + ORIENTATION_LENGTH * math.sqrt(turn) + remaining[i]
+        out[Evaluation.REMAINING] = left
+        if left < d[Discrete.BEST] - 1e-4:
+            d[Discrete.BEST] = left
+            d[Discrete.T_BEST] = t
+        if bad:
+            return Status.NON_FINITE
+        if out[Evaluation.COS_PITCH] < MIN_COS_PITCH:
+            return Status.SINGULAR
+        if finished:
+            return Status.FINISHED
+        if t - d[Discrete.T_BEST] > p[Parameter.STALL_TIME]:
+            return Status.STALL
+        return Status.RUNNING
+
+    return update_kernel
+
+
+update_kernel = _update_kernel(_DEPENDENCIES)
+
+
+def _finished_kernel(dependencies):
+    @compiled
+    def finished_kernel(q, d, p, waypoints) -> bool:
+        """True once p_w is the active target and the TCP is within ε of it."""
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        i = int(d[Discrete.WAYPOINT])
+        if i < int(p[Parameter.NUM_WAYPOINTS]) - 1:
+            return False
+        pose = np.empty(6)
+        kinematics_into(q, np.zeros(6), pose, np.empty((6, 6)), np.empty(6))
+        return _position_distance(pose, waypoints, i) < p[Parameter.ACCURACY]
+
+    return finished_kernel
+
+
+finished_kernel = _finished_kernel(_DEPENDENCIES)
+
+
+def _integrate_kernel(dependencies):
+    @compiled
+    def integrate_kernel(q0, d0, dt, steps, settle_steps, p, waypoints, remaining, log, peak, out, final):
+        """Integrate one task from rest at ``q0`` with RK4 at a fixed step ``dt``, updating the
+        discrete state (from ``d0``) every step.
+
+        At every step k: discrete update at t_k, then the sample (row k of ``log``, layout
+        :class:`Log`), then an RK4 step with the discrete state held (its first stage is the
+        sample). Stops ``settle_steps`` steps after the first sample where the task is finished,
+        at a failure, or after ``steps`` steps. ``peak`` (2, 6) gets max |q̇| and max |q̈| per
+        joint over every evaluation (RK4 stages included); ``out`` the last evaluation; ``final``
+        [q; q̇; d] (12 + Discrete.SIZE) at the last step, after its update.
+
+        Returns:
+            (samples logged, status, finish index or -1): status is FINISHED once finished
+            (later failures ignored), else the failure (STALL, SINGULAR, NON_FINITE) or TIMEOUT.
+        """
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        q = q0.copy()
+        qd = np.zeros(6)
+        d = d0.copy()
+        finish = -1
+        stage_q = np.empty((4, 6))
+        stage_qd = np.empty((4, 6))
+        stage_qdd = np.empty((4, 6))
+        for k in range(steps + settle_steps + 1):
+            t = k * dt
+            status = update_kernel(t, q, qd, d, p, waypoints, remaining, out)
+            final[:6] = q
+            final[6:12] = qd
+            final[12:] = d
+            if status < 0 and finish < 0:
+                return k, status, finish
+            stage_q[0] = q
+            stage_qd[0] = qd
+            for s in range(4):  # RK4 stages at t, t + dt/2, t + dt/2, t + dt
+                if s > 0:
+                    h = dt if s == 3 else 0.5 * dt
+                    stage_q[s] = q + h * stage_qd[s - 1]
+                    stage_qd[s] = qd + h * stage_qdd[s - 1]
+                evaluate_kernel(t + (0.0 if s == 0 else (dt if s == 3 else 0.5 * dt)), stage_q[s], stage_qd[s],
+                                d, p, waypoints, out)
+                stage_qdd[s] = out[Evaluation.QDD:Evaluation.QDD + 6]
+                for j in range(6):
+                    peak[0, j] = max(peak[0, j], abs(stage_qd[s, j]))
+                    peak[1, j] = max(peak[1, j], abs(stage_qdd[s, j]))
+                if s == 0:
+                    if out[Evaluation.COS_PITCH] < MIN_COS_PITCH:
+                        return k, Status.SINGULAR, finish
+                    if not _finite(stage_qdd[0]):
+                        return k, Status.NON_FINITE, finish
+                    row = log[k]
+                    row[Log.T] = t
+                    row[Log.Q:Log.Q + 6] = q
+                    row[Log.QD:Log.QD + 6] = qd
+                    row[Log.QDD:Log.QDD + 6] = stage_qdd[0]
+                    row[Log.C] = out[Evaluation.C]
+                    row[Log.TCP:Log.TCP + 6] = out[Evaluation.POSE:Evaluation.POSE + 6]
+                    row[Log.SATURATED] = out[Evaluation.SATURATED]
+                    row[Log.DISCRETE:Log.DISCRETE + Discrete.SIZE] = d
+                    if status == Status.FINISHED and finish < 0:
+                        finish = k
+                    if finish >= 0 and k >= finish + settle_steps:
+                        return k + 1, Status.FINISHED, finish
+                    if finish < 0 and k >= steps:
+                        return k + 1, Status.TIMEOUT, finish
+            for j in range(6):
+                q[j] += dt / 6.0 * (stage_qd[0, j] + 2.0 * stage_qd[1, j] + 2.0 * stage_qd[2, j] + stage_qd[3, j])
+                qd[j] += dt / 6.0 * (stage_qdd[0, j] + 2.0 * stage_qdd[1, j] + 2.0 * stage_qdd[2, j]
+                                     + stage_qdd[3, j])
+        return steps + settle_steps + 1, Status.TIMEOUT, finish
+
+    return integrate_kernel
+
+
+integrate_kernel = _integrate_kernel(_DEPENDENCIES)
