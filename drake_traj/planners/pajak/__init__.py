@@ -13,6 +13,7 @@ from drake_traj.planners.pajak.kernel import (
     Parameter,
     acceleration_terms,
     approach_damping,
+    approach_rate,
     blend_progress,
     blended_target,
     choose_scaling,
@@ -26,7 +27,7 @@ from drake_traj.planners.pajak.system import PajakPlanner, make
 
 __all__ = [
     "DISCRETE_NAMES", "Discrete", "Evaluation", "PAPER_METHOD", "Parameter", "PajakConfig", "PajakLaw",
-    "PajakPlanner", "PlanningError", "acceleration_terms", "approach_damping", "blend_progress", "blended_target",
-    "choose_scaling", "damping_factor", "integrate", "make", "paper_initial_configuration", "paper_parameters",
-    "scaling_interval", "velocity_penalty",
+    "PajakPlanner", "PlanningError", "acceleration_terms", "approach_damping", "approach_rate", "blend_progress",
+    "blended_target", "choose_scaling", "damping_factor", "integrate", "make", "paper_initial_configuration",
+    "paper_parameters", "scaling_interval", "velocity_penalty",
 ]

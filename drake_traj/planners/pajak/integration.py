@@ -42,8 +42,9 @@ def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settl
         every evaluation, RK4 stages included.
 
     Raises:
-        PlanningError: singularity, no progress, non-finite values or not finished by t_max;
-            ``.partial`` holds the arrays computed so far.
+        PlanningError: a waypoint out of reach (before integrating), singularity, no progress,
+            non-finite values or not finished by t_max; ``.partial`` holds the arrays computed so
+            far.
     """
     if not isinstance(law, PajakLaw):
         raise ValueError(f"law must be a PajakLaw, got {type(law).__name__}")
@@ -53,6 +54,9 @@ def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settl
     if not np.isfinite(settle_time) or settle_time < 0:
         raise ValueError(f"settle_time must be a non-negative number of seconds, got {settle_time}")
     q0 = np.array(robot._as_joint_vector(q0, "q0"))
+    unreachable = law.reach_failure(q0)
+    if unreachable is not None:
+        raise unreachable
     steps = int(math.ceil(t_max / dt - 1e-9))
     settle_steps = int(math.ceil(settle_time / dt - 1e-9))
     log = np.empty((steps + settle_steps + 1, Log.SIZE))

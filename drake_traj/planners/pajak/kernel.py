@@ -27,12 +27,13 @@ from drake_traj.compiled import compiled
 from drake_traj.planners import scaling
 from drake_traj.planners.scaling import relaxed_scaling
 from drake_traj.robots import ur10e
-from drake_traj.robots.ur10e import kinematics_into, wrapped
+from drake_traj.robots.ur10e import kinematics_into, orientation_error, wrapped
 
 __all__ = [
-    "Discrete", "Evaluation", "Log", "Parameter", "Status", "acceleration_terms", "approach_damping",
-    "blend_progress", "blended_target", "choose_scaling", "damping_factor", "evaluate_kernel", "integrate_kernel",
-    "scaling_interval", "update_kernel", "velocity_penalty",
+    "Discrete", "Evaluation", "Log", "Parameter", "Status", "acceleration_box", "acceleration_terms",
+    "approach_damping", "approach_rate", "blend_progress", "blended_target", "brake_weight", "choose_scaling",
+    "damping_factor", "evaluate_kernel", "finished_kernel", "integrate_kernel", "keep_limits", "scaling_interval",
+    "update_kernel", "velocity_penalty",
 ]
 
 
@@ -52,13 +53,15 @@ Parameter = _layout("Parameter", [
     ("VIABILITY_GAIN", 6),  # K of the velocity-viability bound q̈_i <= K (q̇_max - q̇_i) [1/s]
     ("VIABILITY_ONSET", 6),  # |q̇_i| above which that bound can bind [rad/s]
     ("PENALTY_ONSET", 6),  # |q̇_i| above which the penalty of eq. 14 is active [rad/s]
-    ("APPROACH_DELTA", 6),  # δ of the approach rate per task component [m, rad]
     ("VARTHETA", 1), ("RHO", 1),  # ϑ, ρ of eq. 14
     ("ACCURACY", 1),  # ε [m]
+    ("ORIENTATION_ACCURACY", 1),  # the finish's orientation bound [rad]
     ("NEIGHBOURHOOD", 1),  # ϵ [m] (eq. 19)
     ("BLEND_DISTANCE", 1),  # path length through the ball at which σ = 1 [m]
     ("SCALING_RATE", 1),  # rate of eq. 18 [1/s]
+    ("SCALING_SLEW", 1),  # largest |dc/dt| [1/s] (improvement 1)
     ("SINGULARITY_THRESHOLD", 1), ("MAX_DAMPING", 1),  # damped least squares (improvement 3)
+    ("APPROACH_DELTA", 1),  # δ of the approach rate [m] (improvement 4)
     ("STOP_SPEED", 1),  # stop mode: TCP speed below which a waypoint is reached [m/s]
     ("STALL_TIME", 1),  # no progress for this long is a stall [s]
     ("NUM_WAYPOINTS", 1),
@@ -70,6 +73,8 @@ Parameter = _layout("Parameter", [
 Discrete = _layout("Discrete", [
     ("C", 1),  # c at the last update
     ("T0", 1), ("C0", 1),  # eq. 18 anchor: c was C0 at time T0 [s]
+    ("GOAL", 1),  # the value c relaxes to (eq. 18: 1; the speed override)
+    ("T_UPDATE", 1),  # time of the last update [s]
     ("WAYPOINT", 1),  # index i of the active waypoint p_i (an integer)
     ("BLENDING", 1),  # 1 while the TCP passes the neighbourhood of p_i (eq. 19, second case)
     ("SIGMA", 1),  # σ of eq. 19 at the last update (σ never decreases)
@@ -77,17 +82,23 @@ Discrete = _layout("Discrete", [
     ("X_REF", 3),  # TCP position at the last update [m]
     ("BEST", 1),  # smallest remaining path so far (progress monitor) [m]
     ("T_BEST", 1),  # when BEST last improved [s]
-    ("SATURATED", 1),  # updates at which no c in [0, 1] kept the limits (improvement 2)
+    ("BRAKE", 1), ("BRAKE_SLOPE", 1),  # fallback braking weight at the last update and its slope [1/s]
+    ("SATURATED", 1),  # updates at which the limits overruled the law (improvement 2)
 ])
 
 Evaluation = _layout("Evaluation", [
     ("QDD", 6),  # q̈ [rad/s²]
     ("C", 1), ("C_RELAXED", 1),  # c and the eq. 18 value c_r
-    ("SATURATED", 1),  # 1 where no c in [0, 1] keeps the limits (the fallback acts)
+    ("SATURATED", 1),  # 1 where the limits overrule the law (q̈ clipped to the box, braking)
+    ("VIOLATION", 1),  # how far a = -J⁻¹J̇q̇ alone is outside the box, relative to q̈_max
+    ("BRAKE", 1),  # weight of the fallback braking in q̈
     ("SIGMA", 1), ("MEASURE", 1), ("COS_PITCH", 1),  # σ, singularity measure, cos φ_Y
     ("POSE", 6), ("TARGET", 6),  # k(q) and the target of eq. 6 / eq. 19 [m, rad]
-    ("REMAINING", 1),  # remaining path to p_w (filled by update_kernel) [m]
+    ("POSITION_ERROR", 1), ("ORIENTATION_ERROR", 1),  # to the active waypoint (update_kernel) [m, rad]
+    ("REMAINING", 1),  # remaining path to p_w (update_kernel) [m]
 ])
+
+_EVALUATION_SIZE = int(Evaluation.SIZE)  # a plain int for np.empty in compiled code
 
 Log = _layout("Log", [
     ("T", 1), ("Q", 6), ("QD", 6), ("QDD", 6), ("C", 1), ("TCP", 6), ("SATURATED", 1),
@@ -106,14 +117,17 @@ class Status(IntEnum):
     TIMEOUT = -4
 
 
-ORIENTATION_LENGTH = 0.1  # [m/rad], weight of orientation in the progress measure
+ORIENTATION_LENGTH = 0.1  # [m/rad], weight of orientation in the progress measure and the approach rate
 MIN_COS_PITCH = 1e-6  # Euler gimbal lock (as ur10e.analytic_jacobian_and_bias)
 BRAKE_TIME = 0.05  # [s], time constant of the fallback braking at low speed (improvement 2)
-BRAKE_GAP = 0.1  # emptiness of the c interval at which the fallback is pure braking
+BRAKE_ONSET = 0.5  # violation (relative to q̈_max) at which the fallback is pure braking
+BRAKE_LAG = 0.02  # [s], time constant with which the braking weight follows its target
+BRAKE_SLEW = 10.0  # [1/s], largest rate of change of the braking weight
+SCALE_FLOOR = 0.1  # smallest c_r the approach damping is sized for (improvement 4)
 
 
 # --------------------------------------------------------------------------------------------
-# The law's pieces (scalar functions, tested one by one)
+# The law's pieces (compiled functions of floats and small arrays, tested one by one)
 # --------------------------------------------------------------------------------------------
 
 
@@ -141,16 +155,31 @@ def velocity_penalty(qd: float, qd_max: float, rho: float, vartheta: float, smoo
 
 
 @compiled
-def approach_damping(error: float, error_rate: float, stiffness: float, damping: float, delta: float) -> float:
-    """Damping [1/s] of one error component that keeps it from changing sign (improvement 4).
+def approach_rate(error, error_rate, delta: float) -> float:
+    """r = -ė·e / (|e|² + δ²) [1/s]: the rate at which the TCP closes on p_w, from the error e to
+    it and ė = J q̇ (6 each), orientation rows weighted by 0.1 m/rad (improvement 4). The distance
+    decays as exp(-r t) while r holds; δ only keeps r finite at e = 0. One rate for the whole pose,
+    not one per component: a component that passes 0 while the TCP sweeps by the goal would give
+    a rate that spikes to ±∞ and back within milliseconds."""
+    closing = 0.0
+    size = delta * delta
+    for k in range(6):
+        weight = 1.0 if k < 3 else ORIENTATION_LENGTH * ORIENTATION_LENGTH
+        closing += weight * error[k] * error_rate[k]
+        size += weight * error[k] * error[k]
+    return -closing / size
 
-    For ë = -D ė - K e, the approach rate r = -ė/e obeys dr/dt = r² - D r + K. With D = r + K/r
-    it is constant: ė = -r e is invariant and e decays as exp(-r t) without crossing 0. Returned:
-    the given ``damping`` for r <= sqrt(K) (the literal law), ramped (smoothstep in r) up to
-    λ + K/λ at r = λ = 2 sqrt(K), and r + K/r above λ; never below ``damping``. Continuous in
-    the state. r = -ė e / (e² + δ²): δ only keeps r finite at e = 0.
+
+@compiled
+def approach_damping(rate: float, stiffness: float, damping: float) -> float:
+    """Damping D [1/s] that keeps the TCP from overshooting p_w when it closes at ``rate`` r
+    against ``stiffness`` K, given the law's ``damping`` (improvement 4).
+
+    For ë = -D ė - K e, r = -ė/e obeys dr/dt = r² - D r + K. With D = r + K/r it is constant:
+    ė = -r e is invariant and e decays as exp(-r t) without crossing 0. Returned: the given
+    ``damping`` for r <= sqrt(K) (the literal law), ramped (smoothstep in r) up to λ + K/λ at
+    r = λ = 2 sqrt(K), and r + K/r above λ; never below ``damping``. Continuous in r.
     """
-    rate = -(error * error_rate) / (error * error + delta * delta)
     root = math.sqrt(stiffness)
     held = max(rate, 2.0 * root)
     hold = held + stiffness / held
@@ -161,9 +190,10 @@ def approach_damping(error: float, error_rate: float, stiffness: float, damping:
 @compiled
 def damping_factor(measure: float, threshold: float, max_damping: float) -> float:
     """λ² of the damped least-squares inverse (improvement 3): 0 for measure >= threshold,
-    rising to max_damping² at a singular J: λ² = λ_max² (1 - (measure/threshold)²)."""
-    ratio = min(measure / threshold, 1.0)
-    return max_damping * max_damping * (1.0 - ratio * ratio)
+    rising to max_damping² at a singular J: λ² = λ_max² (1 - measure/threshold)², which starts
+    with zero slope, so q̈ does not bend sharply where the damping sets in."""
+    gap = max(1.0 - measure / threshold, 0.0)
+    return max_damping * max_damping * gap * gap
 
 
 @compiled
@@ -221,29 +251,25 @@ def _solve(jac, use_damped, matrix, pivots, rhs, out):
 
 
 @compiled
-def acceleration_terms(jac, bias, error, qd, kp, kv, penalty, lam2, use_damped, a, b):
-    """a and b = b_V + b_P of eq. 17 into ``a``, ``b`` (6,):
+def acceleration_terms(jac, bias, error, error_rate, kp, damping, penalty, lam2, use_damped, a, b):
+    """a and b of eq. 17 into ``a``, ``b`` (6,):
 
-    a = -J⁻¹ J̇q̇, b_V = -J⁻¹ Λ_V J q̇ + Δq̈, b_P = -J⁻¹ Λ_P e (e of eq. 6 or eq. 19).
-    q̈ = a + c b is eq. 17; with c = 1 it is eq. 16 (eq. 13 without Δq̈). With ``use_damped``
-    J⁻¹ is the damped least-squares inverse with λ² = ``lam2`` (:func:`damping_factor`).
+    a = -J⁻¹ J̇q̇, b = -J⁻¹ (D ė + Λ_P e) + Δq̈, with ė = J q̇ (``error_rate``), e of eq. 6 or
+    eq. 19 and the damping D = Λ_V (eq. 13) or more (improvement 4). q̈ = a + c b is eq. 17;
+    with c = 1 it is eq. 16 (eq. 13 without Δq̈). With ``use_damped`` J⁻¹ is the damped
+    least-squares inverse with λ² = ``lam2`` (:func:`damping_factor`).
     """
     matrix = np.empty((6, 6))
     pivots = np.empty(6, dtype=np.int64)
     _factor(jac, lam2, use_damped, matrix, pivots)
     rhs = np.empty(6)
-    out = np.empty(6)
-    _solve(jac, use_damped, matrix, pivots, bias, out)
+    _solve(jac, use_damped, matrix, pivots, bias, a)
     for i in range(6):
-        a[i] = -out[i]
+        a[i] = -a[i]
+        rhs[i] = damping[i] * error_rate[i] + kp[i] * error[i]
+    _solve(jac, use_damped, matrix, pivots, rhs, b)
     for i in range(6):
-        rate = 0.0
-        for j in range(6):
-            rate += jac[i, j] * qd[j]
-        rhs[i] = kv[i] * rate + kp[i] * error[i]
-    _solve(jac, use_damped, matrix, pivots, rhs, out)
-    for i in range(6):
-        b[i] = penalty[i] - out[i]
+        b[i] = penalty[i] - b[i]
 
 
 @compiled
@@ -304,6 +330,79 @@ def choose_scaling(c_relaxed: float, c_lo: float, c_hi: float, bounded: bool = T
     if bounded:
         c = min(max(c, 0.0), 1.0)
     return c, c_lo <= c_hi
+
+
+@compiled
+def acceleration_box(qd, p, lower, upper):
+    """The box [lower, upper] (6 each) that q̈ must stay in: ±q̈_max (eq. 5), narrowed near the
+    velocity limits (improvement 2) so that q̇ stays viable: q̈_i <= K (q̇_max - q̇_i) and the
+    mirror bound, so q̇ can only approach its limit exponentially even when c is held small by
+    another joint and the penalty (scaled by c) cannot act. K puts the bound's onset at d = ϑ/4,
+    inside the penalty zone."""
+    viable = p[Parameter.BOUNDED_SCALING] > 0.0 and p[Parameter.LIMIT_VELOCITY] > 0.0
+    for k in range(6):
+        limit = p[Parameter.QDD_MAX + k]
+        lower[k], upper[k] = -limit, limit
+        if viable and abs(qd[k]) > p[Parameter.VIABILITY_ONSET + k]:
+            gain = p[Parameter.VIABILITY_GAIN + k]
+            speed = p[Parameter.QD_MAX + k]
+            upper[k] = min(max(gain * (speed - qd[k]), -limit), limit)
+            lower[k] = min(max(gain * (-speed - qd[k]), -limit), limit)
+
+
+@compiled
+def keep_limits(a, b, c_relaxed: float, lower, upper, qdd_max, c_low: float, c_high: float, qdd):
+    """Improvement 2: q̈ = a + c b (eq. 17) inside the box [lower, upper] at every evaluation,
+    with c continuous in the state; returns (c, violation), q̈ into ``qdd``.
+
+    - c is chosen by cases 1-4 and a-c (:func:`scaling_interval`, :func:`choose_scaling`) in
+      [0, 1], then kept in [c_low, c_high] (the rate limit of c, improvement 1).
+    - When a = -J⁻¹J̇q̇ alone is outside the box (``violation`` = the largest excess relative to
+      q̈_max > 0: the joints move too fast for the curvature of the path), no c in [0, 1] keeps
+      the limits. c is then chosen in the box widened by twice the violation, which a is
+      strictly inside, so c stays continuous as some b_i changes sign (in the box itself the
+      interval's bounds would jump between ±∞).
+    - q̈ is clipped to the box: the limits win where the law (or the rate-limited c) would
+      break them; the caller counts those evaluations.
+    """
+    violation = 0.0
+    for k in range(6):
+        violation = max(violation, (a[k] - upper[k]) / qdd_max[k], (lower[k] - a[k]) / qdd_max[k])
+    low = np.empty(6)
+    high = np.empty(6)
+    for k in range(6):
+        widen = 2.0 * violation * qdd_max[k]
+        low[k] = lower[k] - widen
+        high[k] = upper[k] + widen
+    c_lo, c_hi = scaling_interval(a, b, low, high)  # cases 1-4
+    c, _ = choose_scaling(c_relaxed, c_lo, c_hi, True)  # cases a-c
+    c = min(max(c, c_low), c_high)
+    for k in range(6):
+        qdd[k] = min(max(a[k] + c * b[k], lower[k]), upper[k])  # eq. 17, clipped to the box
+    return c, violation
+
+
+@compiled
+def brake_weight(violation: float, weight: float, slope: float, elapsed: float):
+    """(weight now, its target): the share of braking in q̈ (improvement 2). The target is
+    smoothstep(violation / BRAKE_ONSET); the weight follows it from its value ``weight`` at the
+    last update with that update's ``slope`` [1/s] for ``elapsed`` seconds (so q̈ changes at a
+    bounded rate while the braking sets in or ends)."""
+    x = min(violation / BRAKE_ONSET, 1.0)
+    return min(max(weight + slope * elapsed, 0.0), 1.0), x * x * (3.0 - 2.0 * x)
+
+
+@compiled
+def brake(qd, lower, upper, qdd_max, weight: float, qdd):
+    """q̈ blended by ``weight`` from its value in ``qdd`` (in the box) into braking every joint in
+    proportion to its speed at the largest rate the box allows (at most 1/BRAKE_TIME); both ends
+    are in the box, so the blend is (improvement 2)."""
+    rate = 1.0 / BRAKE_TIME
+    for k in range(6):
+        rate = min(rate, qdd_max[k] / abs(qd[k]))
+    for k in range(6):
+        braking = min(max(-qd[k] * rate, lower[k]), upper[k])
+        qdd[k] += weight * (braking - qdd[k])
 
 
 @compiled
@@ -382,8 +481,7 @@ def _evaluate_kernel(dependencies):
     @compiled
     def evaluate_kernel(t, q, qd, d, p, waypoints, out):
         """One evaluation of the law at time t for (q, q̇) and the discrete state ``d`` into
-        ``out`` (layout :class:`Evaluation`): q̈ of eq. 17 with c = min(eq. 18 relaxation, the
-        admissible ĉ).
+        ``out`` (layout :class:`Evaluation`): q̈ of eq. 17 with c from eq. 18 and the limits.
 
         No exception: gimbal lock shows in out[COS_PITCH], a failure as non-finite out[QDD].
         """
@@ -397,6 +495,8 @@ def _evaluate_kernel(dependencies):
         out[Evaluation.COS_PITCH] = cos_pitch
         out[Evaluation.MEASURE] = measure
         out[Evaluation.SATURATED] = 0.0
+        out[Evaluation.VIOLATION] = 0.0
+        out[Evaluation.BRAKE] = 0.0
         i = int(d[Discrete.WAYPOINT])
         last = int(p[Parameter.NUM_WAYPOINTS]) - 1
         sigma = 0.0
@@ -409,10 +509,15 @@ def _evaluate_kernel(dependencies):
             target[:] = waypoints[i]  # eq. 6
         out[Evaluation.SIGMA] = sigma
         error = np.empty(6)
+        error_rate = np.empty(6)
         for k in range(6):
             error[k] = pose[k] - target[k]  # eq. 6
             if k >= 3:
                 error[k] = wrapped(error[k])  # orientation wrapped (docs/papers.md)
+            rate = 0.0
+            for j in range(6):
+                rate += jac[k, j] * qd[j]
+            error_rate[k] = rate  # ė = J q̇
         penalty = np.zeros(6)
         if p[Parameter.LIMIT_VELOCITY] > 0.0:
             smooth = p[Parameter.SMOOTH_PENALTY] > 0.0
@@ -425,93 +530,94 @@ def _evaluate_kernel(dependencies):
         if use_damped:
             lam2 = damping_factor(measure, p[Parameter.SINGULARITY_THRESHOLD], p[Parameter.MAX_DAMPING])
         kp = p[Parameter.KP:Parameter.KP + 6]
-        kv = p[Parameter.KV:Parameter.KV + 6]
+        damping = p[Parameter.KV:Parameter.KV + 6].copy()
+        limited = p[Parameter.LIMIT_ACCELERATION] > 0.0
+        c_r = 1.0
+        if limited:
+            c_r = relaxed_scaling(t, d[Discrete.T0], d[Discrete.C0], d[Discrete.GOAL],
+                                  p[Parameter.SCALING_RATE])[0]  # eq. 18
+        if limited and p[Parameter.PRESERVE_DAMPING] > 0.0:
+            # improvement 4: with the gains scaled by c the damping breaks condition (11) below
+            # c = 4 Λ_P / Λ_V² and the TCP overshoots p_w. The damping that holds the approach
+            # rate (approach_damping), sized for c = c_r (at least SCALE_FLOOR) and scaled by c
+            # like the rest of b, so q̈ stays linear in c. Applied while converging to a fixed
+            # target (p_w; every waypoint in stop mode), ramped in with σ during the last blend.
+            weight = 0.0
+            if p[Parameter.BLEND_WAYPOINTS] == 0.0 or i >= last:
+                weight = 1.0
+            elif i == last - 1:
+                weight = sigma
+            if weight > 0.0:
+                goal = i if p[Parameter.BLEND_WAYPOINTS] == 0.0 else last
+                final = np.empty(6)
+                for k in range(6):
+                    final[k] = pose[k] - waypoints[goal, k]
+                    if k >= 3:
+                        final[k] = wrapped(final[k])
+                closing = approach_rate(final, error_rate, p[Parameter.APPROACH_DELTA])
+                scale = min(max(c_r, SCALE_FLOOR), 1.0)
+                for k in range(6):
+                    held = approach_damping(closing, scale * kp[k], scale * damping[k])
+                    damping[k] += weight * (held / scale - damping[k])  # per unit of c
         a = np.empty(6)
         b = np.empty(6)
-        acceleration_terms(jac, bias, error, qd, kp, kv, penalty, lam2, use_damped, a, b)  # eq. 17
-        if p[Parameter.LIMIT_ACCELERATION] == 0.0:
+        acceleration_terms(jac, bias, error, error_rate, kp, damping, penalty, lam2, use_damped, a, b)  # eq. 17
+        if not limited:
             out[Evaluation.C] = 1.0
             out[Evaluation.C_RELAXED] = 1.0
             for k in range(6):
                 qdd[k] = a[k] + b[k]  # eq. 16 (eq. 13 without the penalty)
             return
-        c_r = relaxed_scaling(t, d[Discrete.T0], d[Discrete.C0], 1.0, p[Parameter.SCALING_RATE])[0]  # eq. 18
         out[Evaluation.C_RELAXED] = c_r
-        if p[Parameter.PRESERVE_DAMPING] > 0.0:
-            # improvement 4: per error component, the damping that keeps it from changing sign
-            # (approach_damping), with the gains scaled by c_r so that q̈ stays linear in c.
-            # Applied while converging to a fixed target (p_w; every waypoint in stop mode),
-            # ramped in with σ during the last blend so that q̈ stays continuous.
-            weight = -1.0
-            if p[Parameter.BLEND_WAYPOINTS] == 0.0 or i >= last:
-                weight = 1.0
-            elif i == last - 1:
-                weight = sigma
-            if weight >= 0.0:
-                scale = min(max(c_r, 1e-3), 1.0)
-                added = np.empty(6)
-                any_added = False
-                for k in range(6):
-                    rate = 0.0
-                    for j in range(6):
-                        rate += jac[k, j] * qd[j]  # ė = J q̇
-                    damping = approach_damping(error[k], rate, scale * kp[k], scale * kv[k],
-                                               p[Parameter.APPROACH_DELTA + k])
-                    extra = weight * (damping / scale - kv[k])  # per unit of c
-                    added[k] = extra * rate
-                    any_added = any_added or extra > 0.0
-                if any_added:
-                    matrix = np.empty((6, 6))
-                    pivots = np.empty(6, dtype=np.int64)
-                    _factor(jac, lam2, use_damped, matrix, pivots)
-                    solved = np.empty(6)
-                    _solve(jac, use_damped, matrix, pivots, added, solved)
-                    for k in range(6):
-                        b[k] -= solved[k]
         lower = np.empty(6)
         upper = np.empty(6)
-        near_limit = False
-        for k in range(6):
-            upper[k] = p[Parameter.QDD_MAX + k]
-            lower[k] = -upper[k]
-            near_limit = near_limit or abs(qd[k]) > p[Parameter.VIABILITY_ONSET + k]
-        bounded = p[Parameter.BOUNDED_SCALING] > 0.0
-        if bounded and p[Parameter.LIMIT_VELOCITY] > 0.0 and near_limit:
-            # improvement 2: the box also keeps q̇ viable: q̈_i <= K (q̇_max - q̇_i) (and the mirror
-            # bound), so q̇ can only approach its limit exponentially even when c is held small by
-            # another joint and the penalty (scaled by c) cannot act. K puts the bound's onset at
-            # d = ϑ/4, inside the penalty zone.
+        acceleration_box(qd, p, lower, upper)
+        if p[Parameter.BOUNDED_SCALING] == 0.0:  # the paper's choice of c (may leave [0, 1])
+            c_lo, c_hi = scaling_interval(a, b, lower, upper)  # cases 1-4
+            c, _ = choose_scaling(c_r, c_lo, c_hi, False)  # cases a-c
+            out[Evaluation.C] = c
             for k in range(6):
-                limit = p[Parameter.QDD_MAX + k]
-                gain = p[Parameter.VIABILITY_GAIN + k]
-                speed = p[Parameter.QD_MAX + k]
-                upper[k] = min(max(gain * (speed - qd[k]), -limit), limit)
-                lower[k] = min(max(gain * (-speed - qd[k]), -limit), limit)
-        c_lo, c_hi = scaling_interval(a, b, lower, upper)  # cases 1-4
-        c, feasible = choose_scaling(c_r, c_lo, c_hi, bounded)  # cases a-c
+                qdd[k] = a[k] + c * b[k]  # eq. 17
+            return
+        qdd_max = p[Parameter.QDD_MAX:Parameter.QDD_MAX + 6]
+        elapsed = max(t - d[Discrete.T_UPDATE], 0.0)
+        slew = p[Parameter.SCALING_SLEW] * elapsed
+        c, violation = keep_limits(a, b, c_r, lower, upper, qdd_max, d[Discrete.C] - slew, d[Discrete.C] + slew,
+                                   qdd)
         out[Evaluation.C] = c
+        out[Evaluation.VIOLATION] = violation
+        weight, _ = brake_weight(violation, d[Discrete.BRAKE], d[Discrete.BRAKE_SLOPE], elapsed)
+        out[Evaluation.BRAKE] = weight
+        if weight > 0.0:
+            brake(qd, lower, upper, qdd_max, weight, qdd)
         for k in range(6):
-            qdd[k] = a[k] + c * b[k]  # eq. 17
-        if bounded and not feasible:
-            # improvement 2: no c in [0, 1] keeps the limits (then a = -J⁻¹J̇q̇ alone breaks
-            # them: the joints move too fast for the curvature of the path). Blend, by how
-            # empty the interval is, from q̈ clipped to the box to braking all joints
-            # proportionally at the largest admissible rate; both stay in the box (braking only
-            # lowers |q̇|), and the blend is continuous.
-            out[Evaluation.SATURATED] = 1.0
-            rate = 1.0 / BRAKE_TIME
-            for k in range(6):
-                rate = min(rate, p[Parameter.QDD_MAX + k] / abs(qd[k]))
-            gap = max(c_lo, 0.0) - min(c_hi, 1.0)
-            weight = min(max(gap / BRAKE_GAP, 0.0), 1.0)
-            for k in range(6):
-                clipped = min(max(qdd[k], lower[k]), upper[k])
-                qdd[k] = clipped + weight * (-qd[k] * rate - clipped)
+            if abs(qdd[k] - (a[k] + c * b[k])) > 1e-9 * qdd_max[k]:
+                out[Evaluation.SATURATED] = 1.0  # the limits overrule the law
 
     return evaluate_kernel
 
 
 evaluate_kernel = _evaluate_kernel(_DEPENDENCIES)
+
+
+def _pose_reached(dependencies):
+    @compiled
+    def pose_reached(pose, waypoint, p, out) -> bool:
+        """The whole pose within the accuracies of ``waypoint``: |x - p| < ε and the angle of
+        R_pᵀ R below the orientation accuracy (the paper's |e| < ε over all six components of e);
+        the errors into out[POSITION_ERROR], out[ORIENTATION_ERROR]."""
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        position = math.sqrt((pose[0] - waypoint[0]) ** 2 + (pose[1] - waypoint[1]) ** 2
+                             + (pose[2] - waypoint[2]) ** 2)
+        orientation = orientation_error(pose[3:], waypoint[3:])
+        out[Evaluation.POSITION_ERROR] = position
+        out[Evaluation.ORIENTATION_ERROR] = orientation
+        return position < p[Parameter.ACCURACY] and orientation < p[Parameter.ORIENTATION_ACCURACY]
+
+    return pose_reached
+
+
+pose_reached = _pose_reached(_DEPENDENCIES)
 
 
 def _update_kernel(dependencies):
@@ -520,10 +626,10 @@ def _update_kernel(dependencies):
         """The discrete update at time t, in place on ``d``; returns a :class:`Status`.
 
         Evaluates the law first (into ``out``, with the discrete state before the update);
-        records the eq. 18 anchor (t0, c0) = (t, c) when the limits set c; switches waypoints
-        (eq. 19 blending, or stop-and-go with c restarting from 0 when the acceleration is
-        limited); tracks progress (out[REMAINING]) and reports a finish, a stall, gimbal lock or
-        non-finite values.
+        records the eq. 18 anchor (t0, c0) = (t, c) when the limits set c, and c and the braking
+        weight for their rate limits; switches waypoints (eq. 19 blending, or stop-and-go with c
+        restarting from 0 when the acceleration is limited); tracks progress (out[REMAINING])
+        and reports a finish, a stall, gimbal lock or non-finite values.
         """
         dependencies  # noqa: B018 (numba's cache key, see above)
         evaluate_kernel(t, q, qd, d, p, waypoints, out)
@@ -534,8 +640,15 @@ def _update_kernel(dependencies):
             if abs(c - out[Evaluation.C_RELAXED]) > 1e-12:  # the limits moved c off eq. 18: new anchor
                 d[Discrete.T0] = t
                 d[Discrete.C0] = c
+            weight, target = brake_weight(out[Evaluation.VIOLATION], d[Discrete.BRAKE], d[Discrete.BRAKE_SLOPE],
+                                          max(t - d[Discrete.T_UPDATE], 0.0))
+            if abs(target - weight) < 1e-6:  # settled: exactly on the target (0 when the fallback is over)
+                weight = target
+            d[Discrete.BRAKE] = weight
+            d[Discrete.BRAKE_SLOPE] = min(max((target - weight) / BRAKE_LAG, -BRAKE_SLEW), BRAKE_SLEW)
             d[Discrete.SATURATED] += out[Evaluation.SATURATED]
         d[Discrete.C] = c
+        d[Discrete.T_UPDATE] = t
         i = int(d[Discrete.WAYPOINT])
         last = int(p[Parameter.NUM_WAYPOINTS]) - 1
         if p[Parameter.BLEND_WAYPOINTS] > 0.0:
@@ -560,8 +673,8 @@ def _update_kernel(dependencies):
                 d[Discrete.BLENDING] = 1.0
                 d[Discrete.TRAVEL] = 0.0
                 d[Discrete.SIGMA] = 0.0
-        elif i < last and _position_distance(pose, waypoints, i) < p[Parameter.ACCURACY]:
-            # stop at each waypoint: reached within ε at low TCP speed, then the next task starts
+        elif i < last and pose_reached(pose, waypoints[i], p, out):
+            # stop at each waypoint: the pose reached at low TCP speed, then the next task starts
             # from rest (with c from 0 again when the acceleration is limited)
             jac = np.empty((6, 6))
             kinematics_into(q, qd, np.empty(6), jac, np.empty(6))
@@ -578,13 +691,9 @@ def _update_kernel(dependencies):
                     d[Discrete.T0] = t
                     d[Discrete.C0] = 0.0
                     d[Discrete.C] = 0.0
-        distance = _position_distance(pose, waypoints, i)
-        finished = i >= last and distance < p[Parameter.ACCURACY]
+        finished = pose_reached(pose, waypoints[i], p, out) and i >= last
         # progress monitor: remaining path = distance to p_i (+ weighted orientation) + the rest
-        turn = 0.0
-        for k in range(3, 6):
-            turn += wrapped(pose[k] - waypoints[i, k]) ** 2
-        left = distance + ORIENTATION_LENGTH * math.sqrt(turn) + remaining[i]
+        left = out[Evaluation.POSITION_ERROR] + ORIENTATION_LENGTH * out[Evaluation.ORIENTATION_ERROR] + remaining[i]
         out[Evaluation.REMAINING] = left
         if left < d[Discrete.BEST] - 1e-4:
             d[Discrete.BEST] = left
@@ -608,14 +717,14 @@ update_kernel = _update_kernel(_DEPENDENCIES)
 def _finished_kernel(dependencies):
     @compiled
     def finished_kernel(q, d, p, waypoints) -> bool:
-        """True once p_w is the active target and the TCP is within ε of it."""
+        """True once p_w is the active target and the whole pose is within the accuracies of it."""
         dependencies  # noqa: B018 (numba's cache key, see above)
         i = int(d[Discrete.WAYPOINT])
         if i < int(p[Parameter.NUM_WAYPOINTS]) - 1:
             return False
         pose = np.empty(6)
         kinematics_into(q, np.zeros(6), pose, np.empty((6, 6)), np.empty(6))
-        return _position_distance(pose, waypoints, i) < p[Parameter.ACCURACY]
+        return pose_reached(pose, waypoints[i], p, np.empty(_EVALUATION_SIZE))
 
     return finished_kernel
 
@@ -659,36 +768,36 @@ def _integrate_kernel(dependencies):
             stage_q[0] = q
             stage_qd[0] = qd
             for s in range(4):  # RK4 stages at t, t + dt/2, t + dt/2, t + dt
+                h = (0.0, 0.5 * dt, 0.5 * dt, dt)[s]
                 if s > 0:
-                    h = dt if s == 3 else 0.5 * dt
                     stage_q[s] = q + h * stage_qd[s - 1]
                     stage_qd[s] = qd + h * stage_qdd[s - 1]
-                evaluate_kernel(t + (0.0 if s == 0 else (dt if s == 3 else 0.5 * dt)), stage_q[s], stage_qd[s],
-                                d, p, waypoints, out)
+                evaluate_kernel(t + h, stage_q[s], stage_qd[s], d, p, waypoints, out)
                 stage_qdd[s] = out[Evaluation.QDD:Evaluation.QDD + 6]
                 for j in range(6):
                     peak[0, j] = max(peak[0, j], abs(stage_qd[s, j]))
                     peak[1, j] = max(peak[1, j], abs(stage_qdd[s, j]))
-                if s == 0:
-                    if out[Evaluation.COS_PITCH] < MIN_COS_PITCH:
-                        return k, Status.SINGULAR, finish
-                    if not _finite(stage_qdd[0]):
-                        return k, Status.NON_FINITE, finish
-                    row = log[k]
-                    row[Log.T] = t
-                    row[Log.Q:Log.Q + 6] = q
-                    row[Log.QD:Log.QD + 6] = qd
-                    row[Log.QDD:Log.QDD + 6] = stage_qdd[0]
-                    row[Log.C] = out[Evaluation.C]
-                    row[Log.TCP:Log.TCP + 6] = out[Evaluation.POSE:Evaluation.POSE + 6]
-                    row[Log.SATURATED] = out[Evaluation.SATURATED]
-                    row[Log.DISCRETE:Log.DISCRETE + Discrete.SIZE] = d
-                    if status == Status.FINISHED and finish < 0:
-                        finish = k
-                    if finish >= 0 and k >= finish + settle_steps:
-                        return k + 1, Status.FINISHED, finish
-                    if finish < 0 and k >= steps:
-                        return k + 1, Status.TIMEOUT, finish
+                if s > 0:
+                    continue
+                if out[Evaluation.COS_PITCH] < MIN_COS_PITCH:
+                    return k, Status.SINGULAR, finish
+                if not _finite(stage_qdd[0]):
+                    return k, Status.NON_FINITE, finish
+                row = log[k]
+                row[Log.T] = t
+                row[Log.Q:Log.Q + 6] = q
+                row[Log.QD:Log.QD + 6] = qd
+                row[Log.QDD:Log.QDD + 6] = stage_qdd[0]
+                row[Log.C] = out[Evaluation.C]
+                row[Log.TCP:Log.TCP + 6] = out[Evaluation.POSE:Evaluation.POSE + 6]
+                row[Log.SATURATED] = out[Evaluation.SATURATED]
+                row[Log.DISCRETE:Log.DISCRETE + Discrete.SIZE] = d
+                if status == Status.FINISHED and finish < 0:
+                    finish = k
+                if finish >= 0 and k >= finish + settle_steps:
+                    return k + 1, Status.FINISHED, finish
+                if finish < 0 and k >= steps:
+                    return k + 1, Status.TIMEOUT, finish
             for j in range(6):
                 q[j] += dt / 6.0 * (stage_qd[0, j] + 2.0 * stage_qd[1, j] + 2.0 * stage_qd[2, j] + stage_qd[3, j])
                 qd[j] += dt / 6.0 * (stage_qdd[0, j] + 2.0 * stage_qdd[1, j] + 2.0 * stage_qdd[2, j]

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from drake_traj.errors import PlanningError
+from drake_traj.errors import PlanningError, SingularConfigurationError
 from drake_traj.planners.pajak.kernel import (
     MIN_COS_PITCH,
     ORIENTATION_LENGTH,
@@ -92,16 +92,15 @@ class PajakLaw:
         put(Parameter.VIABILITY_ONSET, p.velocity_limit * (1.0 - 0.5 * p.vartheta))
         # |q̇| above which the penalty of eq. 14 is active: d < ϑ  <=>  |q̇| > q̇_max (1 - 2ϑ)
         put(Parameter.PENALTY_ONSET, p.velocity_limit * (1.0 - 2.0 * p.vartheta))
-        # improvement 4: regularisation δ of the approach rate at e_j = 0, 1e-4 ε (orientation
-        # through the progress measure's m/rad weight)
-        delta = 1e-4 * p.accuracy
-        put(Parameter.APPROACH_DELTA, [delta] * 3 + [delta / ORIENTATION_LENGTH] * 3)
         for slot, value in (
             (Parameter.VARTHETA, p.vartheta), (Parameter.RHO, p.rho), (Parameter.ACCURACY, p.accuracy),
-            (Parameter.NEIGHBOURHOOD, p.neighbourhood), (Parameter.BLEND_DISTANCE, p.blend_length * p.neighbourhood),
-            (Parameter.SCALING_RATE, p.scaling_rate), (Parameter.SINGULARITY_THRESHOLD, p.singularity_threshold),
-            (Parameter.MAX_DAMPING, p.max_damping), (Parameter.STOP_SPEED, p.stop_speed),
-            (Parameter.STALL_TIME, p.stall_time), (Parameter.NUM_WAYPOINTS, count),
+            (Parameter.ORIENTATION_ACCURACY, p.orientation_accuracy), (Parameter.NEIGHBOURHOOD, p.neighbourhood),
+            (Parameter.BLEND_DISTANCE, p.blend_length * p.neighbourhood), (Parameter.SCALING_RATE, p.scaling_rate),
+            (Parameter.SCALING_SLEW, p.scaling_slew), (Parameter.SINGULARITY_THRESHOLD, p.singularity_threshold),
+            (Parameter.MAX_DAMPING, p.max_damping),
+            (Parameter.APPROACH_DELTA, 1e-4 * p.accuracy),  # improvement 4: keeps the approach rate finite at p_w
+            (Parameter.STOP_SPEED, p.stop_speed), (Parameter.STALL_TIME, p.stall_time),
+            (Parameter.NUM_WAYPOINTS, count),
             (Parameter.LIMIT_VELOCITY, p.limit_velocity), (Parameter.LIMIT_ACCELERATION, p.limit_acceleration),
             (Parameter.BLEND_WAYPOINTS, p.blend_waypoints), (Parameter.SMOOTH_PENALTY, p.smooth_penalty),
             (Parameter.CONTINUOUS_SWITCHING, p.continuous_switching), (Parameter.BOUNDED_SCALING, p.bounded_scaling),
@@ -121,6 +120,7 @@ class PajakLaw:
         d = np.zeros(Discrete.SIZE)
         c = 0.0 if self.parameters.limit_acceleration else 1.0
         d[Discrete.C] = d[Discrete.C0] = c
+        d[Discrete.GOAL] = 1.0
         d[Discrete.BEST] = np.inf
         return d
 
@@ -154,24 +154,28 @@ class PajakLaw:
 
     def evaluate(self, t: float, q, qd, discrete) -> dict:
         """Everything the law computes at (t, q, q̇, discrete), as a dict (layout
-        :class:`~.kernel.Evaluation`): qdd, c, c_relaxed, saturated, sigma, measure
+        :class:`~.kernel.Evaluation`): qdd, c, c_relaxed, saturated (the limits overrule the law),
+        violation (of the box by a alone), brake (weight of the fallback braking), sigma, measure
         (singularity), cos_pitch, pose, target."""
         out = self._evaluate(t, q, qd, discrete)
         return {
             "qdd": out[Evaluation.QDD:Evaluation.QDD + 6].copy(), "c": float(out[Evaluation.C]),
             "c_relaxed": float(out[Evaluation.C_RELAXED]), "saturated": bool(out[Evaluation.SATURATED]),
+            "violation": float(out[Evaluation.VIOLATION]), "brake": float(out[Evaluation.BRAKE]),
             "sigma": float(out[Evaluation.SIGMA]), "measure": float(out[Evaluation.MEASURE]),
             "cos_pitch": float(out[Evaluation.COS_PITCH]), "pose": out[Evaluation.POSE:Evaluation.POSE + 6].copy(),
             "target": out[Evaluation.TARGET:Evaluation.TARGET + 6].copy(),
         }
 
     # --- discrete update -----------------------------------------------------------------------
-    def update(self, t: float, q, qd, discrete) -> np.ndarray:
+    def update(self, t: float, q, qd, discrete, goal: float = 1.0) -> np.ndarray:
         """New discrete state at time t (call periodically, e.g. every integration step).
 
         Records the eq. 18 anchor (t0, c0) = (t, c) when the limits set c; switches waypoints
         (eq. 19 blending, or stop-and-go with c restarting from 0 when the acceleration is
-        limited); tracks progress.
+        limited); tracks progress. ``goal`` in [0, 1] is the value c relaxes to (eq. 18: 1; the
+        speed override): when it changes, the anchor becomes (t, c) with the new goal, so c
+        stays continuous and approaches the goal at the rate of eq. 18.
 
         Raises:
             PlanningError: no progress for ``stall_time`` s, gimbal lock, or non-finite values.
@@ -185,7 +189,25 @@ class PajakLaw:
         status = update_kernel(float(t), q, qd, updated, self.vector, self.waypoints, self.remaining, self._out)
         if status < 0:
             raise self.failure(status, t, q, updated, self._out)
+        if self.parameters.limit_acceleration and goal != updated[Discrete.GOAL]:
+            updated[Discrete.T0] = t
+            updated[Discrete.C0] = updated[Discrete.C]
+            updated[Discrete.GOAL] = goal
         return updated
+
+    def reach_failure(self, q0) -> PlanningError | None:
+        """The :class:`PlanningError` (cause "unreachable", time 0) for the first waypoint whose
+        pose no IK branch of the UR10e reaches, naming it and the reason; None when every
+        waypoint is reachable (a wrist-singular pose counts as reachable)."""
+        for k, pose in enumerate(self.waypoints):
+            try:
+                robot.inverse_kinematics_all(pose)
+            except SingularConfigurationError:
+                continue
+            except ValueError as exc:
+                return PlanningError(f"waypoint {k} cannot be reached: {exc}", time=0.0,
+                                     configuration=np.array(q0, dtype=float), cause="unreachable")
+        return None
 
     def finished(self, q, qd, discrete) -> bool:
         """True once the TCP is within ε of the final waypoint p_w and p_w is the active target."""
@@ -209,8 +231,8 @@ class PajakLaw:
             near = " near a singular configuration" if out[Evaluation.MEASURE] < self.parameters.singularity_threshold \
                 else ""
             message = (
-                f"no progress towards waypoint {int(discrete[Discrete.WAYPOINT])} for {self.parameters.stall_time:.1f} s"
-                f"{near}: remaining path {out[Evaluation.REMAINING]:.4f} m, TCP "
+                f"no progress towards waypoint {int(discrete[Discrete.WAYPOINT])} for "
+                f"{self.parameters.stall_time:.1f} s{near}: remaining path {out[Evaluation.REMAINING]:.4f} m, TCP "
                 f"{np.round(out[Evaluation.POSE:Evaluation.POSE + 3], 4).tolist()}, c = {out[Evaluation.C]:.3g}, "
                 f"singularity measure {out[Evaluation.MEASURE]:.3g}"
             )
