@@ -125,14 +125,18 @@ class PajakLaw:
         return d
 
     # --- evaluation ----------------------------------------------------------------------------
-    def _evaluate(self, t, q, qd, discrete) -> np.ndarray:
-        q = np.asarray(q, dtype=float)
-        qd = np.asarray(qd, dtype=float)
-        discrete = np.asarray(discrete, dtype=float)
+    @staticmethod
+    def _state(q, qd, discrete) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q, q̇, discrete) as float arrays of shapes (6,), (6,), (Discrete.SIZE,); ValueError
+        otherwise."""
+        q, qd, discrete = (np.asarray(v, dtype=float) for v in (q, qd, discrete))
         if q.shape != (6,) or qd.shape != (6,) or discrete.shape != (Discrete.SIZE,):
             raise ValueError(f"q, qd and discrete must have shapes (6,), (6,) and ({Discrete.SIZE},), "
                              f"got {q.shape}, {qd.shape} and {discrete.shape}")
-        evaluate_kernel(float(t), q, qd, discrete, self.vector, self.waypoints, self._out)
+        return q, qd, discrete
+
+    def _evaluate(self, t, q, qd, discrete) -> np.ndarray:
+        evaluate_kernel(float(t), *self._state(q, qd, discrete), self.vector, self.waypoints, self._out)
         return self._out
 
     def acceleration(self, t: float, q, qd, discrete) -> tuple[np.ndarray, float]:
@@ -180,12 +184,8 @@ class PajakLaw:
         Raises:
             PlanningError: no progress for ``stall_time`` s, gimbal lock, or non-finite values.
         """
-        q = np.asarray(q, dtype=float)
-        qd = np.asarray(qd, dtype=float)
-        updated = np.array(discrete, dtype=float)
-        if q.shape != (6,) or qd.shape != (6,) or updated.shape != (Discrete.SIZE,):
-            raise ValueError(f"q, qd and discrete must have shapes (6,), (6,) and ({Discrete.SIZE},), "
-                             f"got {q.shape}, {qd.shape} and {updated.shape}")
+        q, qd, discrete = self._state(q, qd, discrete)
+        updated = discrete.copy()
         status = update_kernel(float(t), q, qd, updated, self.vector, self.waypoints, self.remaining, self._out)
         if status < 0:
             raise self.failure(status, t, q, updated, self._out)
