@@ -1,6 +1,6 @@
 """Benchmark: what the closed loop costs beside the plant it drives, and what the planners cost.
 
-    python examples/bench_planner_cost.py [--repeats 3] [--time-step 0.001]
+    python examples/bench_planner_cost.py [--repeats 3] [--time-step 0.001] [--pajak-law-only]
 
 All in one process, floor first:
 
@@ -11,7 +11,12 @@ All in one process, floor first:
    same robot;
 3. the planner's cost per evaluation of its law at mid-motion (``evaluate``, uncached; median of
    7 batches of 500) and, for the Pająk planner, its law integrated alone (``preflight``: RK4 at
-   1 ms) against the floor's wall time for the same simulated time.
+   1 ms) against the floor's wall time for the same simulated time;
+4. the Pająk law (Pająk 2024, sim 3): one evaluation of q̈ and c from Python (``PajakLaw.acceleration``,
+   median of 9 batches of 2000 calls), ``integrate`` of the whole task (best of ``--repeats``)
+   against the floor simulating the same time (best of ``--repeats``) in this process, and the
+   compiled kernels' first-call cost: a fresh process with an empty numba cache (compiles and
+   writes the cache), then a second one reading it.
 
 Best of ``--repeats`` runs for the real-time factors (the machine is shared; the best run is the
 one least disturbed). Prints Markdown tables. A benchmark, not a test: numbers depend on the
@@ -19,7 +24,11 @@ machine.
 """
 
 import argparse
+import os
 import statistics
+import subprocess
+import sys
+import tempfile
 import time
 
 import numpy as np
@@ -30,6 +39,7 @@ from pydrake.systems.controllers import InverseDynamics
 from pydrake.systems.framework import DiagramBuilder, TriggerType
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
+from drake_traj.planners import pajak
 from drake_traj.robots import get_robot
 from drake_traj.scenario import default_scenario_path, load_scenario
 from drake_traj.station import build_station, run_station
@@ -39,9 +49,10 @@ SCENARIOS = (("quintic_ptp.yaml", None), ("pajak.yaml", "sim3"), ("boryga_loop.y
 FLOOR_DURATION = 5.0  # [s] simulated
 
 
-def floor_real_time_factor(scenario) -> float:
+def floor_real_time_factor(scenario, duration: float = FLOOR_DURATION) -> float:
     """Real-time factor of the plant alone: the scenario's robot, plant config and gains, held at
-    its start by a constant desired state, gravity compensation, three loggers."""
+    its start by a constant desired state, gravity compensation, three loggers; ``duration`` [s]
+    simulated."""
     robot = get_robot(scenario.robot)
     gains = scenario.controller.for_robot(robot)
     builder = DiagramBuilder()
@@ -63,8 +74,8 @@ def floor_real_time_factor(scenario) -> float:
     simulator = Simulator(builder.Build())
     ApplySimulatorConfig(scenario.simulator, simulator)
     start = time.perf_counter()
-    simulator.AdvanceTo(FLOOR_DURATION)
-    return FLOOR_DURATION / (time.perf_counter() - start)
+    simulator.AdvanceTo(duration)
+    return duration / (time.perf_counter() - start)
 
 
 def station_real_time_factor(scenario) -> tuple[float, float]:
@@ -98,16 +109,75 @@ def evaluation_cost_us(scenario) -> float:
     return statistics.median(batches)
 
 
+_FIRST_CALL = """
+import time
+start = time.perf_counter()
+from drake_traj.planners import pajak
+imported = time.perf_counter()
+pajak.integrate(pajak.PajakLaw(pajak.paper_parameters(3)), pajak.paper_initial_configuration())
+print(imported - start, time.perf_counter() - imported)
+"""
+
+
+def pajak_first_call_s() -> tuple[float, float]:
+    """(compile, cached) [s]: the first integrate of sim 3 in a fresh process with an empty numba
+    cache (it compiles the kernels and writes the cache), then in a second process reading it
+    (imports excluded)."""
+    with tempfile.TemporaryDirectory() as cache:
+        environment = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        runs = [subprocess.run([sys.executable, "-c", _FIRST_CALL], env=environment, check=True, capture_output=True,
+                               text=True).stdout.split() for _ in range(2)]
+    return float(runs[0][1]), float(runs[1][1])
+
+
+def pajak_law_cost(scenario, repeats: int) -> None:
+    """Print the Pająk law's cost (item 4 of the module docstring) on the scenario's task."""
+    law = pajak.PajakLaw(scenario.planner)
+    q0 = scenario.start_configuration()
+    run = pajak.integrate(law, q0)
+    k = len(run["t"]) // 2
+    arguments = (run["t"][k], run["q"][k].copy(), run["qd"][k].copy(), run["discrete"][k].copy())
+    batches = []
+    for _ in range(9):
+        start = time.perf_counter()
+        for _ in range(2000):
+            law.acceleration(*arguments)
+        batches.append((time.perf_counter() - start) / 2000 * 1e6)
+    walls = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        pajak.integrate(law, q0)
+        walls.append(time.perf_counter() - start)
+    floor = max(floor_real_time_factor(scenario, run["T"]) for _ in range(repeats))
+    compile_s, cached_s = pajak_first_call_s()
+    rows = (
+        ("evaluation (q̈, c) from Python, median [µs]", f"{statistics.median(batches):.1f}"),
+        (f"integrate, {run['T']:.3f} s of motion, best [s]", f"{min(walls):.3f}"),
+        ("the plant floor, same simulated time, best [s]", f"{run['T'] / floor:.3f}"),
+        ("integrate / floor", f"{min(walls) * floor / run['T']:.2f}"),
+        ("first integrate, empty numba cache (compiles) [s]", f"{compile_s:.1f}"),
+        ("first integrate, cache written [s]", f"{cached_s:.2f}"),
+    )
+    print(f"\n| Pająk law ({scenario.name}) | |\n|---|---|")
+    for name, value in rows:
+        print(f"| {name} | {value} |", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3, help="runs per measurement (the best is kept)")
     parser.add_argument("--time-step", type=float, default=None, help="plant time step [s] (default: the scenario's)")
+    parser.add_argument("--pajak-law-only", action="store_true", help="only item 4, the Pająk law's cost")
     args = parser.parse_args()
     scenarios = [load_scenario(default_scenario_path().parent / path, variant) for path, variant in SCENARIOS]
     if args.time_step is not None:
         for scenario in scenarios:
             scenario.plant.time_step = args.time_step
             scenario.simulator.max_step_size = args.time_step
+    pajak_scenario = next(s for s in scenarios if isinstance(s.planner, pajak.PajakConfig))
+    if args.pajak_law_only:
+        pajak_law_cost(pajak_scenario, args.repeats)
+        return
     floors = {}
     print("| robot | floor real-time factor |\n|---|---|")
     for scenario in scenarios:
@@ -130,6 +200,7 @@ def main() -> None:
                 walls.append(time.perf_counter() - start)
             law = f"{min(walls) / (runs[0][1] / floors[scenario.robot]):.2f}"
         print(f"| {scenario.name} | {rtf:.2f} | {rtf / floors[scenario.robot]:.2f} | {cost:.0f} | {law} |", flush=True)
+    pajak_law_cost(pajak_scenario, args.repeats)
 
 
 if __name__ == "__main__":

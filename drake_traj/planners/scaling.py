@@ -15,12 +15,19 @@ point of the law (:func:`admissible_clock_rate`).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from drake_traj.compiled import compiled
 
-def relaxed_scaling(t, t0: float, c0: float, goal: float = 1.0, rate: float = 1.0):
-    """(c, dc/dt) at time t [s] of eq. 18 generalised: c = (c0 - goal) exp(-rate (t - t0)) + goal."""
-    decay = np.exp(-rate * (np.asarray(t, dtype=float) - t0))
+
+@compiled
+def relaxed_scaling(t: float, t0: float, c0: float, goal: float = 1.0, rate: float = 1.0):
+    """(c, dc/dt) at time t [s] of eq. 18 generalised: c = (c0 - goal) exp(-rate (t - t0)) + goal.
+
+    Compiled (:mod:`drake_traj.compiled`): the Pająk 2024 law calls it on every evaluation."""
+    decay = math.exp(-rate * (t - t0))
     return (c0 - goal) * decay + goal, -rate * (c0 - goal) * decay
 
 

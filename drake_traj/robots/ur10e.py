@@ -17,6 +17,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from drake_traj.compiled import compiled
 from drake_traj.errors import SingularConfigurationError
 from drake_traj.robots.base import Robot
 
@@ -103,9 +104,15 @@ def flange_pose(q) -> np.ndarray:
     return dh_frames(q)[-1]
 
 
+@compiled
+def wrapped(angle):
+    """:func:`wrap_angle` compiled, for a float or an array (the form compiled kernels call)."""
+    return np.pi - np.mod(np.pi - angle, 2.0 * np.pi)
+
+
 def wrap_angle(angle):
     """Wrap angles [rad] to (-pi, pi] (Corrected (docs/papers.md): the orientation error of Pająk 2024 must be wrapped)."""
-    return np.pi - np.mod(np.pi - np.asarray(angle, dtype=float), 2 * np.pi)
+    return wrapped(np.asarray(angle, dtype=float))
 
 
 def zyx_euler_from_rotation(rotation: np.ndarray) -> np.ndarray:
@@ -147,6 +154,55 @@ def task_pose_error(pose, goal) -> np.ndarray:
     error = np.asarray(pose, dtype=float) - np.asarray(goal, dtype=float)
     error[3:] = wrap_angle(error[3:])
     return error
+
+
+@compiled
+def orientation_error(phi, goal) -> float:
+    """Angle [rad] of R_goalᵀ R between the Z-Y-X Euler orientations ``phi`` and ``goal`` (3 each):
+    the rotation that is left, not a difference of Euler angles. Compiled, for kernels."""
+    r = np.empty((2, 3, 3))
+    for k, angles in enumerate((phi, goal)):
+        cx, sx = math.cos(angles[0]), math.sin(angles[0])
+        cy, sy = math.cos(angles[1]), math.sin(angles[1])
+        cz, sz = math.cos(angles[2]), math.sin(angles[2])
+        r[k, 0, 0], r[k, 0, 1], r[k, 0, 2] = cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx
+        r[k, 1, 0], r[k, 1, 1], r[k, 1, 2] = sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx
+        r[k, 2, 0], r[k, 2, 1], r[k, 2, 2] = -sy, cy * sx, cy * cx
+    m = np.empty((3, 3))  # R_goalᵀ R
+    for i in range(3):
+        for j in range(3):
+            m[i, j] = r[1, 0, i] * r[0, 0, j] + r[1, 1, i] * r[0, 1, j] + r[1, 2, i] * r[0, 2, j]
+    # sin and cos of the angle from the skew part and the trace: accurate at any angle
+    sine = 0.5 * math.sqrt((m[2, 1] - m[1, 2]) ** 2 + (m[0, 2] - m[2, 0]) ** 2 + (m[1, 0] - m[0, 1]) ** 2)
+    return math.atan2(sine, 0.5 * (m[0, 0] + m[1, 1] + m[2, 2] - 1.0))
+
+
+@compiled
+def _pose_errors(pose, goal, position, orientation):
+    for k in range(pose.shape[0]):
+        g = goal[k % goal.shape[0]]
+        position[k] = math.sqrt((pose[k, 0] - g[0]) ** 2 + (pose[k, 1] - g[1]) ** 2 + (pose[k, 2] - g[2]) ** 2)
+        orientation[k] = orientation_error(pose[k, 3:], g[3:])
+
+
+def pose_error(pose, goal):
+    """(position error [m], orientation error [rad]) of task poses [x, y, z, φ_X, φ_Y, φ_Z] against
+    ``goal``: the distance of the positions and the angle of R_goalᵀ R (:func:`orientation_error`).
+
+    ``pose`` has shape (..., 6) and ``goal`` (6,) or the same shape; the errors have the leading
+    shape (floats for one pose).
+    """
+    pose = np.asarray(pose, dtype=float)
+    goal = np.asarray(goal, dtype=float)
+    if pose.shape[-1:] != (6,) or goal.shape not in ((6,), pose.shape):
+        raise ValueError(f"pose must have shape (..., 6) and goal (6,) or the same shape, got {pose.shape} "
+                         f"and {goal.shape}")
+    rows = np.ascontiguousarray(pose.reshape(-1, 6))
+    position, orientation = np.empty(rows.shape[0]), np.empty(rows.shape[0])
+    _pose_errors(rows, np.ascontiguousarray(goal.reshape(-1, 6)), position, orientation)
+    if pose.ndim == 1:
+        return float(position[0]), float(orientation[0])
+    return position.reshape(pose.shape[:-1]), orientation.reshape(pose.shape[:-1])
 
 
 def euler_rate_matrix(phi) -> np.ndarray:
@@ -197,153 +253,151 @@ def analytic_jacobian_and_bias(q, qd, *, min_cos_pitch: float = 1e-6) -> tuple[n
 
 
 # --------------------------------------------------------------------------------------------
-# Closed-form k(q), analytic J(q) and J̇q̇: the hot path of the task-space planners.
+# Closed-form k(q), analytic J(q) and J̇q̇: the hot path of the task-space planners, compiled.
 # --------------------------------------------------------------------------------------------
 
 
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _chain(q, qd, m):
-    """k(q), analytic J and J̇q̇ as nested tuples of components (floats, or arrays of tasks).
-
-    ``m`` is ``math`` for floats or ``numpy`` for arrays. Standard DH frames of :func:`dh_frames` written
-    out: joint axes z_j at origins o_j, flange o_6; J_g columns z_j x (o_6 - o_j) and z_j; the
-    bias by the usual velocity/acceleration recursion with q̈ = 0; then J = diag(I, B⁻¹) J_g and
-    the Euler part of the bias B⁻¹ (α - Ḃ φ̇) (Pająk 2024, with B's columns in k(q)'s order).
-    """
-    q1, q2, q3, q4, q5, q6 = q
-    c1, s1 = m.cos(q1), m.sin(q1)
-    c2, s2 = m.cos(q2), m.sin(q2)
-    c5, s5 = m.cos(q5), m.sin(q5)
-    c6, s6 = m.cos(q6), m.sin(q6)
-    q23 = q2 + q3
-    q234 = q23 + q4
-    c23, s23 = m.cos(q23), m.sin(q23)
-    c234, s234 = m.cos(q234), m.sin(q234)
-    z0 = (0.0, 0.0, 1.0)
-    z1 = (s1, -c1, 0.0)
-    x4 = (c1 * c234, s1 * c234, s234)
-    z4 = (c1 * s234, s1 * s234, -c234)
-    z5 = (c5 * s1 - s5 * x4[0], -c5 * c1 - s5 * x4[1], -s5 * s234)
-    x5 = (c5 * x4[0] + s5 * s1, c5 * x4[1] - s5 * c1, c5 * s234)
-    x6 = tuple(c6 * x5[k] - s6 * z4[k] for k in range(3))
-    y6 = tuple(-s6 * x5[k] - c6 * z4[k] for k in range(3))
-    # r_j = o_{j+1} - o_j
-    rs = (
-        (0.0, 0.0, _D1),
-        (_A2 * c1 * c2, _A2 * s1 * c2, _A2 * s2),
-        (_A3 * c1 * c23, _A3 * s1 * c23, _A3 * s23),
-        (_D4 * z1[0], _D4 * z1[1], 0.0),
-        (_D5 * z4[0], _D5 * z4[1], _D5 * z4[2]),
-        (_D6 * z5[0], _D6 * z5[1], _D6 * z5[2]),
-    )
-    axes = (z0, z1, z1, z1, z4, z5)
-    # p_j = o_6 - o_j
-    ps = [None] * 6
-    acc = (0.0, 0.0, 0.0)
-    for j in range(5, -1, -1):
-        r = rs[j]
-        acc = (acc[0] + r[0], acc[1] + r[1], acc[2] + r[2])
-        ps[j] = acc
-    jv = [_cross(axes[j], ps[j]) for j in range(6)]
-    # bias recursion (q̈ = 0): α_{j+1} = α_j + ω_j x z_j q̇_j, ω_{j+1} = ω_j + z_j q̇_j,
-    # a_{j+1} = a_j + α_{j+1} x r_j + ω_{j+1} x (ω_{j+1} x r_j)
-    w = (0.0, 0.0, 0.0)
-    al = (0.0, 0.0, 0.0)
-    lin = (0.0, 0.0, 0.0)
-    for j in range(6):
-        z, r, v = axes[j], rs[j], qd[j]
-        zq = (z[0] * v, z[1] * v, z[2] * v)
-        if j:
-            wz = _cross(w, zq)
-            al = (al[0] + wz[0], al[1] + wz[1], al[2] + wz[2])
-        w = (w[0] + zq[0], w[1] + zq[1], w[2] + zq[2])
-        t1 = _cross(al, r)
-        t2 = _cross(w, _cross(w, r))
-        lin = (lin[0] + t1[0] + t2[0], lin[1] + t1[1] + t2[1], lin[2] + t1[2] + t2[2])
-    # Z-Y-X Euler angles (k(q) rows 4-6)
-    r11, r21, r31, r32, r33 = x6[0], x6[1], x6[2], y6[2], z5[2]
-    phx = m.atan2(r32, r33)
-    cy = m.hypot(r32, r33)  # = cos φ_Y >= 0
-    phy = m.atan2(-r31, cy)
-    phz = m.atan2(r21, r11)
-    sy, cz, sz = -r31, m.cos(phz), m.sin(phz)
-    if m is math:
-        icy = 1.0 / cy if cy > 0.0 else 1e300
-    else:
-        icy = 1.0 / np.maximum(cy, 1e-300)
-
-    def binv(v):  # B(φ)⁻¹ v, B of robot.euler_rate_matrix
-        fx = (cz * v[0] + sz * v[1]) * icy
-        return (fx, -sz * v[0] + cz * v[1], v[2] + sy * fx)
-
-    jw = [binv(axes[j]) for j in range(6)]
-    fx, fy, fz = binv(w)  # Euler rates φ̇
-    bdot = (
-        -sy * cz * fx * fy + fz * (-cy * sz * fx - cz * fy),
-        -sy * sz * fx * fy + fz * (cy * cz * fx - sz * fy),
-        -cy * fx * fy,
-    )
-    ang = binv((al[0] - bdot[0], al[1] - bdot[1], al[2] - bdot[2]))
-    pose = (ps[0][0], ps[0][1], ps[0][2] + 0.0, phx, phy, phz)
-    jac = tuple(tuple(jv[j][k] for j in range(6)) for k in range(3)) + tuple(
-        tuple(jw[j][k] for j in range(6)) for k in range(3)
-    )
-    bias = lin + ang
-    measure = _singularity_factors(s5, m.sin(q3), c2, c23, s234, m)
-    return pose, jac, bias, cy, measure
-
-
-def _singularity_factors(s5, s3, c2, c23, s234, m):
+@compiled
+def _singularity_factors(s3, s5, c2, c23, s234):
     # det J_g = a2 a3 s3 s5 (a2 c2 + a3 c23 + d5 s234): elbow, wrist and shoulder factors.
     shoulder = (_A2 * c2 + _A3 * c23 + _D5 * s234) / (abs(_A2) + abs(_A3))
-    if m is math:
-        return min(abs(s3), abs(s5), abs(shoulder))
-    return np.minimum(np.minimum(np.abs(s3), np.abs(s5)), np.abs(shoulder))
+    return min(abs(s3), abs(s5), abs(shoulder))
+
+
+@compiled
+def kinematics_into(q, qd, pose, jac, bias):
+    """k(q) into ``pose`` (6), the analytic J into ``jac`` (6, 6) and J̇q̇ into ``bias`` (6) of the
+    flange; returns (cos φ_Y, singularity measure). Compiled; the kernel of :func:`ur10e_kinematics`.
+
+    The standard-DH chain of :func:`dh_frames` written out: joint axes z_j at origins o_j, flange
+    o_6; J_g columns z_j x (o_6 - o_j) and z_j; the bias by the velocity/acceleration recursion with
+    q̈ = 0; then J = diag(I, B⁻¹) J_g and the Euler part of the bias B⁻¹ (α - Ḃ φ̇) (Pająk 2024,
+    with B's columns in k(q)'s order). At gimbal lock (cos φ_Y = 0) B⁻¹ uses 1e300 for 1/cos φ_Y:
+    callers check the returned cos φ_Y.
+    """
+    c1, s1 = math.cos(q[0]), math.sin(q[0])
+    c2, s2 = math.cos(q[1]), math.sin(q[1])
+    c5, s5 = math.cos(q[4]), math.sin(q[4])
+    c6, s6 = math.cos(q[5]), math.sin(q[5])
+    q23 = q[1] + q[2]
+    q234 = q23 + q[3]
+    c23, s23 = math.cos(q23), math.sin(q23)
+    c234, s234 = math.cos(q234), math.sin(q234)
+    # joint axes z_0..z_5 (z_1 = z_2 = z_3) and the link vectors r_j = o_{j+1} - o_j
+    axes = np.empty((6, 3))
+    links = np.empty((6, 3))
+    axes[0, 0], axes[0, 1], axes[0, 2] = 0.0, 0.0, 1.0
+    for j in range(1, 4):
+        axes[j, 0], axes[j, 1], axes[j, 2] = s1, -c1, 0.0
+    x4 = (c1 * c234, s1 * c234, s234)
+    axes[4, 0], axes[4, 1], axes[4, 2] = c1 * s234, s1 * s234, -c234
+    axes[5, 0], axes[5, 1], axes[5, 2] = c5 * s1 - s5 * x4[0], -c5 * c1 - s5 * x4[1], -s5 * s234
+    x5 = (c5 * x4[0] + s5 * s1, c5 * x4[1] - s5 * c1, c5 * s234)
+    links[0, 0], links[0, 1], links[0, 2] = 0.0, 0.0, _D1
+    links[1, 0], links[1, 1], links[1, 2] = _A2 * c1 * c2, _A2 * s1 * c2, _A2 * s2
+    links[2, 0], links[2, 1], links[2, 2] = _A3 * c1 * c23, _A3 * s1 * c23, _A3 * s23
+    links[3, 0], links[3, 1], links[3, 2] = _D4 * s1, -_D4 * c1, 0.0
+    for k in range(3):
+        links[4, k] = _D5 * axes[4, k]
+        links[5, k] = _D6 * axes[5, k]
+    # J_v column j = z_j x (o_6 - o_j), accumulating o_6 - o_j from the flange back
+    p0 = p1 = p2 = 0.0
+    for j in range(5, -1, -1):
+        p0 += links[j, 0]
+        p1 += links[j, 1]
+        p2 += links[j, 2]
+        jac[0, j] = axes[j, 1] * p2 - axes[j, 2] * p1
+        jac[1, j] = axes[j, 2] * p0 - axes[j, 0] * p2
+        jac[2, j] = axes[j, 0] * p1 - axes[j, 1] * p0
+    # bias recursion (q̈ = 0): α_{j+1} = α_j + ω_j x z_j q̇_j, ω_{j+1} = ω_j + z_j q̇_j,
+    # a_{j+1} = a_j + α_{j+1} x r_j + ω_{j+1} x (ω_{j+1} x r_j)
+    w0 = w1 = w2 = 0.0
+    al0 = al1 = al2 = 0.0
+    l0 = l1 = l2 = 0.0
+    for j in range(6):
+        z0, z1, z2 = axes[j, 0] * qd[j], axes[j, 1] * qd[j], axes[j, 2] * qd[j]
+        al0 += w1 * z2 - w2 * z1
+        al1 += w2 * z0 - w0 * z2
+        al2 += w0 * z1 - w1 * z0
+        w0 += z0
+        w1 += z1
+        w2 += z2
+        r0, r1, r2 = links[j, 0], links[j, 1], links[j, 2]
+        u0, u1, u2 = w1 * r2 - w2 * r1, w2 * r0 - w0 * r2, w0 * r1 - w1 * r0
+        l0 += al1 * r2 - al2 * r1 + w1 * u2 - w2 * u1
+        l1 += al2 * r0 - al0 * r2 + w2 * u0 - w0 * u2
+        l2 += al0 * r1 - al1 * r0 + w0 * u1 - w1 * u0
+    # Z-Y-X Euler angles (k(q) rows 4-6) from x6, y6 (r32) and z6 (r33)
+    r11 = c6 * x5[0] - s6 * axes[4, 0]
+    r21 = c6 * x5[1] - s6 * axes[4, 1]
+    r31 = c6 * x5[2] - s6 * axes[4, 2]
+    r32 = -s6 * x5[2] - c6 * axes[4, 2]
+    r33 = axes[5, 2]
+    cy = math.hypot(r32, r33)  # cos φ_Y >= 0
+    pose[0], pose[1], pose[2] = p0, p1, p2 + 0.0
+    pose[3], pose[4], pose[5] = math.atan2(r32, r33), math.atan2(-r31, cy), math.atan2(r21, r11)
+    sy, cz, sz = -r31, math.cos(pose[5]), math.sin(pose[5])
+    icy = 1.0 / cy if cy > 0.0 else 1e300
+    # B(φ)⁻¹ v for B of euler_rate_matrix: fx = (cz v0 + sz v1)/cy, fy = -sz v0 + cz v1, fz = v2 + sy fx
+    for j in range(6):
+        fx = (cz * axes[j, 0] + sz * axes[j, 1]) * icy
+        jac[3, j] = fx
+        jac[4, j] = -sz * axes[j, 0] + cz * axes[j, 1]
+        jac[5, j] = axes[j, 2] + sy * fx
+    fx = (cz * w0 + sz * w1) * icy  # Euler rates φ̇
+    fy = -sz * w0 + cz * w1
+    fz = w2 + sy * fx
+    v0 = al0 - (-sy * cz * fx * fy + fz * (-cy * sz * fx - cz * fy))  # α - Ḃ φ̇
+    v1 = al1 - (-sy * sz * fx * fy + fz * (cy * cz * fx - sz * fy))
+    v2 = al2 + cy * fx * fy
+    gx = (cz * v0 + sz * v1) * icy
+    bias[0], bias[1], bias[2] = l0, l1, l2
+    bias[3], bias[4], bias[5] = gx, -sz * v0 + cz * v1, v2 + sy * gx
+    return cy, _singularity_factors(math.sin(q[2]), s5, c2, c23, s234)
+
+
+@compiled
+def _kinematics_many(q, qd, pose, jac, bias, cos_pitch, measure):
+    for k in range(q.shape[0]):
+        cos_pitch[k], measure[k] = kinematics_into(q[k], qd[k], pose[k], jac[k], bias[k])
 
 
 def ur10e_kinematics(q, qd):
     """(k(q), J(q), J̇(q, q̇) q̇, cos φ_Y, singularity measure) of the UR10e flange.
 
-    The standard-DH chain of :func:`dh_frames` written out in closed form (tests check it against
-    MultibodyPlant and finite differences of :func:`task_pose`): about 20 µs for one state, and
-    vectorised over leading dimensions (q, q̇ of shape (..., 6)).
+    The closed form of :func:`kinematics_into` (tests check it against MultibodyPlant and finite
+    differences of :func:`task_pose`), vectorised over leading dimensions (q, q̇ of shape (..., 6)).
 
     Returns:
         pose (..., 6), J (..., 6, 6), bias (..., 6), cos_pitch (...), measure (...), where
         ``measure`` is :func:`singularity_measure`. No exception at gimbal lock: callers check
-        ``cos_pitch``.
+        ``cos_pitch``. For one state, cos_pitch and measure are floats.
     """
     q = np.asarray(q, dtype=float)
     qd = np.asarray(qd, dtype=float)
     if q.shape == (6,) and qd.shape == (6,):
-        pose, jac, bias, cy, measure = _chain(q.tolist(), qd.tolist(), math)
-        return np.array(pose), np.array(jac), np.array(bias), cy, measure
+        pose, jac, bias = np.empty(6), np.empty((6, 6)), np.empty(6)
+        cos_pitch, measure = kinematics_into(q, qd, pose, jac, bias)
+        return pose, jac, bias, cos_pitch, measure
     shape = np.broadcast_shapes(q.shape, qd.shape)
     if shape[-1] != 6:
         raise ValueError(f"q and qd must have shape (..., 6), got {q.shape} and {qd.shape}")
-    q = np.broadcast_to(q, shape).reshape(-1, 6)
-    qd = np.broadcast_to(qd, shape).reshape(-1, 6)
-    pose, jac, bias, cy, measure = _chain(tuple(q.T), tuple(qd.T), np)
+    q = np.ascontiguousarray(np.broadcast_to(q, shape).reshape(-1, 6))
+    qd = np.ascontiguousarray(np.broadcast_to(qd, shape).reshape(-1, 6))
     count = q.shape[0]
-    pose_a = np.empty((count, 6))
-    bias_a = np.empty((count, 6))
-    jac_a = np.empty((count, 6, 6))
-    for k in range(6):
-        pose_a[:, k] = pose[k]
-        bias_a[:, k] = bias[k]
-        for j in range(6):
-            jac_a[:, k, j] = jac[k][j]
+    pose, jac, bias = np.empty((count, 6)), np.empty((count, 6, 6)), np.empty((count, 6))
+    cos_pitch, measure = np.empty(count), np.empty(count)
+    _kinematics_many(q, qd, pose, jac, bias, cos_pitch, measure)
     lead = shape[:-1]
-    return (
-        pose_a.reshape(lead + (6,)),
-        jac_a.reshape(lead + (6, 6)),
-        bias_a.reshape(lead + (6,)),
-        np.reshape(cy, lead),
-        np.reshape(measure, lead),
-    )
+    return pose.reshape(lead + (6,)), jac.reshape(lead + (6, 6)), bias.reshape(lead + (6,)), \
+        cos_pitch.reshape(lead), measure.reshape(lead)
+
+
+@compiled
+def _singularity_measure_many(q, out):
+    for k in range(q.shape[0]):
+        out[k] = _singularity_factors(math.sin(q[k, 2]), math.sin(q[k, 4]), math.cos(q[k, 1]),
+                                      math.cos(q[k, 1] + q[k, 2]), math.sin(q[k, 1] + q[k, 2] + q[k, 3]))
 
 
 def singularity_measure(q):
@@ -351,10 +405,13 @@ def singularity_measure(q):
 
     det J_g = a2 a3 s3 s5 (a2 c2 + a3 c23 + d5 s234) for the UR10e: the three factors are the
     elbow, wrist and shoulder singularities; the measure is zero exactly at a singular J.
+    q has shape (..., 6); the result the leading shape (a float for one q).
     """
     q = np.asarray(q, dtype=float)
-    c2, c23, s234 = np.cos(q[..., 1]), np.cos(q[..., 1] + q[..., 2]), np.sin(q[..., 1:4].sum(-1))
-    return _singularity_factors(np.sin(q[..., 4]), np.sin(q[..., 2]), c2, c23, s234, np)
+    rows = np.ascontiguousarray(q.reshape(-1, 6))
+    out = np.empty(rows.shape[0])
+    _singularity_measure_many(rows, out)
+    return float(out[0]) if q.ndim == 1 else out.reshape(q.shape[:-1])
 
 
 # --------------------------------------------------------------------------------------------

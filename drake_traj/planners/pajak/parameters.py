@@ -39,7 +39,11 @@ class PajakConfig:
         acceleration_limit: q̈_max = -q̈_min (scalar or 6) [rad/s²], eq. 5.
         vartheta: ϑ, penalty threshold on the normalised distance d (eq. 14), in (0, 0.5).
         rho: ρ, penalty strength (eq. 14) [rad²/s³], not given in the paper (ERRATA: 0.03).
-        accuracy: ε, the task is finished when the TCP is this close to p_w [m].
+        accuracy: ε, the task is finished when the TCP is this close to p_w [m] (and its
+            orientation within ``orientation_accuracy``).
+        orientation_accuracy: the task is finished when the angle of R_wᵀ R between the tool's
+            orientation R and p_w's R_w is below this [rad] (and the position within ε): the
+            paper's |e| < ε read over all six components of e.
         neighbourhood: ϵ, radius of the blending ball around each waypoint [m] (eq. 19).
         limit_velocity: add the penalty perturbation Δq̈ (eq. 15-16); sims 2 and 3.
         limit_acceleration: scale the trajectory (eq. 17-18), c(0) = 0; sim 3.
@@ -52,6 +56,8 @@ class PajakConfig:
         preserve_damping: improvement 4, no error component changes sign (overshoot) near the
             final goal, whatever c.
         scaling_rate: rate of eq. 18 [1/s] (1 in the paper).
+        scaling_slew: improvement 1 (with ``bounded_scaling``): c changes by at most this per
+            second [1/s]; where the limits would need c to fall faster, q̈ is clipped to them.
         singularity_threshold: damped least squares below this :func:`drake_traj.robot.singularity_measure`.
         max_damping: damping λ of the damped least squares at a singular J.
         stop_speed: stop mode: TCP speed [m/s] below which a waypoint counts as reached.
@@ -73,6 +79,7 @@ class PajakConfig:
     vartheta: float = 0.1
     rho: float = 0.03
     accuracy: float = 0.001
+    orientation_accuracy: float = 0.001
     neighbourhood: float = 0.05
     limit_velocity: bool = True
     limit_acceleration: bool = True
@@ -83,6 +90,7 @@ class PajakConfig:
     damped_inverse: bool = True
     preserve_damping: bool = True
     scaling_rate: float = 1.0
+    scaling_slew: float = 3.0
     singularity_threshold: float = 0.1
     max_damping: float = 0.2
     stop_speed: float = 0.01
@@ -122,7 +130,8 @@ class PajakConfig:
         for name in ("position_gain", "velocity_gain", "velocity_limit", "acceleration_limit"):
             values[name] = positive_vector(getattr(self, name), name, n)
         for name in (
-            "rho", "accuracy", "neighbourhood", "scaling_rate", "singularity_threshold", "max_damping",
+            "rho", "accuracy", "orientation_accuracy", "neighbourhood", "scaling_rate", "scaling_slew",
+            "singularity_threshold", "max_damping",
             "stop_speed", "stall_time", "blend_length", "update_period",
         ):
             value = getattr(self, name)

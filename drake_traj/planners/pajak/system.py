@@ -6,7 +6,8 @@ import numpy as np
 
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.planners.pajak.integration import integrate
-from drake_traj.planners.pajak.law import C, C0, PajakLaw
+from drake_traj.planners.pajak.kernel import Discrete
+from drake_traj.planners.pajak.law import PajakLaw
 from drake_traj.planners.pajak.parameters import PajakConfig
 from drake_traj.robots import ur10e
 from drake_traj.robots.base import Robot
@@ -16,12 +17,14 @@ __all__ = ["PajakPlanner", "make"]
 
 class PajakPlanner(PlannerSystem):
     """Pająk 2024's planner as a LeafSystem: continuous [q; q̇], discrete ``scaling`` [c, t0, c0]
-    and ``task`` (the rest of :data:`DISCRETE_NAMES`), updated every ``update_period``.
+    and ``task`` (the rest of :class:`~.kernel.Discrete`), updated every ``update_period``.
 
     The acceleration (and c) are evaluated by :meth:`PajakLaw.acceleration` at every derivative
     call, so the acceleration limit holds at every integrator stage, not only at updates. A
-    :class:`PlanningError` from the law ends the simulation; ``simulate`` keeps the log.
-    The ``speed_override`` input is not used by this planner (its clock is real time).
+    :class:`PlanningError` from the law ends the simulation; ``simulate`` keeps the log. The
+    ``speed_override`` input, sampled at the updates, is the value c relaxes to instead of 1
+    (eq. 18): c stays continuous and within the limits, and the task is still completed (at
+    0 the feedback fades out and the arm coasts: an override for slowing, not for stopping).
 
     Args:
         parameters: the task and the law's settings.
@@ -34,48 +37,58 @@ class PajakPlanner(PlannerSystem):
         self.law = PajakLaw(parameters)
         update_period = self.law.parameters.update_period
         initial = self.law.initial_discrete()
-        super().__init__(ur10e._as_joint_vector(q_initial, "q_initial"), initial_scaling=float(initial[C]))
-        self.task_state_index = self.DeclareDiscreteState(initial[C0 + 1 :])
-        self.velocity_limit = self.law.qd_max[0]
-        self.acceleration_limit = self.law.qdd_max[0]
+        super().__init__(ur10e._as_joint_vector(q_initial, "q_initial"), initial_scaling=float(initial[Discrete.C]))
+        self.task_state_index = self.DeclareDiscreteState(initial[Discrete.C0 + 1:])
+        self.velocity_limit = self.law.qd_max
+        self.acceleration_limit = self.law.qdd_max
         self.DeclarePeriodicDiscreteUpdateEvent(update_period, 0.0, self._update)
 
     def _law_arguments(self, context):
         state = self.reference_state(context)
-        discrete = np.concatenate(
-            [
-                context.get_discrete_state(self.scaling_state_index).get_value(),
-                context.get_discrete_state(self.task_state_index).get_value(),
-            ]
-        )
-        return context.get_time(), state[: self.num_joints], state[self.num_joints :], discrete
+        discrete = np.concatenate([
+            context.get_discrete_state(self.scaling_state_index).get_value(),
+            context.get_discrete_state(self.task_state_index).get_value(),
+        ])
+        return context.get_time(), state[: self.num_joints], state[self.num_joints:], discrete
 
     def evaluate(self, context) -> tuple[np.ndarray, float]:
-        qdd, c = self.law.acceleration(*self._law_arguments(context))
-        return qdd, float(c)
+        return self.law.acceleration(*self._law_arguments(context))
 
     def finished(self, context) -> bool:
         _, q, qd, discrete = self._law_arguments(context)
-        return bool(self.law.finished(q, qd, discrete))
+        return self.law.finished(q, qd, discrete)
+
+    def limit_conflicts(self, context) -> int:
+        """Updates so far at which the limits overruled the law (q̈ clipped to the box, or the
+        fallback braking; improvement 2)."""
+        return int(context.get_discrete_state(self.task_state_index).get_value()[Discrete.SATURATED - Discrete.C0 - 1])
 
     def preflight(self) -> np.ndarray:
-        """Integrate the law alone over the whole task (:func:`integrate`); raises its
-        :class:`PlanningError` (time, configuration, cause) if the task cannot be completed.
-        Returns the planned TCP path [m], (N, 3)."""
+        """Run the whole task ahead of time (:func:`integrate`, the law alone) before t = 0.
+
+        Raises the :class:`PlanningError` that the motion would end with: a waypoint out of
+        reach (before integrating), a stall, gimbal lock, non-finite values or no finish within
+        30 s, naming the time, the configuration and the cause (the stall message names the
+        waypoint). A run that finishes has reached the whole pose (position within ε,
+        orientation within ``orientation_accuracy``).
+
+        Returns:
+            The planned TCP path [m], (N, 3).
+        """
         return integrate(self.law, self.initial_positions())["tcp"][:, :3]
 
     def goal_pose(self) -> np.ndarray:
         """p_f, the last waypoint [m, rad]."""
-        return self.law.parameters.waypoints[-1].copy()
+        return self.law.waypoints[-1].copy()
 
     def task_waypoints(self) -> np.ndarray:
-        return self.law.parameters.waypoints[:, :3].copy()
+        return self.law.tcp_positions()
 
     def _update(self, context, discrete_state):
         t, q, qd, discrete = self._law_arguments(context)
-        updated = self.law.update(t, q, qd, discrete)
-        discrete_state.get_mutable_vector(self.scaling_state_index).SetFromVector(updated[: C0 + 1])
-        discrete_state.get_mutable_vector(self.task_state_index).SetFromVector(updated[C0 + 1 :])
+        updated = self.law.update(t, q, qd, discrete, self.speed_override(context))
+        discrete_state.get_mutable_vector(self.scaling_state_index).SetFromVector(updated[: Discrete.C0 + 1])
+        discrete_state.get_mutable_vector(self.task_state_index).SetFromVector(updated[Discrete.C0 + 1:])
         if self.law.finished(q, qd, updated):
             self._record_finish(discrete_state.get_mutable_vector(self.finish_state_index), t)
 

@@ -1,0 +1,810 @@
+"""The Pająk 2024 law, compiled: every equation of the planner and its fixed-step integrator.
+
+This module is the one implementation of the law. :mod:`.law` wraps it for Python callers (the
+Drake system, tests) and :mod:`.integration` for whole runs; the functions here take flat float
+vectors whose layouts are the enums below, so that a call from Python costs no conversion:
+
+- :class:`Parameter`: the task's settings (from :class:`~.parameters.PajakConfig`), with the
+  waypoints (w, 6) and the remaining path after each waypoint (w,) as separate arrays;
+- :class:`Discrete`: the discrete state of the law (the Drake system's ``scaling`` group is its
+  first three entries, c, t0 and c0);
+- :class:`Evaluation`: what one evaluation computes (q̈, c, the pose, the target, ...);
+- :class:`Log`: one sample of :func:`integrate_kernel`'s log.
+
+Equation numbers in comments are Pająk 2024's; docs/papers.md explains the corrections and our
+improvements (each a flag of the parameters).
+"""
+
+import hashlib
+import math
+from enum import IntEnum
+from pathlib import Path
+
+import numpy as np
+
+from drake_traj import compiled as compiled_module
+from drake_traj.compiled import compiled
+from drake_traj.planners import scaling
+from drake_traj.planners.scaling import relaxed_scaling
+from drake_traj.robots import ur10e
+from drake_traj.robots.ur10e import kinematics_into, orientation_error, wrapped
+
+__all__ = [
+    "Discrete", "Evaluation", "Log", "Parameter", "Status", "acceleration_box", "acceleration_terms",
+    "approach_damping", "approach_rate", "blend_progress", "blended_target", "brake_weight", "choose_scaling",
+    "damping_factor", "evaluate_kernel", "finished_kernel", "integrate_kernel", "keep_limits", "scaling_interval",
+    "update_kernel", "velocity_penalty",
+]
+
+
+def _layout(name: str, fields) -> type[IntEnum]:
+    """An IntEnum of the start index of each (field, size) in a flat vector, and SIZE."""
+    offsets, start = {}, 0
+    for field, size in fields:
+        offsets[field] = start
+        start += size
+    offsets["SIZE"] = start
+    return IntEnum(name, offsets)
+
+
+Parameter = _layout("Parameter", [
+    ("KP", 6), ("KV", 6),  # Λ_P [1/s²], Λ_V [1/s] per task component (eq. 9)
+    ("QD_MAX", 6), ("QDD_MAX", 6),  # joint limits [rad/s], [rad/s²] (eq. 4-5)
+    ("VIABILITY_GAIN", 6),  # K of the velocity-viability bound q̈_i <= K (q̇_max - q̇_i) [1/s]
+    ("VIABILITY_ONSET", 6),  # |q̇_i| above which that bound can bind [rad/s]
+    ("PENALTY_ONSET", 6),  # |q̇_i| above which the penalty of eq. 14 is active [rad/s]
+    ("VARTHETA", 1), ("RHO", 1),  # ϑ, ρ of eq. 14
+    ("ACCURACY", 1),  # ε [m]
+    ("ORIENTATION_ACCURACY", 1),  # the finish's orientation bound [rad]
+    ("NEIGHBOURHOOD", 1),  # ϵ [m] (eq. 19)
+    ("BLEND_DISTANCE", 1),  # path length through the ball at which σ = 1 [m]
+    ("SCALING_RATE", 1),  # rate of eq. 18 [1/s]
+    ("SCALING_SLEW", 1),  # largest |dc/dt| [1/s] (improvement 1)
+    ("SINGULARITY_THRESHOLD", 1), ("MAX_DAMPING", 1),  # damped least squares (improvement 3)
+    ("APPROACH_DELTA", 1),  # δ of the approach rate [m] (improvement 4)
+    ("STOP_SPEED", 1),  # stop mode: TCP speed below which a waypoint is reached [m/s]
+    ("STALL_TIME", 1),  # no progress for this long is a stall [s]
+    ("NUM_WAYPOINTS", 1),
+    # switches (1.0 on, 0.0 off): PajakConfig's flags
+    ("LIMIT_VELOCITY", 1), ("LIMIT_ACCELERATION", 1), ("BLEND_WAYPOINTS", 1), ("SMOOTH_PENALTY", 1),
+    ("CONTINUOUS_SWITCHING", 1), ("BOUNDED_SCALING", 1), ("DAMPED_INVERSE", 1), ("PRESERVE_DAMPING", 1),
+])
+
+Discrete = _layout("Discrete", [
+    ("C", 1),  # c at the last update
+    ("T0", 1), ("C0", 1),  # eq. 18 anchor: c was C0 at time T0 [s]
+    ("GOAL", 1),  # the value c relaxes to (eq. 18: 1; the speed override)
+    ("T_UPDATE", 1),  # time of the last update [s]
+    ("WAYPOINT", 1),  # index i of the active waypoint p_i (an integer)
+    ("BLENDING", 1),  # 1 while the TCP passes the neighbourhood of p_i (eq. 19, second case)
+    ("SIGMA", 1),  # σ of eq. 19 at the last update (σ never decreases)
+    ("TRAVEL", 1),  # TCP path length since it entered the ball, up to the last update [m]
+    ("X_REF", 3),  # TCP position at the last update [m]
+    ("BEST", 1),  # smallest remaining path so far (progress monitor) [m]
+    ("T_BEST", 1),  # when BEST last improved [s]
+    ("BRAKE", 1), ("BRAKE_SLOPE", 1),  # fallback braking weight at the last update and its slope [1/s]
+    ("SATURATED", 1),  # updates at which the limits overruled the law (improvement 2)
+])
+
+Evaluation = _layout("Evaluation", [
+    ("QDD", 6),  # q̈ [rad/s²]
+    ("C", 1), ("C_RELAXED", 1),  # c and the eq. 18 value c_r
+    ("SATURATED", 1),  # 1 where the limits overrule the law (q̈ clipped to the box, braking)
+    ("VIOLATION", 1),  # how far a = -J⁻¹J̇q̇ alone is outside the box, relative to q̈_max
+    ("BRAKE", 1),  # weight of the fallback braking in q̈
+    ("SIGMA", 1), ("MEASURE", 1), ("COS_PITCH", 1),  # σ, singularity measure, cos φ_Y
+    ("POSE", 6), ("TARGET", 6),  # k(q) and the target of eq. 6 / eq. 19 [m, rad]
+    ("POSITION_ERROR", 1), ("ORIENTATION_ERROR", 1),  # to the active waypoint (update_kernel) [m, rad]
+    ("REMAINING", 1),  # remaining path to p_w (update_kernel) [m]
+])
+
+_EVALUATION_SIZE = int(Evaluation.SIZE)  # a plain int for np.empty in compiled code
+
+Log = _layout("Log", [
+    ("T", 1), ("Q", 6), ("QD", 6), ("QDD", 6), ("C", 1), ("TCP", 6), ("SATURATED", 1),
+    ("DISCRETE", int(Discrete.SIZE)),
+])
+
+
+class Status(IntEnum):
+    """What :func:`update_kernel` and :func:`integrate_kernel` report."""
+
+    RUNNING = 0
+    FINISHED = 1
+    STALL = -1
+    SINGULAR = -2  # Euler gimbal lock
+    NON_FINITE = -3
+    TIMEOUT = -4
+
+
+ORIENTATION_LENGTH = 0.1  # [m/rad], weight of orientation in the progress measure and the approach rate
+MIN_COS_PITCH = 1e-6  # Euler gimbal lock (as ur10e.analytic_jacobian_and_bias)
+BRAKE_TIME = 0.05  # [s], time constant of the fallback braking at low speed (improvement 2)
+BRAKE_ONSET = 0.5  # violation (relative to q̈_max) at which the fallback is pure braking
+BRAKE_LAG = 0.02  # [s], time constant with which the braking weight follows its target
+BRAKE_SLEW = 10.0  # [1/s], largest rate of change of the braking weight
+SCALE_FLOOR = 0.1  # smallest c_r the approach damping is sized for (improvement 4)
+
+
+# --------------------------------------------------------------------------------------------
+# The law's pieces (compiled functions of floats and small arrays, tested one by one)
+# --------------------------------------------------------------------------------------------
+
+
+@compiled
+def velocity_penalty(qd: float, qd_max: float, rho: float, vartheta: float, smooth: bool) -> float:
+    """Δq̈_i = -∂κ(q̇_i)/∂q̇_i (eq. 15) for the interior penalty κ of eq. 14 [rad/s²], limits ±q̇_max.
+
+    d(q̇_i) = min(q̇_i - q̇_min, q̇_max - q̇_i) / (q̇_max - q̇_min) (eq. 14). Literal (``smooth``
+    False): κ = ρ (1/d - 1/ϑ) for d < ϑ, whose slope -ρ/ϑ² at d = ϑ makes q̈ jump by
+    ρ/((q̇_max - q̇_min) ϑ²) when the penalty switches on. Smooth (improvement 1): κ minus its
+    tangent at ϑ, κ = ρ (1/d - 1/ϑ + (d - ϑ)/ϑ²), zero value and slope at the threshold, the
+    same 1/d growth at the limit. d is floored at 1e-3 beyond the limits.
+    """
+    span = 2.0 * qd_max
+    to_min = qd + qd_max
+    to_max = qd_max - qd
+    d = max(min(to_min, to_max) / span, 1e-3)  # eq. 14
+    if d >= vartheta:
+        return 0.0
+    magnitude = rho / (d * d * span)
+    if smooth:
+        magnitude -= rho / (vartheta * vartheta * span)
+    # ∂κ/∂q̇_i = κ'(d) ∂d/∂q̇_i, ∂d/∂q̇_i = -1/span near q̇_max: eq. 15 pushes from the nearer limit
+    return -magnitude if to_max < to_min else magnitude
+
+
+@compiled
+def approach_rate(error, error_rate, delta: float) -> float:
+    """r = -ė·e / (|e|² + δ²) [1/s]: the rate at which the TCP closes on p_w, from the error e to
+    it and ė = J q̇ (6 each), orientation rows weighted by 0.1 m/rad (improvement 4). The distance
+    decays as exp(-r t) while r holds; δ only keeps r finite at e = 0. One rate for the whole pose,
+    not one per component: a component that passes 0 while the TCP sweeps by the goal would give
+    a rate that spikes to ±∞ and back within milliseconds."""
+    closing = 0.0
+    size = delta * delta
+    for k in range(6):
+        weight = 1.0 if k < 3 else ORIENTATION_LENGTH * ORIENTATION_LENGTH
+        closing += weight * error[k] * error_rate[k]
+        size += weight * error[k] * error[k]
+    return -closing / size
+
+
+@compiled
+def approach_damping(rate: float, stiffness: float, damping: float) -> float:
+    """Damping D [1/s] that keeps the TCP from overshooting p_w when it closes at ``rate`` r
+    against ``stiffness`` K, given the law's ``damping`` (improvement 4).
+
+    For ë = -D ė - K e, r = -ė/e obeys dr/dt = r² - D r + K. With D = r + K/r it is constant:
+    ė = -r e is invariant and e decays as exp(-r t) without crossing 0. Returned: the given
+    ``damping`` for r <= sqrt(K) (the literal law), ramped (smoothstep in r) up to λ + K/λ at
+    r = λ = 2 sqrt(K), and r + K/r above λ; never below ``damping``. Continuous in r.
+    """
+    root = math.sqrt(stiffness)
+    held = max(rate, 2.0 * root)
+    hold = held + stiffness / held
+    x = min(max(rate / root - 1.0, 0.0), 1.0)
+    return max(damping, damping + (hold - damping) * (x * x * (3.0 - 2.0 * x)))
+
+
+@compiled
+def damping_factor(measure: float, threshold: float, max_damping: float) -> float:
+    """λ² of the damped least-squares inverse (improvement 3): 0 for measure >= threshold,
+    rising to max_damping² at a singular J: λ² = λ_max² (1 - measure/threshold)², which starts
+    with zero slope, so q̈ does not bend sharply where the damping sets in."""
+    gap = max(1.0 - measure / threshold, 0.0)
+    return max_damping * max_damping * gap * gap
+
+
+@compiled
+def _factor(jac, lam2, use_damped, matrix, pivots):
+    """LU factors (partial pivoting) of J, or of JᵀJ + λ²I for the damped inverse, into
+    ``matrix`` (6, 6) and ``pivots`` (6,)."""
+    for i in range(6):
+        for j in range(6):
+            if use_damped:
+                total = 0.0
+                for k in range(6):
+                    total += jac[k, i] * jac[k, j]
+                matrix[i, j] = total + (lam2 if i == j else 0.0)
+            else:
+                matrix[i, j] = jac[i, j]
+    for k in range(6):
+        pivot = k
+        for i in range(k + 1, 6):
+            if abs(matrix[i, k]) > abs(matrix[pivot, k]):
+                pivot = i
+        pivots[k] = pivot
+        if pivot != k:
+            for j in range(6):
+                matrix[k, j], matrix[pivot, j] = matrix[pivot, j], matrix[k, j]
+        for i in range(k + 1, 6):
+            factor = matrix[i, k] / matrix[k, k]
+            matrix[i, k] = factor
+            for j in range(k + 1, 6):
+                matrix[i, j] -= factor * matrix[k, j]
+
+
+@compiled
+def _solve(jac, use_damped, matrix, pivots, rhs, out):
+    """J⁻¹ rhs (eq. 13), or (JᵀJ + λ²I)⁻¹ Jᵀ rhs (damped least squares), into ``out`` (6,),
+    from the factors of :func:`_factor`."""
+    for i in range(6):
+        if use_damped:
+            total = 0.0
+            for k in range(6):
+                total += jac[k, i] * rhs[k]
+            out[i] = total
+        else:
+            out[i] = rhs[i]
+    for k in range(6):
+        pivot = pivots[k]
+        if pivot != k:
+            out[k], out[pivot] = out[pivot], out[k]
+    for i in range(6):
+        for k in range(i):
+            out[i] -= matrix[i, k] * out[k]
+    for i in range(5, -1, -1):
+        for k in range(i + 1, 6):
+            out[i] -= matrix[i, k] * out[k]
+        out[i] /= matrix[i, i]
+
+
+@compiled
+def acceleration_terms(jac, bias, error, error_rate, kp, damping, penalty, lam2, use_damped, a, b):
+    """a and b of eq. 17 into ``a``, ``b`` (6,):
+
+    a = -J⁻¹ J̇q̇, b = -J⁻¹ (D ė + Λ_P e) + Δq̈, with ė = J q̇ (``error_rate``), e of eq. 6 or
+    eq. 19 and the damping D = Λ_V (eq. 13) or more (improvement 4). q̈ = a + c b is eq. 17;
+    with c = 1 it is eq. 16 (eq. 13 without Δq̈). With ``use_damped`` J⁻¹ is the damped
+    least-squares inverse with λ² = ``lam2`` (:func:`damping_factor`).
+    """
+    matrix = np.empty((6, 6))
+    pivots = np.empty(6, dtype=np.int64)
+    _factor(jac, lam2, use_damped, matrix, pivots)
+    rhs = np.empty(6)
+    _solve(jac, use_damped, matrix, pivots, bias, a)
+    for i in range(6):
+        a[i] = -a[i]
+        rhs[i] = damping[i] * error_rate[i] + kp[i] * error[i]
+    _solve(jac, use_damped, matrix, pivots, rhs, b)
+    for i in range(6):
+        b[i] = penalty[i] - b[i]
+
+
+@compiled
+def _fmin(x: float, y: float) -> float:
+    """min ignoring NaN (numpy's fmin)."""
+    if x != x:
+        return y
+    if y != y:
+        return x
+    return min(x, y)
+
+
+@compiled
+def _fmax(x: float, y: float) -> float:
+    """max ignoring NaN (numpy's fmax)."""
+    if x != x:
+        return y
+    if y != y:
+        return x
+    return max(x, y)
+
+
+@compiled
+def scaling_interval(a, b, lower, upper):
+    """(c_lo, c_hi): the interval of c with lower <= a + c b <= upper on every joint.
+
+    Each joint gives the bound of cases (1)-(4) (Corrected (docs/papers.md): (2) and (4) use q̈_min):
+    b_i > 0: (q̈_min - a_i)/b_i <= c <= (q̈_max - a_i)/b_i; b_i < 0: the same with the roles
+    of q̈_min and q̈_max swapped; b_i = 0: no bound if a_i is inside the box, else empty.
+    Upper bounds (cases 1, 2) combine by min (case a), lower bounds (3, 4) by max (case b).
+    The interval is empty where c_lo > c_hi.
+    """
+    c_lo = -np.inf
+    c_hi = np.inf
+    for i in range(a.shape[0]):
+        to_max = (upper[i] - a[i]) / b[i]
+        to_min = (lower[i] - a[i]) / b[i]
+        c_lo = max(c_lo, _fmin(to_max, to_min))
+        c_hi = min(c_hi, _fmax(to_max, to_min))
+    return c_lo, c_hi
+
+
+@compiled
+def choose_scaling(c_relaxed: float, c_lo: float, c_hi: float, bounded: bool = True):
+    """(c, feasible) from the relaxed value c_r (eq. 18) and the admissible interval (case a-c).
+
+    c = c_r when it is admissible; otherwise the admissible value closest to c_r (case a: the
+    smallest upper bound, case b: the largest lower bound, case c: the point of
+    [ĉ_min, ĉ_max] closest to c_r, which is the previous c when the anchor was just recorded).
+    ``bounded`` (improvement 2) restricts the interval to [0, 1]. feasible is False where the
+    interval is empty (then c is the clip of c_r to it, and the caller must keep the limits
+    some other way).
+    """
+    if bounded:
+        c_lo = max(c_lo, 0.0)
+        c_hi = min(c_hi, 1.0)
+    c = min(max(c_relaxed, c_lo), c_hi)
+    if bounded:
+        c = min(max(c, 0.0), 1.0)
+    return c, c_lo <= c_hi
+
+
+@compiled
+def acceleration_box(qd, p, lower, upper):
+    """The box [lower, upper] (6 each) that q̈ must stay in: ±q̈_max (eq. 5), narrowed near the
+    velocity limits (improvement 2) so that q̇ stays viable: q̈_i <= K (q̇_max - q̇_i) and the
+    mirror bound, so q̇ can only approach its limit exponentially even when c is held small by
+    another joint and the penalty (scaled by c) cannot act. K puts the bound's onset at d = ϑ/4,
+    inside the penalty zone."""
+    viable = p[Parameter.BOUNDED_SCALING] > 0.0 and p[Parameter.LIMIT_VELOCITY] > 0.0
+    for k in range(6):
+        limit = p[Parameter.QDD_MAX + k]
+        lower[k], upper[k] = -limit, limit
+        if viable and abs(qd[k]) > p[Parameter.VIABILITY_ONSET + k]:
+            gain = p[Parameter.VIABILITY_GAIN + k]
+            speed = p[Parameter.QD_MAX + k]
+            upper[k] = min(max(gain * (speed - qd[k]), -limit), limit)
+            lower[k] = min(max(gain * (-speed - qd[k]), -limit), limit)
+
+
+@compiled
+def keep_limits(a, b, c_relaxed: float, lower, upper, qdd_max, c_low: float, c_high: float, qdd):
+    """Improvement 2: q̈ = a + c b (eq. 17) inside the box [lower, upper] at every evaluation,
+    with c continuous in the state; returns (c, violation), q̈ into ``qdd``.
+
+    - c is chosen by cases 1-4 and a-c (:func:`scaling_interval`, :func:`choose_scaling`) in
+      [0, 1], then kept in [c_low, c_high] (the rate limit of c, improvement 1).
+    - When a = -J⁻¹J̇q̇ alone is outside the box (``violation`` = the largest excess relative to
+      q̈_max > 0: the joints move too fast for the curvature of the path), no c in [0, 1] keeps
+      the limits. c is then chosen in the box widened by twice the violation, which a is
+      strictly inside, so c stays continuous as some b_i changes sign (in the box itself the
+      interval's bounds would jump between ±∞).
+    - q̈ is clipped to the box: the limits win where the law (or the rate-limited c) would
+      break them; the caller counts those evaluations.
+    """
+    violation = 0.0
+    for k in range(6):
+        violation = max(violation, (a[k] - upper[k]) / qdd_max[k], (lower[k] - a[k]) / qdd_max[k])
+    low = np.empty(6)
+    high = np.empty(6)
+    for k in range(6):
+        widen = 2.0 * violation * qdd_max[k]
+        low[k] = lower[k] - widen
+        high[k] = upper[k] + widen
+    c_lo, c_hi = scaling_interval(a, b, low, high)  # cases 1-4
+    c, _ = choose_scaling(c_relaxed, c_lo, c_hi, True)  # cases a-c
+    c = min(max(c, c_low), c_high)
+    for k in range(6):
+        qdd[k] = min(max(a[k] + c * b[k], lower[k]), upper[k])  # eq. 17, clipped to the box
+    return c, violation
+
+
+@compiled
+def brake_weight(violation: float, weight: float, slope: float, elapsed: float):
+    """(weight now, its target): the share of braking in q̈ (improvement 2). The target is
+    smoothstep(violation / BRAKE_ONSET); the weight follows it from its value ``weight`` at the
+    last update with that update's ``slope`` [1/s] for ``elapsed`` seconds (so q̈ changes at a
+    bounded rate while the braking sets in or ends)."""
+    x = min(violation / BRAKE_ONSET, 1.0)
+    return min(max(weight + slope * elapsed, 0.0), 1.0), x * x * (3.0 - 2.0 * x)
+
+
+@compiled
+def brake(qd, lower, upper, qdd_max, weight: float, qdd):
+    """q̈ blended by ``weight`` from its value in ``qdd`` (in the box) into braking every joint in
+    proportion to its speed at the largest rate the box allows (at most 1/BRAKE_TIME); both ends
+    are in the box, so the blend is (improvement 2)."""
+    rate = 1.0 / BRAKE_TIME
+    for k in range(6):
+        rate = min(rate, qdd_max[k] / abs(qd[k]))
+    for k in range(6):
+        braking = min(max(-qd[k] * rate, lower[k]), upper[k])
+        qdd[k] += weight * (braking - qdd[k])
+
+
+@compiled
+def blend_progress(position, reference, travel: float, length: float):
+    """(σ of eq. 19 before the monotone max, step): σ = the TCP path length through the ball /
+    ``length``, clipped to [0, 1].
+
+    σ = (ℓ + |x - x_ref|) / length, where ℓ is the path length accumulated at the updates since
+    the TCP entered the ball and x_ref the TCP position at the last update (step = |x - x_ref|).
+    It is 0 on entry, continuous in x and grows whenever the TCP moves, so the target always
+    leads (a projection on p_i -> p_{i+1} does not grow while the TCP is still heading for p_i,
+    and 1 - δ/ϵ is not monotone: both stall, docs/papers.md). ``length`` = ``blend_length`` · ϵ.
+    """
+    step = math.sqrt((position[0] - reference[0]) ** 2 + (position[1] - reference[1]) ** 2
+                     + (position[2] - reference[2]) ** 2)
+    return min(max((travel + step) / length, 0.0), 1.0), step
+
+
+# --------------------------------------------------------------------------------------------
+# The law
+# --------------------------------------------------------------------------------------------
+#
+# numba caches a compiled function under its own source file only (numba issue #1833): after an
+# edit of the UR10e kinematics or of eq. 18 in their modules, the cached law would go on using the
+# old code. Numba does hash a function's closure into its cache key, so each function below that
+# reaches compiled code of another module is made in a closure over the digest of those modules'
+# sources (``dependencies``, unused otherwise); they call each other through the module's globals.
+
+
+def _sources_digest(*modules) -> str:
+    """sha256 of the source files of ``modules``."""
+    digest = hashlib.sha256()
+    for module in modules:
+        digest.update(Path(module.__file__).read_bytes())
+    return digest.hexdigest()
+
+
+_DEPENDENCIES = _sources_digest(ur10e, scaling, compiled_module)
+
+
+@compiled
+def _position_distance(pose, waypoints, i):
+    """|x - p_i| of the TCP position [m]."""
+    return math.sqrt((pose[0] - waypoints[i, 0]) ** 2 + (pose[1] - waypoints[i, 1]) ** 2
+                     + (pose[2] - waypoints[i, 2]) ** 2)
+
+
+@compiled
+def _finite(values) -> bool:
+    for value in values:
+        if not math.isfinite(value):
+            return False
+    return True
+
+
+def _blended_target(dependencies):
+    @compiled
+    def blended_target(p_i, p_next, sigma):
+        """σ p_{i+1} + (1 - σ) p_i of eq. 19, the orientation part along the wrapped difference."""
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        target = np.empty(6)
+        for k in range(6):
+            step = p_next[k] - p_i[k]
+            if k >= 3:
+                step = wrapped(step)
+            target[k] = p_i[k] + sigma * step
+        return target
+
+    return blended_target
+
+
+blended_target = _blended_target(_DEPENDENCIES)
+
+
+def _evaluate_kernel(dependencies):
+    @compiled
+    def evaluate_kernel(t, q, qd, d, p, waypoints, out):
+        """One evaluation of the law at time t for (q, q̇) and the discrete state ``d`` into
+        ``out`` (layout :class:`Evaluation`): q̈ of eq. 17 with c from eq. 18 and the limits.
+
+        No exception: gimbal lock shows in out[COS_PITCH], a failure as non-finite out[QDD].
+        """
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        pose = out[Evaluation.POSE:Evaluation.POSE + 6]
+        qdd = out[Evaluation.QDD:Evaluation.QDD + 6]
+        target = out[Evaluation.TARGET:Evaluation.TARGET + 6]
+        jac = np.empty((6, 6))
+        bias = np.empty(6)
+        cos_pitch, measure = kinematics_into(q, qd, pose, jac, bias)
+        out[Evaluation.COS_PITCH] = cos_pitch
+        out[Evaluation.MEASURE] = measure
+        out[Evaluation.SATURATED] = 0.0
+        out[Evaluation.VIOLATION] = 0.0
+        out[Evaluation.BRAKE] = 0.0
+        i = int(d[Discrete.WAYPOINT])
+        last = int(p[Parameter.NUM_WAYPOINTS]) - 1
+        sigma = 0.0
+        if p[Parameter.BLEND_WAYPOINTS] > 0.0 and d[Discrete.BLENDING] > 0.5:
+            raw, _ = blend_progress(pose, d[Discrete.X_REF:Discrete.X_REF + 3], d[Discrete.TRAVEL],
+                                    p[Parameter.BLEND_DISTANCE])
+            sigma = max(raw, d[Discrete.SIGMA])  # σ never decreases
+            target[:] = blended_target(waypoints[i], waypoints[min(i + 1, last)], sigma)  # eq. 19
+        else:
+            target[:] = waypoints[i]  # eq. 6
+        out[Evaluation.SIGMA] = sigma
+        error = np.empty(6)
+        error_rate = np.empty(6)
+        for k in range(6):
+            error[k] = pose[k] - target[k]  # eq. 6
+            if k >= 3:
+                error[k] = wrapped(error[k])  # orientation wrapped (docs/papers.md)
+            rate = 0.0
+            for j in range(6):
+                rate += jac[k, j] * qd[j]
+            error_rate[k] = rate  # ė = J q̇
+        penalty = np.zeros(6)
+        if p[Parameter.LIMIT_VELOCITY] > 0.0:
+            smooth = p[Parameter.SMOOTH_PENALTY] > 0.0
+            for k in range(6):
+                if abs(qd[k]) > p[Parameter.PENALTY_ONSET + k]:
+                    penalty[k] = velocity_penalty(qd[k], p[Parameter.QD_MAX + k], p[Parameter.RHO],
+                                                  p[Parameter.VARTHETA], smooth)  # eq. 14-15
+        use_damped = p[Parameter.DAMPED_INVERSE] > 0.0 and measure < p[Parameter.SINGULARITY_THRESHOLD]
+        lam2 = 0.0
+        if use_damped:
+            lam2 = damping_factor(measure, p[Parameter.SINGULARITY_THRESHOLD], p[Parameter.MAX_DAMPING])
+        kp = p[Parameter.KP:Parameter.KP + 6]
+        damping = p[Parameter.KV:Parameter.KV + 6].copy()
+        limited = p[Parameter.LIMIT_ACCELERATION] > 0.0
+        c_r = 1.0
+        if limited:
+            c_r = relaxed_scaling(t, d[Discrete.T0], d[Discrete.C0], d[Discrete.GOAL],
+                                  p[Parameter.SCALING_RATE])[0]  # eq. 18
+        if limited and p[Parameter.PRESERVE_DAMPING] > 0.0:
+            # improvement 4: with the gains scaled by c the damping breaks condition (11) below
+            # c = 4 Λ_P / Λ_V² and the TCP overshoots p_w. The damping that holds the approach
+            # rate (approach_damping), sized for c = c_r (at least SCALE_FLOOR) and scaled by c
+            # like the rest of b, so q̈ stays linear in c. Applied while converging to a fixed
+            # target (p_w; every waypoint in stop mode), ramped in with σ during the last blend.
+            weight = 0.0
+            if p[Parameter.BLEND_WAYPOINTS] == 0.0 or i >= last:
+                weight = 1.0
+            elif i == last - 1:
+                weight = sigma
+            if weight > 0.0:
+                goal = i if p[Parameter.BLEND_WAYPOINTS] == 0.0 else last
+                final = np.empty(6)
+                for k in range(6):
+                    final[k] = pose[k] - waypoints[goal, k]
+                    if k >= 3:
+                        final[k] = wrapped(final[k])
+                closing = approach_rate(final, error_rate, p[Parameter.APPROACH_DELTA])
+                scale = min(max(c_r, SCALE_FLOOR), 1.0)
+                for k in range(6):
+                    held = approach_damping(closing, scale * kp[k], scale * damping[k])
+                    damping[k] += weight * (held / scale - damping[k])  # per unit of c
+        a = np.empty(6)
+        b = np.empty(6)
+        acceleration_terms(jac, bias, error, error_rate, kp, damping, penalty, lam2, use_damped, a, b)  # eq. 17
+        if not limited:
+            out[Evaluation.C] = 1.0
+            out[Evaluation.C_RELAXED] = 1.0
+            for k in range(6):
+                qdd[k] = a[k] + b[k]  # eq. 16 (eq. 13 without the penalty)
+            return
+        out[Evaluation.C_RELAXED] = c_r
+        lower = np.empty(6)
+        upper = np.empty(6)
+        acceleration_box(qd, p, lower, upper)
+        if p[Parameter.BOUNDED_SCALING] == 0.0:  # the paper's choice of c (may leave [0, 1])
+            c_lo, c_hi = scaling_interval(a, b, lower, upper)  # cases 1-4
+            c, _ = choose_scaling(c_r, c_lo, c_hi, False)  # cases a-c
+            out[Evaluation.C] = c
+            for k in range(6):
+                qdd[k] = a[k] + c * b[k]  # eq. 17
+            return
+        qdd_max = p[Parameter.QDD_MAX:Parameter.QDD_MAX + 6]
+        elapsed = max(t - d[Discrete.T_UPDATE], 0.0)
+        slew = p[Parameter.SCALING_SLEW] * elapsed
+        c, violation = keep_limits(a, b, c_r, lower, upper, qdd_max, d[Discrete.C] - slew, d[Discrete.C] + slew,
+                                   qdd)
+        out[Evaluation.C] = c
+        out[Evaluation.VIOLATION] = violation
+        weight, _ = brake_weight(violation, d[Discrete.BRAKE], d[Discrete.BRAKE_SLOPE], elapsed)
+        out[Evaluation.BRAKE] = weight
+        if weight > 0.0:
+            brake(qd, lower, upper, qdd_max, weight, qdd)
+        for k in range(6):
+            if abs(qdd[k] - (a[k] + c * b[k])) > 1e-9 * qdd_max[k]:
+                out[Evaluation.SATURATED] = 1.0  # the limits overrule the law
+
+    return evaluate_kernel
+
+
+evaluate_kernel = _evaluate_kernel(_DEPENDENCIES)
+
+
+def _pose_reached(dependencies):
+    @compiled
+    def pose_reached(pose, waypoint, p, out) -> bool:
+        """The whole pose within the accuracies of ``waypoint``: |x - p| < ε and the angle of
+        R_pᵀ R below the orientation accuracy (the paper's |e| < ε over all six components of e);
+        the errors into out[POSITION_ERROR], out[ORIENTATION_ERROR]."""
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        position = math.sqrt((pose[0] - waypoint[0]) ** 2 + (pose[1] - waypoint[1]) ** 2
+                             + (pose[2] - waypoint[2]) ** 2)
+        orientation = orientation_error(pose[3:], waypoint[3:])
+        out[Evaluation.POSITION_ERROR] = position
+        out[Evaluation.ORIENTATION_ERROR] = orientation
+        return position < p[Parameter.ACCURACY] and orientation < p[Parameter.ORIENTATION_ACCURACY]
+
+    return pose_reached
+
+
+pose_reached = _pose_reached(_DEPENDENCIES)
+
+
+def _update_kernel(dependencies):
+    @compiled
+    def update_kernel(t, q, qd, d, p, waypoints, remaining, out):
+        """The discrete update at time t, in place on ``d``; returns a :class:`Status`.
+
+        Evaluates the law first (into ``out``, with the discrete state before the update);
+        records the eq. 18 anchor (t0, c0) = (t, c) when the limits set c, and c and the braking
+        weight for their rate limits; switches waypoints (eq. 19 blending, or stop-and-go with c
+        restarting from 0 when the acceleration is limited); tracks progress (out[REMAINING])
+        and reports a finish, a stall, gimbal lock or non-finite values.
+        """
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        evaluate_kernel(t, q, qd, d, p, waypoints, out)
+        pose = out[Evaluation.POSE:Evaluation.POSE + 6]
+        bad = not (_finite(out[Evaluation.QDD:Evaluation.QDD + 6]) and _finite(q) and _finite(qd))
+        c = out[Evaluation.C]
+        if p[Parameter.LIMIT_ACCELERATION] > 0.0:
+            if abs(c - out[Evaluation.C_RELAXED]) > 1e-12:  # the limits moved c off eq. 18: new anchor
+                d[Discrete.T0] = t
+                d[Discrete.C0] = c
+            weight, target = brake_weight(out[Evaluation.VIOLATION], d[Discrete.BRAKE], d[Discrete.BRAKE_SLOPE],
+                                          max(t - d[Discrete.T_UPDATE], 0.0))
+            if abs(target - weight) < 1e-6:  # settled: exactly on the target (0 when the fallback is over)
+                weight = target
+            d[Discrete.BRAKE] = weight
+            d[Discrete.BRAKE_SLOPE] = min(max((target - weight) / BRAKE_LAG, -BRAKE_SLEW), BRAKE_SLEW)
+            d[Discrete.SATURATED] += out[Evaluation.SATURATED]
+        d[Discrete.C] = c
+        d[Discrete.T_UPDATE] = t
+        i = int(d[Discrete.WAYPOINT])
+        last = int(p[Parameter.NUM_WAYPOINTS]) - 1
+        if p[Parameter.BLEND_WAYPOINTS] > 0.0:
+            blending = d[Discrete.BLENDING] > 0.5
+            _, step = blend_progress(pose, d[Discrete.X_REF:Discrete.X_REF + 3], d[Discrete.TRAVEL],
+                                     p[Parameter.BLEND_DISTANCE])
+            d[Discrete.TRAVEL] = d[Discrete.TRAVEL] + step if blending else 0.0
+            d[Discrete.X_REF:Discrete.X_REF + 3] = pose[:3]
+            d[Discrete.SIGMA] = out[Evaluation.SIGMA] if blending else 0.0
+            if p[Parameter.CONTINUOUS_SWITCHING] > 0.0:
+                switch = blending and out[Evaluation.SIGMA] >= 1.0  # the target is p_{i+1} already
+            else:  # literal: when the TCP leaves the ball
+                switch = blending and _position_distance(pose, waypoints, i) >= p[Parameter.NEIGHBOURHOOD]
+            if switch:
+                i += 1
+                d[Discrete.WAYPOINT] = i
+                d[Discrete.BLENDING] = 0.0
+                d[Discrete.SIGMA] = 0.0
+            # entering the ball of p_i (i < w): blend towards p_{i+1} from σ = 0
+            if d[Discrete.BLENDING] < 0.5 and i < last and \
+                    _position_distance(pose, waypoints, i) < p[Parameter.NEIGHBOURHOOD]:
+                d[Discrete.BLENDING] = 1.0
+                d[Discrete.TRAVEL] = 0.0
+                d[Discrete.SIGMA] = 0.0
+        elif i < last and pose_reached(pose, waypoints[i], p, out):
+            # stop at each waypoint: the pose reached at low TCP speed, then the next task starts
+            # from rest (with c from 0 again when the acceleration is limited)
+            jac = np.empty((6, 6))
+            kinematics_into(q, qd, np.empty(6), jac, np.empty(6))
+            speed = 0.0
+            for k in range(3):
+                rate = 0.0
+                for j in range(6):
+                    rate += jac[k, j] * qd[j]
+                speed += rate * rate
+            if math.sqrt(speed) < p[Parameter.STOP_SPEED]:
+                i += 1
+                d[Discrete.WAYPOINT] = i
+                if p[Parameter.LIMIT_ACCELERATION] > 0.0:
+                    d[Discrete.T0] = t
+                    d[Discrete.C0] = 0.0
+                    d[Discrete.C] = 0.0
+        finished = pose_reached(pose, waypoints[i], p, out) and i >= last
+        # progress monitor: remaining path = distance to p_i (+ weighted orientation) + the rest
+        left = out[Evaluation.POSITION_ERROR] + ORIENTATION_LENGTH * out[Evaluation.ORIENTATION_ERROR] + remaining[i]
+        out[Evaluation.REMAINING] = left
+        if left < d[Discrete.BEST] - 1e-4:
+            d[Discrete.BEST] = left
+            d[Discrete.T_BEST] = t
+        if bad:
+            return Status.NON_FINITE
+        if out[Evaluation.COS_PITCH] < MIN_COS_PITCH:
+            return Status.SINGULAR
+        if finished:
+            return Status.FINISHED
+        if t - d[Discrete.T_BEST] > p[Parameter.STALL_TIME]:
+            return Status.STALL
+        return Status.RUNNING
+
+    return update_kernel
+
+
+update_kernel = _update_kernel(_DEPENDENCIES)
+
+
+def _finished_kernel(dependencies):
+    @compiled
+    def finished_kernel(q, d, p, waypoints) -> bool:
+        """True once p_w is the active target and the whole pose is within the accuracies of it."""
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        i = int(d[Discrete.WAYPOINT])
+        if i < int(p[Parameter.NUM_WAYPOINTS]) - 1:
+            return False
+        pose = np.empty(6)
+        kinematics_into(q, np.zeros(6), pose, np.empty((6, 6)), np.empty(6))
+        return pose_reached(pose, waypoints[i], p, np.empty(_EVALUATION_SIZE))
+
+    return finished_kernel
+
+
+finished_kernel = _finished_kernel(_DEPENDENCIES)
+
+
+def _integrate_kernel(dependencies):
+    @compiled
+    def integrate_kernel(q0, d0, dt, steps, settle_steps, p, waypoints, remaining, log, peak, out, final):
+        """Integrate one task from rest at ``q0`` with RK4 at a fixed step ``dt``, updating the
+        discrete state (from ``d0``) every step.
+
+        At every step k: discrete update at t_k, then the sample (row k of ``log``, layout
+        :class:`Log`), then an RK4 step with the discrete state held (its first stage is the
+        sample). Stops ``settle_steps`` steps after the first sample where the task is finished,
+        at a failure, or after ``steps`` steps. ``peak`` (2, 6) gets max |q̇| and max |q̈| per
+        joint over every evaluation (RK4 stages included); ``out`` the last evaluation; ``final``
+        [q; q̇; d] (12 + Discrete.SIZE) at the last step, after its update.
+
+        Returns:
+            (samples logged, status, finish index or -1): status is FINISHED once finished
+            (later failures ignored), else the failure (STALL, SINGULAR, NON_FINITE) or TIMEOUT.
+        """
+        dependencies  # noqa: B018 (numba's cache key, see above)
+        q = q0.copy()
+        qd = np.zeros(6)
+        d = d0.copy()
+        finish = -1
+        stage_q = np.empty((4, 6))
+        stage_qd = np.empty((4, 6))
+        stage_qdd = np.empty((4, 6))
+        for k in range(steps + settle_steps + 1):
+            t = k * dt
+            status = update_kernel(t, q, qd, d, p, waypoints, remaining, out)
+            final[:6] = q
+            final[6:12] = qd
+            final[12:] = d
+            if status < 0 and finish < 0:
+                return k, status, finish
+            stage_q[0] = q
+            stage_qd[0] = qd
+            for s in range(4):  # RK4 stages at t, t + dt/2, t + dt/2, t + dt
+                h = (0.0, 0.5 * dt, 0.5 * dt, dt)[s]
+                if s > 0:
+                    stage_q[s] = q + h * stage_qd[s - 1]
+                    stage_qd[s] = qd + h * stage_qdd[s - 1]
+                evaluate_kernel(t + h, stage_q[s], stage_qd[s], d, p, waypoints, out)
+                stage_qdd[s] = out[Evaluation.QDD:Evaluation.QDD + 6]
+                for j in range(6):
+                    peak[0, j] = max(peak[0, j], abs(stage_qd[s, j]))
+                    peak[1, j] = max(peak[1, j], abs(stage_qdd[s, j]))
+                if s > 0:
+                    continue
+                if out[Evaluation.COS_PITCH] < MIN_COS_PITCH:
+                    return k, Status.SINGULAR, finish
+                if not _finite(stage_qdd[0]):
+                    return k, Status.NON_FINITE, finish
+                row = log[k]
+                row[Log.T] = t
+                row[Log.Q:Log.Q + 6] = q
+                row[Log.QD:Log.QD + 6] = qd
+                row[Log.QDD:Log.QDD + 6] = stage_qdd[0]
+                row[Log.C] = out[Evaluation.C]
+                row[Log.TCP:Log.TCP + 6] = out[Evaluation.POSE:Evaluation.POSE + 6]
+                row[Log.SATURATED] = out[Evaluation.SATURATED]
+                row[Log.DISCRETE:Log.DISCRETE + Discrete.SIZE] = d
+                if status == Status.FINISHED and finish < 0:
+                    finish = k
+                if finish >= 0 and k >= finish + settle_steps:
+                    return k + 1, Status.FINISHED, finish
+                if finish < 0 and k >= steps:
+                    return k + 1, Status.TIMEOUT, finish
+            for j in range(6):
+                q[j] += dt / 6.0 * (stage_qd[0, j] + 2.0 * stage_qd[1, j] + 2.0 * stage_qd[2, j] + stage_qd[3, j])
+                qd[j] += dt / 6.0 * (stage_qdd[0, j] + 2.0 * stage_qdd[1, j] + 2.0 * stage_qdd[2, j]
+                                     + stage_qdd[3, j])
+        return steps + settle_steps + 1, Status.TIMEOUT, finish
+
+    return integrate_kernel
+
+
+integrate_kernel = _integrate_kernel(_DEPENDENCIES)
