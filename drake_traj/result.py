@@ -19,6 +19,7 @@ from matplotlib.figure import Figure
 
 from drake_traj.errors import DrakeTrajError, Failure
 from drake_traj.export import export, reference_trajectory
+from drake_traj.robots.ur10e import pose_error
 
 __all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult"]
 
@@ -61,7 +62,10 @@ class Metrics:
     """Figures of merit of a run (:meth:`SimulationResult.metrics`); :meth:`to_dict` is the
     content of ``metrics.json``. Joint quantities are per joint, in rad, rad/s, rad/s^2 (m, m/s,
     m/s^2 for prismatic joints); ``*_over_limit`` are ratios to the planner's promised limits (the
-    effort limit for torques); ``failure`` is the failure's message (None on success)."""
+    effort limit for torques); ``failure`` is the failure's message (None on success); the final
+    errors are those of the measured tool pose at the end of the log against the task's goal (the
+    reference's last pose where the task is given in joint space), the orientation error the angle
+    of R_goalᵀ R."""
 
     name: str
     succeeded: bool
@@ -78,6 +82,8 @@ class Metrics:
     max_jerk: float
     tracking_error_joint_max_rad: float
     tracking_error_tcp_max_m: float
+    final_position_error_m: float
+    final_orientation_error_rad: float
     peak_torque_nm: list[float]
     peak_torque_over_limit: list[float]
     time_at_effort_limit_s: list[float]
@@ -109,6 +115,7 @@ class SimulationResult:
     acceleration_limit: np.ndarray
     effort_limit: np.ndarray
     waypoints: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    goal: np.ndarray = field(default_factory=lambda: np.full(6, np.nan))  # the task-space goal, NaN if none
     duration: float = float("nan")
     failure: Failure | None = None
     wall_time: float = float("nan")
@@ -162,6 +169,10 @@ class SimulationResult:
         tcp_error = np.linalg.norm(self.tcp_ref[:, :3] - self.tcp[:, :3], axis=1)
         simulated = float(self.t[-1]) if len(self.t) else 0.0
         jerk = self.jerk()
+        final_position = final_orientation = float("nan")
+        if len(self.t):
+            goal = self.goal if np.all(np.isfinite(self.goal)) else self.tcp_ref[-1]
+            final_position, final_orientation = pose_error(self.tcp[-1], goal)
         return Metrics(
             name=self.name,
             succeeded=self.succeeded,
@@ -178,6 +189,8 @@ class SimulationResult:
             max_jerk=float(np.abs(jerk).max()) if len(jerk) else 0.0,
             tracking_error_joint_max_rad=float(np.abs(self.q_ref - self.q_meas).max()),
             tracking_error_tcp_max_m=float(tcp_error.max()),
+            final_position_error_m=final_position,
+            final_orientation_error_rad=final_orientation,
             peak_torque_nm=np.abs(self.tau).max(axis=0).tolist(),
             peak_torque_over_limit=(np.abs(self.tau).max(axis=0) / self.effort_limit).tolist(),
             time_at_effort_limit_s=(self._saturated().sum(axis=0) * self.log_period).tolist(),
@@ -221,6 +234,7 @@ class SimulationResult:
             acceleration_limit=np.broadcast_to(planner.acceleration_limit, (n,)).astype(float),
             effort_limit=robot.effort_limits,
             waypoints=planner.task_waypoints(),
+            goal=np.full(6, np.nan) if planner.goal_pose() is None else np.asarray(planner.goal_pose(), dtype=float),
             duration=planner.finish_time(station.GetSubsystemContext(planner, station_context)),
             failure=failure,
             wall_time=wall_time,
@@ -236,7 +250,7 @@ class SimulationResult:
         """Write ``result.npz`` (arrays) and ``metrics.json`` into ``directory``; returns it."""
         directory = Path(directory)
         directory.mkdir(parents=True, exist_ok=True)
-        arrays = {name: getattr(self, name) for name in ARRAY_NAMES + _LIMIT_NAMES}
+        arrays = {name: getattr(self, name) for name in ARRAY_NAMES + _LIMIT_NAMES + ("goal",)}
         failure = None if self.failure is None else self.failure.to_dict()
         meta = {"name": self.name, "duration": self.duration, "failure": failure, "wall_time": self.wall_time,
                 "joint_types": list(self.joint_types), "robot": self.robot}
@@ -259,6 +273,8 @@ class SimulationResult:
                     raise ResultFileError(f"{path} is not a complete result: it has no {missing[0]!r}")
                 meta = json.loads(str(data["meta"]))
                 arrays = {name: np.array(data[name]) for name in ARRAY_NAMES + _LIMIT_NAMES}
+                if "goal" in data.files:  # runs saved before the goal was
+                    arrays["goal"] = np.array(data["goal"])
         except ResultFileError:
             raise
         except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
