@@ -366,6 +366,7 @@ _TagKeeper.add_multi_constructor("!", lambda loader, suffix, node: {"_tag": "!" 
 SHIPPED = {
     "quintic_ptp": yaml.load(QUINTIC, Loader=_TagKeeper),
     "boryga_loop_scara": yaml.load((DIAGRAMS / "boryga_loop.yaml").read_text(), Loader=_TagKeeper)["scara"],
+    "pajak_sim3": yaml.load((DIAGRAMS / "pajak.yaml").read_text(), Loader=_TagKeeper)["sim3"],
 }
 WEIRD = st.sampled_from([math.nan, math.inf, -math.inf, -1.0, 0.0, 1e9, -1e9, "text", True, [], [1.0], None])
 
@@ -405,7 +406,7 @@ def mutated_scenario(draw):
     return document
 
 
-@settings(max_examples=40, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=60, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(mutated_scenario())
 def test_mutated_scenarios_fail_cleanly_or_run_within_their_limits(tmp_path_factory, document):
     folder = tmp_path_factory.mktemp("mutated")
@@ -413,7 +414,7 @@ def test_mutated_scenarios_fail_cleanly_or_run_within_their_limits(tmp_path_fact
     path.write_text(emit({key: value for key, value in document.items() if value is not None}) + "\n")
     stderr = io.StringIO()
     with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
-        code = cli.main(["run", str(path), "--out", str(folder / "out"), "--no-preflight"])
+        code = cli.main(["run", str(path), "--out", str(folder / "out")])
     err = stderr.getvalue()
     assert "Traceback" not in err and "internal error" not in err, err
     if code == cli.EXIT_BAD_INPUT:
