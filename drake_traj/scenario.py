@@ -9,7 +9,6 @@ file and the field.
 """
 
 from dataclasses import dataclass, field, fields
-from importlib import resources
 from pathlib import Path
 
 import re
@@ -20,6 +19,7 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
 from drake_traj.station import ControllerGains, SpeedOverride, default_plant_config, default_simulator_config
+from drake_traj.data import data_directory
 from drake_traj.planners import PlannerConfig, PlannerSystem, QuinticConfig
 from drake_traj.planners import make_planner as make_planner_from_config
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE
@@ -141,7 +141,7 @@ class Scenario:
 
 def shipped_directory() -> Path:
     """The folder of the scenario files shipped with the package (``diagrams/``)."""
-    return Path(str(resources.files("drake_traj.diagrams")))
+    return data_directory("diagrams")
 
 
 def default_scenario_path() -> Path:

@@ -68,7 +68,7 @@ def test_live_view_shows_the_arm_the_task_and_a_growing_trail(tmp_path):
     process = subprocess.Popen(
         [sys.executable, "-m", "drake_traj.cli", "run", "pajak_sim3", "--out", str(out), "--meshcat",
          "--port", str(port), "--rate", "0.25", "--wait-timeout", "120"],
-        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     try:
         waiting = browser.read_until(process.stderr, "waiting up to", timeout=120)
         assert f"http://localhost:{port}" in waiting

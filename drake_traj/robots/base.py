@@ -14,12 +14,13 @@ inverse kinematics wrapper. Subclasses (frozen dataclasses) give the dimensions,
 
 from __future__ import annotations
 
-from importlib import resources
 from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
 from pydrake.multibody.parsing import Parser
+
+from drake_traj.data import data_directory
 
 __all__ = ["LIMIT_TOL", "PointRobot", "Robot"]
 
@@ -114,7 +115,7 @@ class Robot:
     # ---- model ---------------------------------------------------------------------------------
     def model_path(self) -> Path:
         """Absolute path of the robot's model file shipped with the package (``models/``)."""
-        path = Path(str(resources.files("drake_traj.models").joinpath(self.model_file)))
+        path = data_directory("models") / self.model_file
         if not path.is_file():
             raise ValueError(f"{self.name} model file not found: {path}")
         return path

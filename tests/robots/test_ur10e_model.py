@@ -324,7 +324,7 @@ def test_13_model_path_points_at_the_shipped_file():
 
 
 def test_14_model_path_reports_a_missing_file(monkeypatch, tmp_path):
-    monkeypatch.setattr(robot_base, "resources", SimpleNamespace(files=lambda package: tmp_path))
+    monkeypatch.setattr(robot_base, "data_directory", lambda name: tmp_path)
     with pytest.raises(ValueError, match="ur10e.urdf") as info:
         robot.model_path()
     assert str(tmp_path / "ur10e.urdf") in str(info.value)
