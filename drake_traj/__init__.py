@@ -28,7 +28,8 @@ from drake_traj.version import __version__
 
 
 __all__ = [
-    "BorygaConfig", "ControllerGains", "add_station", "build_station", "make_station", "run_station", "add_station", "build_station", "make_station", "run_station", "DrakeTrajError", "Failure", "LiConfig", "Metrics", "MovejConfig",
-    "PajakConfig", "PlanningError", "QuinticConfig", "Robot", "RuckigConfig", "Scenario", "SimulationResult",
-    "SingularConfigurationError", "ToppraConfig", "get_robot", "load_scenario", "make_planner", "simulate",
+    "add_station", "BorygaConfig", "build_station", "ControllerGains", "DrakeTrajError", "Failure",
+    "get_robot", "LiConfig", "load_scenario", "make_planner", "make_station", "Metrics", "MovejConfig",
+    "PajakConfig", "PlanningError", "QuinticConfig", "Robot", "RuckigConfig", "run_station", "Scenario",
+    "simulate", "SimulationResult", "SingularConfigurationError", "ToppraConfig",
 ]

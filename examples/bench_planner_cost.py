@@ -70,7 +70,7 @@ def floor_real_time_factor(scenario, duration: float = FLOOR_DURATION) -> float:
     builder.Connect(gravity.get_output_port_generalized_force(), plant.get_actuation_input_port(instance))
     for port in (source.get_output_port(), plant.get_state_output_port(instance),
                  plant.get_net_actuation_output_port(instance)):
-        LogVectorOutput(port, builder, {TriggerType.kPeriodic}, scenario.log_period)
+        LogVectorOutput(port, builder, {TriggerType.kPeriodic}, scenario.logging_period())
     simulator = Simulator(builder.Build())
     ApplySimulatorConfig(scenario.simulator, simulator)
     start = time.perf_counter()

@@ -3,6 +3,7 @@ and a public API that imports."""
 
 import ast
 import dataclasses
+import importlib
 from pathlib import Path
 
 import pytest
@@ -86,5 +87,8 @@ def test_config_fields_have_real_types_for_yaml(config):
 def test_public_api():
     for name in drake_traj.__all__:
         assert getattr(drake_traj, name) is not None
+    for name in MODULES:  # each name exported once
+        exported = getattr(importlib.import_module(name), "__all__", [])
+        assert len(exported) == len(set(exported)), name
     assert issubclass(drake_traj.PlanningError, drake_traj.DrakeTrajError)
     assert issubclass(drake_traj.DrakeTrajError, ValueError)
