@@ -176,9 +176,12 @@ def find_scenario(reference: str, variant: str | None = None) -> tuple[Path, str
     path = Path(reference)
     if path.is_file():
         return path, variant
-    if path.is_dir():
+    # a bare name is looked up among the shipped scenarios even when a folder of that name is
+    # here (e.g. an earlier run's --out quintic_ptp)
+    bare_name = path.suffix not in (".yaml", ".yml") and len(path.parts) == 1
+    if path.is_dir() and not (bare_name and _is_shipped_name(reference)):
         raise ScenarioError(f"scenario file {path} is a folder, not a scenario file")
-    if path.suffix in (".yaml", ".yml") or len(path.parts) > 1:
+    if not bare_name:
         raise ValueError(f"scenario file {path} not found")
     shipped = shipped_scenarios()
     for entry in shipped:
@@ -190,6 +193,12 @@ def find_scenario(reference: str, variant: str | None = None) -> tuple[Path, str
     names = ", ".join(entry.name for entry in shipped)
     raise ValueError(f"no scenario file {reference!r} and no shipped scenario of that name; "
                      f"shipped: {names} (drake-traj list)")
+
+
+def _is_shipped_name(reference: str) -> bool:
+    """True when ``reference`` names a shipped scenario or a shipped file."""
+    return (shipped_directory() / f"{reference}.yaml").is_file() or any(
+        entry.name == reference for entry in shipped_scenarios())
 
 
 def scenario_variants(path) -> list[str]:

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from drake_traj import QuinticConfig, cli
-from drake_traj.scenario import Scenario, default_scenario_path, load_scenario, make_planner, scenario_variants
+from drake_traj.scenario import (Scenario, default_scenario_path, find_scenario, load_scenario, make_planner,
+                                 scenario_variants)
 
 from conftest import DIAGRAMS
 
@@ -65,6 +66,16 @@ def test_bad_scenarios_name_the_field(tmp_path, change, message):
 def test_missing_scenario_file_is_named(tmp_path):
     with pytest.raises(ValueError, match="scenario file .*nowhere.yaml not found"):
         load_scenario(tmp_path / "nowhere.yaml")
+
+
+def test_a_shipped_name_is_found_beside_a_folder_of_that_name(tmp_path, monkeypatch):
+    # an earlier run written with --out quintic_ptp must not hide the shipped scenario
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "quintic_ptp").mkdir()
+    (tmp_path / "mine").mkdir()
+    assert find_scenario("quintic_ptp") == (DIAGRAMS / "quintic_ptp.yaml", None)
+    with pytest.raises(ValueError, match="mine is a folder, not a scenario file"):
+        find_scenario("mine")
 
 
 def test_cli_reports_bad_input_without_a_traceback(tmp_path, capsys):
