@@ -190,7 +190,7 @@ def test_look_ahead_steps_back_where_one_forward_pass_is_not_enough():
 # ---------------------------------------------------------------------------------------------
 
 
-def errata_time(case, length, v_s, v_e, v_m, acc) -> float:
+def corrected_time(case, length, v_s, v_e, v_m, acc) -> float:
     """Table 2 as corrected in docs/papers.md (A = (2/3) a_m). The paper's Table 2 uses a_m; see docs/papers.md."""
     v_a = math.sqrt((2 * acc * length + v_s**2 + v_e**2) / 2)  # eq. 13 (corrected)
     return {
@@ -254,7 +254,7 @@ def test_acc_dec_random_segments_cover_all_seven_cases():
         assert case == expected_case(length, v_s, v_e, v_m, acc)
         assert classify_acc_dec(length, v_s, v_e, v_m, a_max) == case
         # Table 2 (docs/papers.md) times.
-        assert profile.duration == pytest.approx(errata_time(case, length, v_s, v_e, v_m, acc), rel=1e-9)
+        assert profile.duration == pytest.approx(corrected_time(case, length, v_s, v_e, v_m, acc), rel=1e-9)
         # Dense samples plus both ramp midpoints (where the bell peaks).
         t = np.concatenate([tau * profile.duration, [0.5 * profile.t_acc],
                             [profile.duration - 0.5 * profile.t_dec]])

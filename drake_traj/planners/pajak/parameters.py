@@ -11,7 +11,7 @@ from drake_traj.validation import positive_vector
 __all__ = ["PAPER_METHOD", "PajakConfig", "paper_initial_configuration", "paper_parameters"]
 
 # The improvement flags of PajakConfig switched off: the paper's method as printed, with the
-# ERRATA corrections (used for the Table 2 reproduction and to show what each improvement fixes).
+# corrections of docs/papers.md (used for the Table 2 reproduction and to show what each improvement fixes).
 PAPER_METHOD = dict(
     smooth_penalty=False,
     continuous_switching=False,
@@ -23,7 +23,7 @@ PAPER_METHOD = dict(
 # UR10e geometry (standard DH) for the reach check of the waypoints.
 _D1 = float(robot.DH_D[0])
 SHOULDER = np.array([0.0, 0.0, _D1])  # shoulder point (joint-2 axis on the base axis) [m]
-REACH = 1.3  # [m], UR10e reach from the shoulder (ur10e_facts.md)
+REACH = 1.3  # [m], UR10e reach from the shoulder (docs/ur10e.md)
 
 
 @dataclass
@@ -38,7 +38,7 @@ class PajakConfig:
         velocity_limit: q̇_max = -q̇_min (scalar or 6) [rad/s], eq. 4.
         acceleration_limit: q̈_max = -q̈_min (scalar or 6) [rad/s²], eq. 5.
         vartheta: ϑ, penalty threshold on the normalised distance d (eq. 14), in (0, 0.5).
-        rho: ρ, penalty strength (eq. 14) [rad²/s³], not given in the paper (ERRATA: 0.03).
+        rho: ρ, penalty strength (eq. 14) [rad²/s³], not given in the paper (ours: 0.03, docs/papers.md).
         accuracy: ε, the task is finished when the TCP is this close to p_w [m] (and its
             orientation within ``orientation_accuracy``).
         orientation_accuracy: the task is finished when the angle of R_wᵀ R between the tool's
