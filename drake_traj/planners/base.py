@@ -213,18 +213,33 @@ class TimeLawPlanner(PlannerSystem):
         self.acceleration_limit = np.asarray(acceleration_limit, dtype=float)
         self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, 0.0]))
         self.DeclarePeriodicUnrestrictedUpdateEvent(update_period, 0.0, self._update)
+        self._last_evaluation = (None, None)  # (key, (q̈, c)) of evaluate
+        jumps = getattr(law, "acceleration_jumps", None)  # law times where q_law'' jumps (None: anywhere)
+        self._acceleration_jumps = None if jumps is None else sorted(np.asarray(jumps, dtype=float).tolist())
+
+    def _clock_state(self, context) -> tuple[float, float, float, float]:
+        """(c0, t0 [s], tau0 [s], ċ [1/s]) of the discrete state: the clock at the last update."""
+        c0, t0, _ = context.get_discrete_state(self.scaling_state_index).value().tolist()
+        tau0, c_rate = context.get_discrete_state(self.clock_state_index).value().tolist()
+        return c0, t0, tau0, c_rate
 
     def _clock(self, context):
         """(tau [s], c, ċ [1/s]) at the context's time."""
-        c0, t0, _ = context.get_discrete_state(self.scaling_state_index).get_value()
-        tau0, c_rate = context.get_discrete_state(self.clock_state_index).get_value()
+        c0, t0, tau0, c_rate = self._clock_state(context)
         tau, c = clock_at(context.get_time() - t0, tau0, c0, c_rate)
         return tau, c, c_rate
 
     def evaluate(self, context) -> tuple[np.ndarray, float]:
-        tau, c, c_rate = self._clock(context)
-        qd_law, qdd_law = self.law.rates_at(tau)
-        return qdd_law * c**2 + qd_law * c_rate, c
+        # q̈ depends on the time and the clock state only. Drake recomputes it at the start of
+        # every integration step (the plant's discrete update marks all discrete state changed),
+        # so the last result is kept by value: one law evaluation per (time, clock state).
+        key = (context.get_time(), *self._clock_state(context))
+        if key != self._last_evaluation[0]:
+            t, c0, t0, tau0, c_rate = key
+            tau, c = clock_at(t - t0, tau0, c0, c_rate)
+            qd_law, qdd_law = self.law.rates_at(tau)
+            self._last_evaluation = (key, (qdd_law * c**2 + qd_law * c_rate, c))
+        return self._last_evaluation[1]
 
     def finished(self, context) -> bool:
         return self._clock(context)[0] >= self.law.duration
@@ -246,16 +261,15 @@ class TimeLawPlanner(PlannerSystem):
 
     def _update(self, context, state):
         t, h = context.get_time(), self.update_period
-        c0, t0, _ = context.get_discrete_state(self.scaling_state_index).get_value()
-        tau0, c_rate = context.get_discrete_state(self.clock_state_index).get_value()
+        c0, t0, tau0, c_rate = self._clock_state(context)
         tau, c = clock_at(t - t0, tau0, c0, c_rate)
         goal = self.speed_cap * self.speed_override(context)
         finishing = tau >= self.law.duration and np.isnan(self.finish_time(context))
         tau_before = clock_at(max(t - h, t0) - t0, tau0, c0, c_rate)[0]
-        jumps = getattr(self.law, "acceleration_jumps", None)  # law times where q_law'' jumps
-        jumped = jumps is None or np.searchsorted(jumps, tau, "right") > np.searchsorted(jumps, tau_before, "right")
+        jumps = self._acceleration_jumps
+        jumped = jumps is None or bisect_right(jumps, tau) > bisect_right(jumps, tau_before)
         if c_rate == 0.0 and c == goal and not (jumped or finishing):
-            return EventStatus.DidNothing()  # the clock runs on as it is: no write, the cache stays valid
+            return EventStatus.DidNothing()  # the clock runs on as it is: nothing to write
         discrete = state.get_mutable_discrete_state()
         if finishing:  # finished in (t0, t]: tau0 + c0 s + ċ s² / 2 = duration
             roots = np.roots([0.5 * c_rate, c0, tau0 - self.law.duration]) if c_rate else [(self.law.duration - tau0) / c0]
@@ -305,6 +319,10 @@ class HermiteLaw:
             (-30 * delta + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h**2) / (2 * h**4),
             (12 * delta - 6 * (v1 + v0) * h + (a1 - a0) * h**2) / (2 * h**5),
         ], axis=1)
+        # (q̇, q̈) at s as one product, powers (1, s, s², s³, s⁴) @ [j c_j | j (j - 1) c_j]: (K-1, 5, 2n)
+        first = np.arange(1, 6)[None, :, None] * self._coefficients[:, 1:]
+        second = np.arange(1, 5)[None, :, None] * first[:, 1:]
+        self._rate_coefficients = np.concatenate([first, np.pad(second, ((0, 0), (0, 1), (0, 0)))], axis=2)
         self._end = left[-1].copy()
 
     def _interval(self, tau: float) -> tuple[int, float]:
@@ -324,8 +342,14 @@ class HermiteLaw:
         return q, (np.arange(1, 6) * powers[:5]) @ c[1:], (np.array([2, 6, 12, 20]) * powers[:4]) @ c[2:]
 
     def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
-        """(q̇, q̈) at law time ``tau`` [s]."""
-        return self.sample(tau)[1:]
+        """(q̇, q̈) at law time ``tau`` [s] (the planner's hot path: one 5 × 2n product)."""
+        n = self._end.shape[1]
+        if tau >= self.duration or tau < 0.0:
+            return np.zeros(n), np.zeros(n)
+        k, s = self._interval(tau)
+        s2 = s * s
+        rates = np.array((1.0, s, s2, s2 * s, s2 * s2)) @ self._rate_coefficients[k]
+        return rates[:n], rates[n:]
 
 
 def start_and_goals(q_initial, goals, num_joints: int) -> np.ndarray:
