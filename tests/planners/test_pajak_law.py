@@ -406,6 +406,21 @@ def test_acceleration_is_continuous(sim):
     assert ratios["literal"] > 0.85
 
 
+def test_jerk_budget_rates():
+    # improvement 1: the rate limits that keep c (and σ, the approach rate) from changing q̈ faster
+    # than the budget: budget / max |∂q̈_i/∂x|
+    from drake_traj.planners.pajak.kernel import budgeted_rate, scaling_slew
+
+    b = np.array([1.0, -200.0, 0.5, 0.0, 0.0, 0.0])
+    assert scaling_slew(b, 3.0, 40.0) == pytest.approx(0.2)  # 200 rad/s² per unit of c
+    assert scaling_slew(b / 100.0, 3.0, 40.0) == 3.0  # the budget is not reached below the slew
+    jac = np.diag([1.0, 2.0, 0.5, 1.0, 1.0, 1.0])
+    direction = np.array([0.0, 0.0, 2.0, 0.0, 0.0, 1.0])  # J⁻¹ direction = (0, 0, 4, 0, 0, 1)
+    assert budgeted_rate(jac, 0.0, False, direction, 0.5, 40.0) == pytest.approx(40.0 / (0.5 * 4.0))
+    still = budgeted_rate(jac, 0.0, False, np.zeros(6), 0.5, 40.0)  # x does not move q̈
+    assert np.isfinite(still) and still * 0.0 == 0.0 and still > 1e100
+
+
 def test_target_does_not_jump_at_the_switch():
     for overrides, continuous in (({}, True), (LITERAL, False)):
         result = run(1, **overrides)

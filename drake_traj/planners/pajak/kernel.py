@@ -31,9 +31,9 @@ from drake_traj.robots.ur10e import kinematics_into, orientation_error, wrapped
 
 __all__ = [
     "Discrete", "Evaluation", "Log", "Parameter", "Status", "acceleration_box", "acceleration_terms",
-    "approach_damping", "approach_rate", "blend_progress", "blended_target", "brake_weight", "choose_scaling",
-    "damping_factor", "evaluate_kernel", "finished_kernel", "integrate_kernel", "keep_limits", "scaling_interval",
-    "update_kernel", "velocity_penalty",
+    "approach_damping", "approach_rate", "blend_progress", "blended_target", "brake_weight", "budgeted_rate",
+    "choose_scaling", "damping_factor", "evaluate_kernel", "finished_kernel", "integrate_kernel", "keep_limits",
+    "scaling_interval", "scaling_slew", "update_kernel", "velocity_penalty",
 ]
 
 
@@ -60,6 +60,7 @@ Parameter = _layout("Parameter", [
     ("BLEND_DISTANCE", 1),  # path length through the ball at which σ = 1 [m]
     ("SCALING_RATE", 1),  # rate of eq. 18 [1/s]
     ("SCALING_SLEW", 1),  # largest |dc/dt| [1/s] (improvement 1)
+    ("JERK_BUDGET", 1),  # largest |dq̈_i/dt| that c, σ and the approach rate may cause [rad/s³] (improvement 1)
     ("SINGULARITY_THRESHOLD", 1), ("MAX_DAMPING", 1),  # damped least squares (improvement 3)
     ("APPROACH_DELTA", 1),  # δ of the approach rate [m] (improvement 4)
     ("STOP_SPEED", 1),  # stop mode: TCP speed below which a waypoint is reached [m/s]
@@ -84,6 +85,7 @@ Discrete = _layout("Discrete", [
     ("T_BEST", 1),  # when BEST last improved [s]
     ("BRAKE", 1), ("BRAKE_SLOPE", 1),  # fallback braking weight at the last update and its slope [1/s]
     ("SATURATED", 1),  # updates at which the limits overruled the law (improvement 2)
+    ("APPROACH", 1),  # approach rate of improvement 4 at the last update (0 where unused) [1/s]
 ])
 
 Evaluation = _layout("Evaluation", [
@@ -96,6 +98,7 @@ Evaluation = _layout("Evaluation", [
     ("POSE", 6), ("TARGET", 6),  # k(q) and the target of eq. 6 / eq. 19 [m, rad]
     ("POSITION_ERROR", 1), ("ORIENTATION_ERROR", 1),  # to the active waypoint (update_kernel) [m, rad]
     ("REMAINING", 1),  # remaining path to p_w (update_kernel) [m]
+    ("APPROACH", 1),  # approach rate the damping of improvement 4 is sized for (0 where unused) [1/s]
 ])
 
 _EVALUATION_SIZE = int(Evaluation.SIZE)  # a plain int for np.empty in compiled code
@@ -270,6 +273,40 @@ def acceleration_terms(jac, bias, error, error_rate, kp, damping, penalty, lam2,
     _solve(jac, use_damped, matrix, pivots, rhs, b)
     for i in range(6):
         b[i] = penalty[i] - b[i]
+
+
+@compiled
+def budgeted_rate(jac, lam2, use_damped, direction, scale: float, budget: float) -> float:
+    """Largest rate [1/s] at which a quantity that moves q̈ = a + c b (eq. 17) by
+    ∂q̈/∂x = -c J⁻¹ ``direction`` (``direction`` (6,) in task space, J⁻¹ damped as in
+    :func:`acceleration_terms`) may change without changing any q̈_i faster than ``budget``
+    [rad/s³] (improvement 1): budget / (c max |J⁻¹ direction|), with c = ``scale``, the largest
+    c until the next update. Very large (not infinite) where x does not move q̈, so that the
+    rate times 0 s is 0."""
+    matrix = np.empty((6, 6))
+    pivots = np.empty(6, dtype=np.int64)
+    _factor(jac, lam2, use_damped, matrix, pivots)
+    sensitivity = np.empty(6)
+    _solve(jac, use_damped, matrix, pivots, direction, sensitivity)
+    largest = 1e-300
+    for k in range(6):
+        largest = max(largest, scale * abs(sensitivity[k]))
+    return budget / largest
+
+
+@compiled
+def scaling_slew(b, slew: float, budget: float) -> float:
+    """Largest |dc/dt| [1/s] (improvement 1): ``slew``, lowered where a change of c at that rate
+    would change some q̈_i = a_i + c b_i faster than ``budget`` [rad/s³]: at most
+    budget / max |b_i|. Where c is small the law's b is large (b_i of 100-400 rad/s² with the
+    penalty of eq. 15 active and c of a few 10⁻³), and eq. 18's relaxation at (1 - c) per second
+    alone changed q̈ by 0.1-0.2 rad/s² per ms."""
+    largest = 0.0
+    for k in range(b.shape[0]):
+        largest = max(largest, abs(b[k]))
+    if largest * slew <= budget:
+        return slew
+    return budget / largest
 
 
 @compiled
@@ -499,12 +536,38 @@ def _evaluate_kernel(dependencies):
         out[Evaluation.BRAKE] = 0.0
         i = int(d[Discrete.WAYPOINT])
         last = int(p[Parameter.NUM_WAYPOINTS]) - 1
+        use_damped = p[Parameter.DAMPED_INVERSE] > 0.0 and measure < p[Parameter.SINGULARITY_THRESHOLD]
+        lam2 = 0.0
+        if use_damped:
+            lam2 = damping_factor(measure, p[Parameter.SINGULARITY_THRESHOLD], p[Parameter.MAX_DAMPING])
+        kp = p[Parameter.KP:Parameter.KP + 6]
+        limited = p[Parameter.LIMIT_ACCELERATION] > 0.0
+        bounded = limited and p[Parameter.BOUNDED_SCALING] > 0.0
+        elapsed = max(t - d[Discrete.T_UPDATE], 0.0)
+        # c is at most this until the next update (improvement 1's rate limit of c)
+        scale_bound = min(d[Discrete.C] + p[Parameter.SCALING_SLEW] * elapsed, 1.0)
+        out[Evaluation.APPROACH] = 0.0
         sigma = 0.0
         if p[Parameter.BLEND_WAYPOINTS] > 0.0 and d[Discrete.BLENDING] > 0.5:
             raw, _ = blend_progress(pose, d[Discrete.X_REF:Discrete.X_REF + 3], d[Discrete.TRAVEL],
                                     p[Parameter.BLEND_DISTANCE])
+            following = min(i + 1, last)
+            if bounded:
+                # improvement 1: σ follows the TCP's path, but no faster than the jerk budget
+                # allows. The target moves by p_{i+1} - p_i per unit of σ, so q̈ by
+                # c J⁻¹ (Λ_P ∘ (p_{i+1} - p_i)) (eq. 17). Driven by the path alone σ moves the
+                # target at (path speed) |p_{i+1} - p_i| / (1.25 ϵ): on a long leg entered at
+                # speed, q̈ changed by up to 0.17 rad/s² per ms for tens of ms.
+                step = np.empty(6)
+                for k in range(6):
+                    step[k] = waypoints[following, k] - waypoints[i, k]
+                    if k >= 3:
+                        step[k] = wrapped(step[k])
+                    step[k] *= kp[k]
+                rate = budgeted_rate(jac, lam2, use_damped, step, scale_bound, p[Parameter.JERK_BUDGET])
+                raw = min(raw, d[Discrete.SIGMA] + rate * elapsed)
             sigma = max(raw, d[Discrete.SIGMA])  # σ never decreases
-            target[:] = blended_target(waypoints[i], waypoints[min(i + 1, last)], sigma)  # eq. 19
+            target[:] = blended_target(waypoints[i], waypoints[following], sigma)  # eq. 19
         else:
             target[:] = waypoints[i]  # eq. 6
         out[Evaluation.SIGMA] = sigma
@@ -525,13 +588,7 @@ def _evaluate_kernel(dependencies):
                 if abs(qd[k]) > p[Parameter.PENALTY_ONSET + k]:
                     penalty[k] = velocity_penalty(qd[k], p[Parameter.QD_MAX + k], p[Parameter.RHO],
                                                   p[Parameter.VARTHETA], smooth)  # eq. 14-15
-        use_damped = p[Parameter.DAMPED_INVERSE] > 0.0 and measure < p[Parameter.SINGULARITY_THRESHOLD]
-        lam2 = 0.0
-        if use_damped:
-            lam2 = damping_factor(measure, p[Parameter.SINGULARITY_THRESHOLD], p[Parameter.MAX_DAMPING])
-        kp = p[Parameter.KP:Parameter.KP + 6]
         damping = p[Parameter.KV:Parameter.KV + 6].copy()
-        limited = p[Parameter.LIMIT_ACCELERATION] > 0.0
         c_r = 1.0
         if limited:
             c_r = relaxed_scaling(t, d[Discrete.T0], d[Discrete.C0], d[Discrete.GOAL],
@@ -556,6 +613,23 @@ def _evaluate_kernel(dependencies):
                         final[k] = wrapped(final[k])
                 closing = approach_rate(final, error_rate, p[Parameter.APPROACH_DELTA])
                 scale = min(max(c_r, SCALE_FLOOR), 1.0)
+                previous = d[Discrete.APPROACH]
+                if bounded and closing < previous:
+                    # improvement 1: the damping eases off no faster than the jerk budget allows.
+                    # When the TCP sweeps past p_w within millimetres, r falls from several per
+                    # second to 0 within a few ms, and with it the damping (per unit of c, several
+                    # times Λ_V with c_r at SCALE_FLOOR): q̈ changed by up to 0.15 rad/s² per ms.
+                    # Held higher, r only adds damping (no overshoot); it may rise at once.
+                    # ∂q̈/∂r = -c J⁻¹ (weight ∂D/∂r ∘ ė) (eq. 17), with the largest slope of
+                    # approach_damping (per unit of c): 1 - K/r² < 1 above r = 2 √K, at most
+                    # 1.5 (2.5 - D_0/√K) on its smoothstep (D_0 the damping it starts from).
+                    direction = np.empty(6)
+                    for k in range(6):
+                        slope = max(1.0, 1.5 * (2.5 - damping[k] * math.sqrt(scale / kp[k])))
+                        direction[k] = weight * slope / scale * error_rate[k]
+                    fall = budgeted_rate(jac, lam2, use_damped, direction, scale_bound, p[Parameter.JERK_BUDGET])
+                    closing = max(closing, previous - fall * elapsed)
+                out[Evaluation.APPROACH] = closing
                 for k in range(6):
                     held = approach_damping(closing, scale * kp[k], scale * damping[k])
                     damping[k] += weight * (held / scale - damping[k])  # per unit of c
@@ -580,8 +654,7 @@ def _evaluate_kernel(dependencies):
                 qdd[k] = a[k] + c * b[k]  # eq. 17
             return
         qdd_max = p[Parameter.QDD_MAX:Parameter.QDD_MAX + 6]
-        elapsed = max(t - d[Discrete.T_UPDATE], 0.0)
-        slew = p[Parameter.SCALING_SLEW] * elapsed
+        slew = scaling_slew(b, p[Parameter.SCALING_SLEW], p[Parameter.JERK_BUDGET]) * elapsed
         c, violation = keep_limits(a, b, c_r, lower, upper, qdd_max, d[Discrete.C] - slew, d[Discrete.C] + slew,
                                    qdd)
         out[Evaluation.C] = c
@@ -648,6 +721,7 @@ def _update_kernel(dependencies):
             d[Discrete.BRAKE_SLOPE] = min(max((target - weight) / BRAKE_LAG, -BRAKE_SLEW), BRAKE_SLEW)
             d[Discrete.SATURATED] += out[Evaluation.SATURATED]
         d[Discrete.C] = c
+        d[Discrete.APPROACH] = out[Evaluation.APPROACH]
         d[Discrete.T_UPDATE] = t
         i = int(d[Discrete.WAYPOINT])
         last = int(p[Parameter.NUM_WAYPOINTS]) - 1
@@ -691,6 +765,7 @@ def _update_kernel(dependencies):
                     d[Discrete.T0] = t
                     d[Discrete.C0] = 0.0
                     d[Discrete.C] = 0.0
+                    d[Discrete.APPROACH] = 0.0  # a new approach (with c = 0, b does not move q̈)
         finished = pose_reached(pose, waypoints[i], p, out) and i >= last
         # progress monitor: remaining path = distance to p_i (+ weighted orientation) + the rest
         left = out[Evaluation.POSITION_ERROR] + ORIENTATION_LENGTH * out[Evaluation.ORIENTATION_ERROR] + remaining[i]

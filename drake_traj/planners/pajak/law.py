@@ -96,7 +96,8 @@ class PajakLaw:
             (Parameter.VARTHETA, p.vartheta), (Parameter.RHO, p.rho), (Parameter.ACCURACY, p.accuracy),
             (Parameter.ORIENTATION_ACCURACY, p.orientation_accuracy), (Parameter.NEIGHBOURHOOD, p.neighbourhood),
             (Parameter.BLEND_DISTANCE, p.blend_length * p.neighbourhood), (Parameter.SCALING_RATE, p.scaling_rate),
-            (Parameter.SCALING_SLEW, p.scaling_slew), (Parameter.SINGULARITY_THRESHOLD, p.singularity_threshold),
+            (Parameter.SCALING_SLEW, p.scaling_slew), (Parameter.JERK_BUDGET, p.jerk_budget),
+            (Parameter.SINGULARITY_THRESHOLD, p.singularity_threshold),
             (Parameter.MAX_DAMPING, p.max_damping),
             (Parameter.APPROACH_DELTA, 1e-4 * p.accuracy),  # improvement 4: keeps the approach rate finite at p_w
             (Parameter.STOP_SPEED, p.stop_speed), (Parameter.STALL_TIME, p.stall_time),

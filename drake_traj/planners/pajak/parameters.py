@@ -58,6 +58,10 @@ class PajakConfig:
         scaling_rate: rate of eq. 18 [1/s] (1 in the paper).
         scaling_slew: improvement 1 (with ``bounded_scaling``): c changes by at most this per
             second [1/s]; where the limits would need c to fall faster, q̈ is clipped to them.
+        jerk_budget: improvement 1 (with ``limit_acceleration`` and ``bounded_scaling``): the
+            largest rate [rad/s³] at which each of these may change any q̈_i: c (its rate limit
+            is lowered below ``scaling_slew``), the blend's σ moving the target (eq. 19) and the
+            approach rate of improvement 4 falling (the feedback itself is not limited).
         singularity_threshold: damped least squares below this :func:`drake_traj.robot.singularity_measure`.
         max_damping: damping λ of the damped least squares at a singular J.
         stop_speed: stop mode: TCP speed [m/s] below which a waypoint counts as reached.
@@ -91,6 +95,7 @@ class PajakConfig:
     preserve_damping: bool = True
     scaling_rate: float = 1.0
     scaling_slew: float = 3.0
+    jerk_budget: float = 40.0
     singularity_threshold: float = 0.1
     max_damping: float = 0.2
     stop_speed: float = 0.01
@@ -130,7 +135,7 @@ class PajakConfig:
         for name in ("position_gain", "velocity_gain", "velocity_limit", "acceleration_limit"):
             values[name] = positive_vector(getattr(self, name), name, n)
         for name in (
-            "rho", "accuracy", "orientation_accuracy", "neighbourhood", "scaling_rate", "scaling_slew",
+            "rho", "accuracy", "orientation_accuracy", "neighbourhood", "scaling_rate", "scaling_slew", "jerk_budget",
             "singularity_threshold", "max_damping",
             "stop_speed", "stall_time", "blend_length", "update_period",
         ):
