@@ -290,7 +290,7 @@ def test_table_2(sim, method):
     t_paper, qd_max_paper, qd_min_paper = TABLE2[sim]
     qd, qdd = until_finish(result, "qd"), until_finish(result, "qdd")
     # paper: 4.98 / 5.22 / 5.32 s; docs/papers.md recomputed 4.95-5.17 / 5.20-5.42 / 5.26-5.43. Sim 3
-    # improved: 5.332 s, passing p_f by 0.17 mm (literal: 5.351 s, finishing while 0.76 mm past p_f)
+    # improved: 5.332 s, passing p_f by 0.17 mm (literal: 5.351 s, 0.76 mm past p_f and back)
     assert result["T"] == pytest.approx(t_paper, rel=0.05)
     assert result["T"] == pytest.approx(TABLE2_RECOMPUTED[method][sim], abs=1.5e-3)
     assert qd.max() == pytest.approx(qd_max_paper, abs=0.06)
