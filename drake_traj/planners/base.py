@@ -219,8 +219,9 @@ class TimeLawPlanner(PlannerSystem):
 
     def _clock_state(self, context) -> tuple[float, float, float, float]:
         """(c0, t0 [s], tau0 [s], ċ [1/s]) of the discrete state: the clock at the last update."""
-        c0, t0, _ = context.get_discrete_state(self.scaling_state_index).value().tolist()
-        tau0, c_rate = context.get_discrete_state(self.clock_state_index).value().tolist()
+        discrete = context.get_discrete_state()
+        c0, t0, _ = discrete.value(self.scaling_state_index).tolist()
+        tau0, c_rate = discrete.value(self.clock_state_index).tolist()
         return c0, t0, tau0, c_rate
 
     def _clock(self, context):
@@ -229,10 +230,16 @@ class TimeLawPlanner(PlannerSystem):
         tau, c = clock_at(context.get_time() - t0, tau0, c0, c_rate)
         return tau, c, c_rate
 
+    def acceleration(self, context) -> np.ndarray:
+        return self.evaluate(context)[0]  # kept by value below, cheaper than the context's cache here
+
+    def scaling(self, context) -> float:
+        return self.evaluate(context)[1]
+
     def evaluate(self, context) -> tuple[np.ndarray, float]:
         # q̈ depends on the time and the clock state only. Drake recomputes it at the start of
-        # every integration step (the plant's discrete update marks all discrete state changed),
-        # so the last result is kept by value: one law evaluation per (time, clock state).
+        # every integration step (the step's updates mark all discrete state changed), so the
+        # last result is kept by value: one law evaluation per (time, clock state).
         key = (context.get_time(), *self._clock_state(context))
         if key != self._last_evaluation[0]:
             t, c0, t0, tau0, c_rate = key
