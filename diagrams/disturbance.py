@@ -55,7 +55,7 @@ def main(argv=None) -> SimulationResult:
     result = SimulationResult.from_station(station, station.GetMyContextFromRoot(simulator.get_context()),
                                            name="disturbance", failure=failure, tracking_tolerance=0.05)
 
-    result.save(args.out)
+    result.save(args.out, overwrite=True)  # this script's own folder: a rerun replaces its run
     result.save_figures(args.out)
     joint_error = 1e3 * (result.q_ref[:, args.joint - 1] - result.q_meas[:, args.joint - 1])
     tcp_error = 1e3 * np.linalg.norm(result.tcp_ref[:, :3] - result.tcp[:, :3], axis=1)

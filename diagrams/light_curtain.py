@@ -54,7 +54,7 @@ def main(argv=None) -> SimulationResult:
     result = SimulationResult.from_station(station, station.GetMyContextFromRoot(simulator.get_context()),
                                            name="light_curtain", failure=failure)
 
-    result.save(args.out)
+    result.save(args.out, overwrite=True)  # this script's own folder: a rerun replaces its run
     result.save_figures(args.out)
     figure = Figure(figsize=(8, 3.5), layout="constrained")
     ax = figure.subplots()

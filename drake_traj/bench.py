@@ -396,14 +396,17 @@ def _engine(workers, scheduler):
 # --------------------------------------------------------------------------------------------
 
 
-def _check_arguments(count, seed, repeats, workers, scheduler, planners, extra_planners) -> None:
-    def whole(value, name, option, least):
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < least:
-            raise BenchSetupError(f"{name} ({option}) must be a whole number >= {least}, got {value!r}")
+MAX_COUNT = 10_000  # seeded tasks per bench: each costs about 10 s of one core here (all planners)
 
-    whole(count, "count", "--count", 0)
+
+def _check_arguments(count, seed, repeats, workers, scheduler, planners, extra_planners) -> None:
+    def whole(value, name, option, least, most=2**32 - 1):
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not least <= value <= most:
+            raise BenchSetupError(f"{name} ({option}) must be a whole number from {least} to {most}, got {value!r}")
+
+    whole(count, "count", "--count", 0, MAX_COUNT)
     whole(seed, "seed", "--seed", 0)
-    whole(repeats, "repeats", "--repeats", 1)
+    whole(repeats, "repeats", "--repeats", 1, 1000)
     if workers is not None:
         whole(workers, "workers", "--workers", 1)
         if scheduler is not None:

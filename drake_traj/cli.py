@@ -13,13 +13,17 @@ every planner and baseline on Pająk 2024's task and N seeded tasks and writes D
 bench.md and bench.png.
 
 Exit codes: 0 success; 1 the run failed (its log is kept in the output folder); 2 bad input
-(nothing was run); 130 interrupted (what was logged is kept). ``--debug`` shows the traceback of
-an error.
+(nothing was run); 130 interrupted by Ctrl-C or SIGTERM (what was logged is kept). ``--debug``
+shows the traceback of an error.
 """
 
 import argparse
+import contextlib
 import json
+import re
+import signal
 import sys
+import threading
 import traceback
 from pathlib import Path
 
@@ -32,8 +36,9 @@ from drake_traj.errors import DrakeTrajError, PlanningError
 from drake_traj.export import FORMATS, UR_CYCLE, ExportError
 from drake_traj.meshcat import add_live_view, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
 from drake_traj.result import SimulationResult
-from drake_traj.rundir import prepare_output, write_manifest
-from drake_traj.scenario import DEFAULT_SCENARIO, default_scenario_path, find_scenario, load_scenario, shipped_scenarios
+from drake_traj.rundir import MANIFEST, add_to_manifest, begin_output, check_output, run_files, write_manifest
+from drake_traj.scenario import (DEFAULT_SCENARIO, ScenarioError, default_scenario_path, find_scenario, load_scenario,
+                                 locate_in_scenario, shipped_scenarios)
 from drake_traj.station import simulate
 
 EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
@@ -69,19 +74,57 @@ def _scenario_reference(args) -> tuple[Path, str | None]:
     return find_scenario(args.scenario, args.variant)
 
 
+@contextlib.contextmanager
+def _interrupts_deferred():
+    """Ctrl-C and SIGTERM wait until the block is done (writing a run's files); yields the list
+    of the signals received meanwhile. Outside the main thread, signals are not ours to handle."""
+    received = []
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
+    previous = {number: signal.signal(number, lambda signum, frame: received.append(signum))
+                for number in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield received
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+def _preflight(planner, scenario):
+    """The planner's preflight; its PlanningError located in the scenario file (a waypoint it
+    names, as ``planner.waypoints[i]``)."""
+    try:
+        return planner.preflight()
+    except PlanningError as error:
+        waypoint = re.search(r"waypoint (\d+)", str(error))
+        field = f"planner.waypoints[{waypoint.group(1)}]" if waypoint else "planner"
+        raise PlanningError(locate_in_scenario(scenario, f"{field}: {error}"), time=None, cause=error.cause,
+                            partial=error.partial) from error
+
+
 def run(args) -> int:
     """``drake-traj run``: simulate one scenario and write its outputs; returns the exit code."""
     scenario = load_scenario(*_scenario_reference(args))
-    out_dir = prepare_output(Path(args.out) if args.out else Path("out") / scenario.name, overwrite=args.overwrite)
+    if args.out == "":
+        raise ValueError("--out must name a folder, got empty text")
     progress = Progress(scenario.max_duration, enabled=sys.stderr.isatty())
+    interrupts = []
     try:
         arguments = scenario.station_arguments()
         planner = arguments.pop("planner")
         planned_path = None
         if args.preflight:
             progress.stage("preflight")
-            planned_path = planner.preflight()
+            planned_path = _preflight(planner, scenario)
         duration = planner.planned_duration()
+        if np.isfinite(duration) and duration > scenario.max_duration:
+            raise ScenarioError(locate_in_scenario(
+                scenario, f"max_duration ({scenario.max_duration:g} s) is shorter than the planned motion "
+                          f"({duration:.3f} s at the planner's limits); raise max_duration or the limits"))
+        # checked before the simulation; written (an earlier run replaced, with --overwrite) only
+        # once there are results
+        out_dir = check_output(Path(args.out) if args.out else Path("out") / scenario.name, overwrite=args.overwrite)
         progress.expect(duration + scenario.settle_time if np.isfinite(duration) else scenario.max_duration)
         meshcat = start_meshcat(args.port, announce=args.meshcat)
         draw_task(meshcat, planner.task_waypoints(), planned_path=planned_path)
@@ -111,15 +154,17 @@ def run(args) -> int:
                           progress=progress.simulated, add_systems=add_systems, before_run=before_run,
                           tracking_tolerance=scenario.tracking_tolerance, **arguments)
         progress.stage("writing figures")
-        result.save(out_dir)
-        files = ["result.npz", "metrics.json"] + [path.name for path in result.save_figures(out_dir)]
-        for stem, figure in planner.figures().items():
-            figure.savefig(out_dir / f"{stem}.png", dpi=110)
-            files.append(f"{stem}.png")
-        draw_tcp_path(meshcat, result.tcp)
-        files.append(export_html(meshcat, out_dir / "meshcat.html").name)
-        write_manifest(out_dir, files, scenario=scenario.name, drake_traj=__version__,
-                       failure=None if result.failure is None else result.failure.to_dict())
+        with _interrupts_deferred() as interrupts:  # a second Ctrl-C must not leave half a run
+            out_dir = begin_output(out_dir, overwrite=args.overwrite)
+            result.save(out_dir)
+            files = ["result.npz", "metrics.json"] + [path.name for path in result.save_figures(out_dir)]
+            for stem, figure in planner.figures().items():
+                figure.savefig(out_dir / f"{stem}.png", dpi=110)
+                files.append(f"{stem}.png")
+            draw_tcp_path(meshcat, result.tcp)
+            files.append(export_html(meshcat, out_dir / "meshcat.html").name)
+            write_manifest(out_dir, files, scenario=scenario.name, drake_traj=__version__,
+                           failure=None if result.failure is None else result.failure.to_dict())
     finally:
         progress.close()
     metrics = result.metrics().to_dict()
@@ -132,6 +177,9 @@ def run(args) -> int:
                 input()
         except (KeyboardInterrupt, EOFError):
             pass
+    if interrupts:
+        print("drake-traj: interrupted while writing; the run's files were completed first", file=sys.stderr)
+        return EXIT_INTERRUPTED
     if result.succeeded:
         return EXIT_OK
     return EXIT_INTERRUPTED if result.failure.cause == "interrupted" else EXIT_RUN_FAILED
@@ -148,14 +196,25 @@ def list_scenarios(args) -> int:
 
 def export_run(args) -> int:
     """``drake-traj export``: a run's reference as CSV, URScript or a ROS 2 JointTrajectory."""
-    result = SimulationResult.load(args.run_dir)
-    out = Path(args.out) if args.out else Path(args.run_dir) / f"reference{FORMATS[args.format]}"
+    run_dir = Path(args.run_dir)
+    result = SimulationResult.load(run_dir)
+    out = Path(args.out) if args.out else run_dir / f"reference{FORMATS[args.format]}"
+    into_run = out.parent.resolve() == run_dir.resolve()
+    if into_run and out.name in {"result.npz", "metrics.json", MANIFEST} | set(run_files(run_dir)) - set(_exports()):
+        raise ExportError(f"--out {out} is one of the run's own files; give another file name")
     if out.exists() and not args.overwrite:
         raise ExportError(f"--out {out} exists; pass --overwrite to replace it")
     path = result.export(out, args.format, period=args.period, lookahead_time=args.lookahead_time, gain=args.gain,
-                         approach_speed=args.approach_speed)
+                         approach_speed=args.approach_speed, allow_failed=args.allow_failed)
+    if into_run and (run_dir / MANIFEST).is_file():
+        add_to_manifest(run_dir, path.name)  # replacing the run (--overwrite) removes its exports too
     print(f"wrote {path}")
     return EXIT_OK
+
+
+def _exports() -> list[str]:
+    """The default export file names (reference.csv, ...), which an export may replace."""
+    return [f"reference{suffix}" for suffix in FORMATS.values()]
 
 
 def run_bench(args) -> int:
@@ -173,6 +232,10 @@ def check_options(args) -> None:
                   ("--rate", np.isfinite(args.rate) and args.rate > 0, args.rate, "a positive real-time rate"),
                   ("--wait-timeout", np.isfinite(args.wait_timeout) and args.wait_timeout >= 0, args.wait_timeout,
                    "a number of seconds >= 0")]
+        live_only = [option for option, given in (("--rate", args.rate != 1.0), ("--port", args.port is not None),
+                                                  ("--no-wait", not args.wait)) if given]
+        if live_only and not args.meshcat:
+            raise ValueError(f"{live_only[0]} sets up the live view; add --meshcat (or leave {live_only[0]} out)")
     for option, ok, value, expected in checks:
         if not ok:
             raise ValueError(f"{option} must be {expected}, got {value}")
@@ -209,6 +272,8 @@ def build_parser() -> argparse.ArgumentParser:
     export_parser.add_argument("--period", type=float, default=UR_CYCLE, help="sampling period [s] (default 0.002)")
     export_parser.add_argument("--out", default=None, help="the file to write (default: RUN_DIR/reference.<ext>)")
     export_parser.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
+    export_parser.add_argument("--allow-failed", action="store_true",
+                               help="export the reference of a run that failed (marked as failed in the file)")
     export_parser.add_argument("--lookahead-time", type=float, default=0.1, help="URScript servoj lookahead [s], 0.03-0.2")
     export_parser.add_argument("--gain", type=float, default=300.0, help="URScript servoj gain, 100-2000")
     export_parser.add_argument("--approach-speed", type=float, default=0.3,
@@ -232,6 +297,9 @@ def main(argv=None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as done:  # --help, --version, or a usage error argparse printed (code 2)
         return done.code
+    on_main_thread = threading.current_thread() is threading.main_thread()
+    if on_main_thread:  # SIGTERM (a job scheduler, kill) stops a run like Ctrl-C: its log is kept
+        previous_sigterm = signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
     try:
         check_options(args)
         return args.handler(args)
@@ -241,13 +309,20 @@ def main(argv=None) -> int:
     except (DrakeTrajError, ValueError) as error:  # bad input: one paragraph, no traceback
         kind = "the task cannot be done" if isinstance(error, PlanningError) else "error"
         print(f"drake-traj: {kind}: {error}", file=sys.stderr)
-        code = EXIT_BAD_INPUT
+        failure, code = error, EXIT_BAD_INPUT
     except Exception as error:  # a bug, or the machine (disk full, ...): still no traceback unless asked
         print(f"drake-traj: internal error: {type(error).__name__}: {error} (--debug shows where)", file=sys.stderr)
-        code = EXIT_RUN_FAILED
+        failure, code = error, EXIT_RUN_FAILED
+    finally:
+        if on_main_thread:
+            signal.signal(signal.SIGTERM, previous_sigterm)
     if args.debug:
-        traceback.print_exc()
+        traceback.print_exception(failure)
     return code
+
+
+def _raise_keyboard_interrupt(signum, frame):
+    raise KeyboardInterrupt
 
 
 if __name__ == "__main__":

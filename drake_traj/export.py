@@ -24,6 +24,7 @@ __all__ = ["FORMATS", "ExportError", "export", "reference_trajectory", "resample
 
 FORMATS = {"csv": ".csv", "urscript": ".script", "ros2": ".yaml"}
 UR_CYCLE = 0.002  # [s], the UR controller's servo cycle (500 Hz)
+MIN_PERIOD = 1e-4  # [s], the finest resampling (10 kHz): the log itself is at 1 ms
 LOOKAHEAD_RANGE = (0.03, 0.2)  # [s], servoj lookahead_time (UR script manual)
 GAIN_RANGE = (100.0, 2000.0)  # servoj gain (UR script manual)
 
@@ -41,8 +42,14 @@ def reference_trajectory(result) -> PiecewisePolynomial:
 
 def resample(result, period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(t, q, q̇, q̈) every ``period`` [s] from 0 to the end of the log (see the module docstring)."""
-    if not np.isfinite(period) or period <= 0:
-        raise ExportError(f"--period must be a positive number of seconds, got {period}")
+    if not np.isfinite(period) or not MIN_PERIOD <= period <= result.t[-1] / 2:
+        raise ExportError(f"--period must be between {MIN_PERIOD:g} s and half the logged motion "
+                          f"({result.t[-1] / 2:g} s: at least three samples), got {period:g}")
+    for name in ("t", "q_ref", "qd_ref", "qdd_ref"):
+        bad = np.argwhere(~np.isfinite(getattr(result, name)))
+        if len(bad):
+            raise ExportError(f"the reference of the run {result.name!r} is not finite: {name} at sample {bad[0][0]} "
+                              f"is {getattr(result, name)[tuple(bad[0])]}; nothing was written")
     trajectory = reference_trajectory(result)
     times = np.arange(0, int(np.floor(result.t[-1] / period + 1e-9)) + 1) * period
     derivative = trajectory.MakeDerivative()
@@ -118,8 +125,11 @@ def _ros2(result, t, q, qd, qdd, joint_names) -> str:
 
 
 def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_time: float = 0.1, gain: float = 300.0,
-           approach_speed: float = 0.3) -> Path:
+           approach_speed: float = 0.3, allow_failed: bool = False) -> Path:
     """Write ``result``'s reference to ``path`` as ``format`` ("csv", "urscript" or "ros2").
+
+    A run that failed (its planner did not finish, or the arm could not follow) is refused unless
+    ``allow_failed``; then the file says so in its header.
 
     Args:
         period: the sampling period [s] (URScript: at least the controller's 2 ms cycle).
@@ -132,6 +142,9 @@ def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_tim
     """
     if format not in FORMATS:
         raise ExportError(f"--format must be one of {sorted(FORMATS)}, got {format!r}")
+    if result.failure is not None and not allow_failed:
+        raise ExportError(f"the run {result.name!r} failed ({result.failure}); its reference is not a motion to "
+                          "send anywhere. Nothing was written (--allow-failed writes it anyway, marked as failed)")
     if format == "urscript":
         if not period >= UR_CYCLE - 1e-12:
             raise ExportError(f"--period must be at least the UR controller's cycle {UR_CYCLE} s, got {period}")
@@ -149,6 +162,8 @@ def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_tim
     else:
         names = UR10E.joint_names if result.robot == UR10E.name else [f"joint_{j + 1}" for j in range(q.shape[1])]
         text = _ros2(result, t, q, qd, qdd, names)
+    if result.failure is not None:  # allowed: the first line says so (a comment in all three formats)
+        text = f"# FAILED RUN: {' '.join(str(result.failure).split())}\n" + text
     path = Path(path)
     if path.is_dir():
         raise ExportError(f"--out {path} is a folder; give a file name")

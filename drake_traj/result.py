@@ -19,6 +19,7 @@ from matplotlib.figure import Figure
 
 from drake_traj.errors import DrakeTrajError, Failure
 from drake_traj.export import export, reference_trajectory
+from drake_traj.rundir import OutputError, clear_run, holds_a_run
 from drake_traj.robots.ur10e import pose_error
 
 __all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult"]
@@ -246,9 +247,16 @@ class SimulationResult:
         return result
 
     # --- persistence ---------------------------------------------------------------------------
-    def save(self, directory) -> Path:
-        """Write ``result.npz`` (arrays) and ``metrics.json`` into ``directory``; returns it."""
+    def save(self, directory, *, overwrite: bool = False) -> Path:
+        """Write ``result.npz`` (arrays) and ``metrics.json`` into ``directory``; returns it. A folder
+        that holds another run is refused (:class:`~drake_traj.rundir.OutputError`) unless
+        ``overwrite``, which first removes that run's files."""
         directory = Path(directory)
+        if directory.is_dir() and holds_a_run(directory):
+            if not overwrite:
+                raise OutputError(f"{directory} holds another run; save into a new folder, or pass "
+                                  "overwrite=True to replace it")
+            clear_run(directory)
         directory.mkdir(parents=True, exist_ok=True)
         arrays = {name: getattr(self, name) for name in ARRAY_NAMES + _LIMIT_NAMES + ("goal",)}
         failure = None if self.failure is None else self.failure.to_dict()
@@ -286,6 +294,8 @@ class SimulationResult:
             if len(arrays[name]) != samples or not np.issubdtype(arrays[name].dtype, np.floating):
                 raise ResultFileError(f"{path}: the array {name!r} has {len(arrays[name])} rows of "
                                       f"{arrays[name].dtype}, the log {samples} rows of numbers")
+        if arrays["t"].ndim != 1 or not np.all(np.diff(arrays["t"]) > 0):
+            raise ResultFileError(f"{path}: the log's times 't' do not increase from sample to sample")
         try:
             if meta["failure"] is not None:
                 meta["failure"] = Failure.from_dict(meta["failure"])

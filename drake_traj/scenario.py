@@ -15,8 +15,9 @@ import re
 
 import numpy as np
 from pydrake.common.yaml import yaml_load_typed
-from pydrake.multibody.plant import MultibodyPlantConfig
+from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
+from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj.station import ControllerGains, SpeedOverride, default_plant_config, default_simulator_config
 from drake_traj.data import data_directory
@@ -27,12 +28,15 @@ from drake_traj.robots import get_robot
 from drake_traj.yaml_schema import ScenarioError, checked_document, locate
 
 __all__ = [
-    "Scenario", "ScenarioError", "ShippedScenario", "default_scenario_path", "find_scenario", "load_scenario", "make_planner",
-    "scenario_variants", "shipped_scenarios",
+    "Scenario", "ScenarioError", "ShippedScenario", "default_scenario_path", "find_scenario", "load_scenario",
+    "locate_in_scenario", "make_planner", "scenario_variants", "shipped_scenarios",
 ]
 
 DEFAULT_SCENARIO = ("pajak.yaml", "sim3")  # what ``drake-traj run`` runs when given no scenario
-_PLAIN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
+_PLAIN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}")
+# The coarsest plant step and log period a run is checked with [s]: the UR controller runs at
+# 2 ms, and the limits and the continuity of q̈ are checked at the logged samples.
+MAX_TIME_STEP = MAX_LOG_PERIOD = 0.01
 
 
 @dataclass
@@ -87,8 +91,8 @@ class Scenario:
         """Raise ValueError naming the first field that is malformed (the message starts with
         the field's path)."""
         if not _PLAIN_NAME.fullmatch(self.name) or ".." in self.name:
-            raise ValueError(f"name must be a plain name (letters, digits, _ . -; no path), got {self.name!r}: "
-                             "it names the default output folder out/<name>")
+            raise ValueError(f"name must be a plain name (letters, digits, _ . -; no path; at most 100 characters), "
+                             f"got {self.name[:120]!r}: it names the default output folder out/<name>")
         try:
             robot = get_robot(self.robot)
         except ValueError as error:
@@ -115,16 +119,25 @@ class Scenario:
             if not np.isfinite(value) or value < smallest_allowed:
                 unit = "metres" if label == "tracking_tolerance" else "seconds"
                 raise ValueError(f"{label} must be a finite, positive number of {unit}, got {value}")
+        for label, value, largest in (("plant.time_step", self.plant.time_step, MAX_TIME_STEP),
+                                      ("log_period", self.logging_period(), MAX_LOG_PERIOD)):
+            if value > largest:
+                raise ValueError(f"{label} must be at most {largest:g} s (the UR controller's cycle is 0.002 s, and "
+                                 f"limits are checked at the logged samples), got {value:g} s")
         steps = self.logging_period() / self.plant.time_step
         if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
             raise ValueError(f"log_period must be a whole multiple of plant.time_step = {self.plant.time_step} s "
                              f"(the loggers sample the plant's steps), got {self.log_period} s")
         if self.logging_period() > self.max_duration:
-            raise ValueError(f"log_period ({self.log_period} s) must not be longer than max_duration "
-                             f"({self.max_duration} s): the run would log one sample")
+            raise ValueError(f"max_duration ({self.max_duration:g} s) must be longer than log_period "
+                             f"({self.logging_period():g} s): the run would log one sample")
         if self.simulator.integration_scheme not in GetIntegrationSchemes():
             raise ValueError(f"simulator.integration_scheme must be one of {GetIntegrationSchemes()}, "
                              f"got {self.simulator.integration_scheme!r}")
+        try:  # Drake checks the plant's options (contact model, approximation, ...) when it adds the plant
+            AddMultibodyPlant(self.plant, DiagramBuilder())
+        except RuntimeError as error:
+            raise ValueError(f"plant: {error}") from None
         self.controller.for_robot(robot)
         self.speed_override.validate()
 
@@ -249,21 +262,23 @@ def make_planner(scenario: Scenario) -> PlannerSystem:
     try:
         planner = make_planner_from_config(scenario.planner, robot, scenario.start_configuration())
     except ValueError as error:
-        field = re.match(r"[A-Za-z_]\w*(\[\d+\])?", str(error))
-        raise type(error)(_where(scenario, f"planner{'.' if field else ': '}{error}")) from error
+        first_word = re.match(r"[A-Za-z_]\w*", str(error))
+        field = first_word is not None and first_word.group(0) in {item.name for item in fields(scenario.planner)}
+        raise type(error)(locate_in_scenario(scenario, f"planner{'.' if field else ': '}{error}")) from error
     velocity = np.broadcast_to(planner.velocity_limit, (robot.num_joints,))
     above = np.flatnonzero(velocity > robot.velocity_limits * (1 + 1e-9))
     if len(above):
         j = int(above[0])
         unit = robot.joint_unit(j)
-        raise ValueError(_where(scenario,
+        raise ValueError(locate_in_scenario(scenario,
             f"planner.velocity_limit[{j}] = {velocity[j]:g} {unit}/s is above the rated "
             f"speed of the {robot.name}'s joint {j + 1} ({robot.joint_names[j]}), {robot.velocity_limits[j]:g} {unit}/s: "
             "the arm could not follow"))
     return planner
 
 
-def _where(scenario: Scenario, message: str) -> str:
-    """``message`` located in the scenario's file (and line) when it was loaded from one."""
+def locate_in_scenario(scenario: Scenario, message: str) -> str:
+    """``message`` located in the scenario's file (and the line of the field it starts with, e.g.
+    ``planner.waypoints[1]: ...``) when it was loaded from one."""
     source = getattr(scenario, "source", None)
     return locate(source[1], source[0], message) if source else f"scenario {scenario.name!r}: {message}"

@@ -21,6 +21,7 @@ from drake_traj.errors import DrakeTrajError
 __all__ = ["ScenarioError", "checked_document"]
 
 _INT, _FLOAT, _BOOL, _STR, _NULL = (f"tag:yaml.org,2002:{name}" for name in ("int", "float", "bool", "str", "null"))
+_YAML12_FLOAT = re.compile(r"[-+]?(\.\d+|\d+(\.\d*)?)([eE][-+]?\d+)?")
 _FOUND = {_INT: "an integer", _FLOAT: "a number", _BOOL: "true/false", _STR: "text", _NULL: "nothing (null)"}
 
 
@@ -71,6 +72,8 @@ class _Checker:
         """The (key, value) nodes of a mapping, merge keys applied, duplicate keys refused."""
         seen = {}
         for key, _ in node.value:
+            if not isinstance(key, yaml.ScalarNode):
+                self.fail(key, field, f"a key must be a plain name, found {_describe(key)}")
             if key.tag == "tag:yaml.org,2002:merge":
                 continue
             if key.value in seen:
@@ -78,7 +81,10 @@ class _Checker:
                           f"duplicate key (first at line {seen[key.value].start_mark.line + 1}); "
                           "each key may appear once")
             seen[key.value] = key
-        self.loader.flatten_mapping(node)
+        try:
+            self.loader.flatten_mapping(node)
+        except yaml.MarkedYAMLError as error:  # e.g. << merging a list or a scalar
+            raise ScenarioError(f"{self.path}: {field + ': ' if field else ''}{_mark_message(error)}") from None
         return node.value
 
     def check(self, node, schema, field: str) -> None:
@@ -102,11 +108,12 @@ class _Checker:
                     str: ("text", (_STR,))}
         if schema in expected:
             description, tags = expected[schema]
-            if not isinstance(node, yaml.ScalarNode) or node.tag not in tags:
-                hint = ""
-                if node.tag == _STR and re.fullmatch(r"[-+]?\d+[eE][-+]?\d+", str(node.value)):
-                    hint = f" (write {node.value.lower().replace('e', '.0e', 1)}: YAML 1.1 reads a number with an exponent only with a dot)"
-                self.fail(node, field, f"expected {description}, found {_describe(node)}{hint}")
+            # PyYAML reads YAML 1.1, where 1e6 and 1.0e6 are text; pydrake's reader (and YAML 1.2)
+            # reads them as numbers, so an unquoted one counts as a number here too
+            yaml12_number = (schema is float and isinstance(node, yaml.ScalarNode) and node.tag == _STR
+                             and node.style is None and _YAML12_FLOAT.fullmatch(node.value) is not None)
+            if not yaml12_number and (not isinstance(node, yaml.ScalarNode) or node.tag not in tags):
+                self.fail(node, field, f"expected {description}, found {_describe(node)}")
             return None
         raise TypeError(f"no YAML check for the type {schema!r} of {field}")  # a schema we did not foresee
 
@@ -162,21 +169,28 @@ def checked_document(path: Path, schema, variant_keys=None) -> tuple[object, dic
     except UnicodeDecodeError as error:
         raise ScenarioError(f"{path} is not a text (UTF-8) file: byte {raw[error.start]:#04x} at offset "
                             f"{error.start} cannot be decoded") from None
-    loader = _Loader(text)
     try:
+        loader = _Loader(text)
         root = loader.get_single_node()
+        loader.dispose()
     except yaml.MarkedYAMLError as error:
         raise ScenarioError(f"{path}: YAML syntax error at {_mark_message(error)}") from None
+    except yaml.reader.ReaderError as error:
+        raise ScenarioError(f"{path}: the character {chr(error.character)!r} at offset {error.position} is not "
+                            "allowed in a YAML file") from None
     except yaml.YAMLError as error:
         raise ScenarioError(f"{path}: YAML error: {error}") from None
-    finally:
-        loader.dispose()
+    except RecursionError:
+        raise ScenarioError(f"{path}: the document is nested too deeply to be a scenario") from None
     checker = _Checker(path, loader)
     if root is None:
         checker.fail(None, "", "the file is empty; a scenario needs at least a planner (see diagrams/)")
     if not isinstance(root, yaml.MappingNode):
         checker.fail(root, "", f"a scenario file must be a mapping of fields (or of named variants), found {_describe(root)}")
     fields = _fields(schema)
+    for key, _ in root.value:
+        if not isinstance(key, yaml.ScalarNode):
+            checker.fail(key, "", f"a key must be a plain name, found {_describe(key)}")
     keys = [key.value for key, _ in root.value]
     variants = {}
     if not set(keys) & set(fields):  # a file of variants: top-level keys name them
@@ -186,7 +200,10 @@ def checked_document(path: Path, schema, variant_keys=None) -> tuple[object, dic
 
     def check(node, prefix: str = "") -> dict:
         checker.marks = {}
-        checker.check_record(node, schema, prefix)
+        try:
+            checker.check_record(node, schema, prefix)
+        except RecursionError:
+            raise ScenarioError(f"{path}: the document is nested too deeply to be a scenario") from None
         return dict(checker.marks)
 
     return root, variants, check

@@ -16,5 +16,5 @@ result = simulate(make_planner(config, ur10e, ur10e.home_configuration), name="e
 metrics = result.metrics()
 print(f"T = {metrics.duration_s:.3f} s, max TCP tracking error = {1e3 * metrics.tracking_error_tcp_max_m:.3f} mm")
 out = sys.argv[1] if len(sys.argv) > 1 else "out/example"
-result.save(out)
+result.save(out, overwrite=True)  # this script's own folder: a rerun replaces its run
 result.save_figures(out)

@@ -6,7 +6,10 @@ import contextlib
 import io
 import json
 import math
+import os
 import re
+import signal
+import time
 import zipfile
 from pathlib import Path
 
@@ -30,6 +33,7 @@ from drake_traj.planners import make_planner
 from drake_traj.planners.pajak import PajakPlanner, paper_parameters
 from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
 from drake_traj.result import ResultFileError
+from drake_traj.rundir import OutputError
 from drake_traj.station import SpeedOverride, build_station
 
 DIAGRAMS = Path(__file__).resolve().parents[1] / "diagrams"
@@ -94,8 +98,23 @@ YAML_CASES = [
     ("name absolute", quintic("name: quintic_ptp", "name: /some/abs/path"), r"name must be a plain name"),
     ("name with space", quintic("name: quintic_ptp", "name: my run"), r"name must be a plain name"),
     ("log period tiny", quintic("settle_time: 0.5", "log_period: 1.0e-7\nsettle_time: 0.5"), r"log_period must be a whole multiple of plant.time_step"),
-    ("exponent without a dot", quintic("settle_time: 0.5", "log_period: 1e-3\nsettle_time: 0.5"), r"log_period: expected a number, found text '1e-3' \(write 1.0e-3"),
-    ("log period huge", quintic("settle_time: 0.5", "log_period: 200.0\nsettle_time: 0.5"), r"log_period \(200.0 s\) must not be longer than max_duration"),
+    ("number quoted", quintic("settle_time: 0.5", 'log_period: "1e-3"\nsettle_time: 0.5'), r"log_period: expected a number, found text '1e-3'"),
+    ("log period huge", quintic("settle_time: 0.5", "log_period: 200.0\nsettle_time: 0.5"), r"log_period must be at most 0.01 s"),
+    ("time step coarse", quintic("  time_step: 0.001", "  time_step: 10"), r"plant.time_step must be at most 0.01 s.*got 10 s"),
+    ("max duration below log period", quintic("settle_time: 0.5", "settle_time: 0.5\nmax_duration: 0.0005"),
+     r"max_duration \(0.0005 s\) must be longer than log_period \(0.001 s\)"),
+    ("motion longer than max duration", quintic("settle_time: 0.5", "settle_time: 0.5\nmax_duration: 2.0"),
+     r"max_duration \(2 s\) is shorter than the planned motion \(6.177 s"),
+    ("contact approximation unknown", quintic("  time_step: 0.001", "  time_step: 0.001\n  discrete_contact_approximation: foo"),
+     r"plant: Unknown discrete_contact_approximation: 'foo'"),
+    ("name too long", quintic("name: quintic_ptp", "name: " + "a" * 150), r"at most 100 characters"),
+    ("NUL byte", quintic("name: quintic_ptp", "name: quintic_ptp\x00"), r"the character '\\x00' at offset \d+ is not allowed"),
+    ("nested too deeply", "a: " + "[" * 3000 + "]" * 3000 + "\n", r"nested too deeply"),
+    ("merge of a list", "name: q\nq_initial: &l [1, 2]\nplanner: !QuinticConfig\n  <<: *l\n", r"expected a mapping for merging"),
+    ("key that is a list", "? [a, b]\n: 1\n", r"a key must be a plain name, found a list of 2 entries"),
+    ("goal of five numbers", quintic("    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]", "    - [-0.9, -1.9, -1.9, -0.9, 1.2]"), r"planner.goals"),
+    ("pajak waypoint on the base axis", pajak("  waypoints:\n    - [0.0, 0.0, 0.1, 3.141592653589793, 0.0, 2.356194490192345]\n"),
+     r"line 5, column 7: planner.waypoints\[0\]: waypoint 0 cannot be reached"),
     ("log period off grid", quintic("settle_time: 0.5", "log_period: 0.0015\nsettle_time: 0.5"), r"log_period must be a whole multiple"),
     ("time step zero", quintic("  time_step: 0.001", "  time_step: 0.0"), r"plant.time_step must be a finite, positive"),
     ("time step negative", quintic("  time_step: 0.001", "  time_step: -0.001"), r"plant.time_step must be a finite, positive"),
@@ -190,6 +209,10 @@ CLI_CASES = [
     ("no variant", ["run", str(DIAGRAMS / "pajak.yaml")], r"no variant was given; its variants are \['sim1', 'sim2', 'sim3'\]"),
     ("unknown variant", ["run", str(DIAGRAMS / "pajak.yaml"), "--variant", "sim4"], r"there is no variant 'sim4'"),
     ("variant of a single file", ["run", "quintic_ptp", "--variant", "sim3"], r"holds one scenario, not variants"),
+    ("rate without meshcat", ["run", "quintic_ptp", "--rate", "2"], r"--rate sets up the live view; add --meshcat"),
+    ("out empty", ["run", "quintic_ptp", "--out", ""], r"--out must name a folder"),
+    ("out holds other files", ["run", "quintic_ptp", "--out", "{foreign}"], r"holds files that are not a drake-traj run \(notes.txt\)"),
+    ("bench count huge", ["bench", "--count", "99999999999", "--workers", "1"], r"count \(--count\) must be a whole number from 0 to 10000"),
 ]
 
 
@@ -199,7 +222,10 @@ def test_bad_command_lines(case, argv, pattern, tmp_path, earlier_run, capsys):
     file.write_text("x")
     (earlier_run / "result.npz").write_bytes(b"an earlier run")
     (tmp_path / "folder.yaml").mkdir()
-    argv = [arg.format(file=file, run=earlier_run, dir=tmp_path / "folder") for arg in argv]
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("mine")
+    argv = [arg.format(file=file, run=earlier_run, dir=tmp_path / "folder", foreign=foreign) for arg in argv]
     before = folder_state(earlier_run)
     assert_clean_exit(cli.main(argv), capsys, pattern)
     assert folder_state(earlier_run) == before
@@ -429,3 +455,68 @@ def test_mutated_scenarios_fail_cleanly_or_run_within_their_limits(tmp_path_fact
         assert metrics.max_velocity_over_limit <= 1 + 1e-6 and metrics.max_acceleration_over_limit <= 1 + 1e-6
     else:
         assert code == cli.EXIT_RUN_FAILED and result.failure is not None
+
+
+# ---- nothing lost: run folders, saving, signals -------------------------------------------------
+
+def fake_run(folder: Path) -> dict:
+    """A folder holding a run (manifest and result); returns its state."""
+    folder.mkdir()
+    (folder / "result.npz").write_bytes(b"the earlier run")
+    (folder / "run.json").write_text(json.dumps({"files": ["result.npz"]}))
+    return folder_state(folder)
+
+
+def test_overwrite_keeps_the_earlier_run_when_the_new_input_is_bad(tmp_path, capsys):
+    earlier = fake_run(tmp_path / "run")
+    path = tmp_path / "bad.yaml"
+    path.write_text(quintic("  velocity_limit: [1.05, ", "  velocity_limit: [.nan, "))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "run"), "--overwrite"]) == cli.EXIT_BAD_INPUT
+    assert folder_state(tmp_path / "run") == earlier
+    assert "velocity_limit" in capsys.readouterr().err
+
+
+def test_save_refuses_another_runs_folder(saved_run, tmp_path):
+    result = SimulationResult.load(saved_run)
+    earlier = fake_run(tmp_path / "other")
+    with pytest.raises(OutputError, match="holds another run"):
+        result.save(tmp_path / "other")
+    assert folder_state(tmp_path / "other") == earlier
+    result.save(tmp_path / "other", overwrite=True)
+    assert SimulationResult.load(tmp_path / "other").name == result.name
+
+
+def test_a_log_whose_time_runs_backwards_is_refused(saved_run, tmp_path):
+    with np.load(saved_run / "result.npz") as archive:
+        arrays = {name: archive[name] for name in archive.files}
+    arrays["t"] = arrays["t"][::-1].copy()
+    (tmp_path / "t_reversed").mkdir()
+    np.savez(tmp_path / "t_reversed" / "result.npz", **arrays)
+    with pytest.raises(ResultFileError, match=r"result.npz: the log's times 't' do not increase"):
+        SimulationResult.load(tmp_path / "t_reversed")
+
+
+def test_signals_while_writing_wait_until_the_files_are_written():
+    with cli._interrupts_deferred() as received:
+        os.kill(os.getpid(), signal.SIGINT)
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(0.05)  # the handlers run here, and record instead of raising
+    assert received == [signal.SIGINT, signal.SIGTERM]
+
+
+def test_sigterm_stops_a_run_like_ctrl_c(tmp_path, monkeypatch, capsys):
+    def terminated(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(1.0)  # the SIGTERM handler raises KeyboardInterrupt here
+        raise AssertionError("SIGTERM did not stop the run")
+
+    monkeypatch.setattr(cli, "simulate", terminated)
+    assert cli.main(["run", "quintic_ptp", "--out", str(tmp_path / "x")]) == cli.EXIT_INTERRUPTED
+    assert "interrupted" in capsys.readouterr().err
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # restored
+
+
+def test_debug_shows_the_traceback(tmp_path, capsys):
+    assert cli.main(["--debug", "run", str(tmp_path / "nowhere.yaml")]) == cli.EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "Traceback (most recent call last)" in err and "not found" in err

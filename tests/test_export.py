@@ -2,7 +2,9 @@
 each read back and compared with the reference; refusals write nothing."""
 
 import csv
+import json
 import runpy
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +12,7 @@ import pytest
 import yaml
 
 from drake_traj import SimulationResult, cli
+from drake_traj.errors import Failure
 from drake_traj.export import ExportError, resample
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -114,3 +117,43 @@ def test_export_command(quintic_run_dir, tmp_path, capsys):
     assert "no result file at" in capsys.readouterr().err
     assert cli.main(["export", str(quintic_run_dir), "--format", "urscript", "--gain", "5000", "--out", str(tmp_path / "x")]) == 2
     assert "--gain must be in UR's range" in capsys.readouterr().err and not (tmp_path / "x").exists()
+
+
+def test_exports_join_the_run_and_leave_with_it(quintic_run_dir, tmp_path, capsys):
+    # an export into the run's folder is listed in its manifest, so --overwrite removes it with the
+    # run; an export never replaces the run's own files
+    run = tmp_path / "run"
+    shutil.copytree(quintic_run_dir, run)
+    assert cli.main(["export", str(run), "--format", "urscript"]) == 0
+    assert "reference.script" in json.loads((run / "run.json").read_text())["files"]
+    for name in ("result.npz", "run.json", "joints.png"):
+        assert cli.main(["export", str(run), "--format", "csv", "--out", str(run / name), "--overwrite"]) == 2
+        assert "is one of the run's own files" in capsys.readouterr().err
+    assert cli.main(["run", "quintic_ptp", "--out", str(run), "--overwrite"]) == 0
+    assert not (run / "reference.script").exists() and (run / "result.npz").is_file()
+
+
+@pytest.mark.parametrize("period, pattern", [
+    (1e9, r"--period must be between 0.0001 s and half the logged motion"),
+    (1e-9, r"--period must be between 0.0001 s"),
+    (float("nan"), r"--period must be between"),
+])
+def test_export_period_outside_the_motion_is_refused(result, tmp_path, period, pattern):
+    with pytest.raises(ExportError, match=pattern):
+        result.export(tmp_path / "x.csv", "csv", period=period)
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_a_failed_or_non_finite_reference_is_not_exported(result, tmp_path):
+    failed = SimulationResult(**{**vars(result), "failure": Failure("tracking", "the TCP was 99 mm from the reference")})
+    for format in ("csv", "urscript", "ros2"):
+        with pytest.raises(ExportError, match=r"the run 'quintic_ptp' failed \(the TCP was 99 mm .*--allow-failed"):
+            failed.export(tmp_path / f"x.{format}", format)
+    path = failed.export(tmp_path / "x.script", "urscript", allow_failed=True)
+    assert path.read_text().startswith("# FAILED RUN: the TCP was 99 mm from the reference\n")
+    q_ref = result.q_ref.copy()
+    q_ref[100, 2] = np.nan
+    broken = SimulationResult(**{**vars(result), "q_ref": q_ref})
+    with pytest.raises(ExportError, match=r"not finite: q_ref at sample 100 is nan"):
+        broken.export(tmp_path / "y.script", "urscript")
+    assert not (tmp_path / "x.csv").exists() and not (tmp_path / "y.script").exists()
