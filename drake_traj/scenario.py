@@ -189,6 +189,10 @@ def find_scenario(reference: str, variant: str | None = None) -> tuple[Path, str
     path = Path(reference)
     if path.is_file():
         return path, variant
+    if path.is_symlink() and not path.exists():
+        raise ScenarioError(f"scenario file {path} is a broken link or a loop of links")
+    if path.exists() and not path.is_dir():
+        raise ScenarioError(f"scenario file {path} is not a regular file (a device or a pipe)")
     # a bare name is looked up among the shipped scenarios even when a folder of that name is
     # here (e.g. an earlier run's --out quintic_ptp)
     bare_name = path.suffix not in (".yaml", ".yml") and len(path.parts) == 1

@@ -112,7 +112,8 @@ YAML_CASES = [
     ("nested too deeply", "a: " + "[" * 3000 + "]" * 3000 + "\n", r"nested too deeply"),
     ("merge of a list", "name: q\nq_initial: &l [1, 2]\nplanner: !QuinticConfig\n  <<: *l\n", r"expected a mapping for merging"),
     ("key that is a list", "? [a, b]\n: 1\n", r"a key must be a plain name, found a list of 2 entries"),
-    ("goal of five numbers", quintic("    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]", "    - [-0.9, -1.9, -1.9, -0.9, 1.2]"), r"planner.goals"),
+    ("goal of five numbers", quintic("    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]", "    - [-0.9, -1.9, -1.9, -0.9, 1.2]"),
+     r"planner.goals must be .*: its rows must have the same length, got lengths \[5, 6, 6\]"),
     ("pajak waypoint on the base axis", pajak("  waypoints:\n    - [0.0, 0.0, 0.1, 3.141592653589793, 0.0, 2.356194490192345]\n"),
      r"line 5, column 7: planner.waypoints\[0\]: waypoint 0 cannot be reached"),
     ("log period off grid", quintic("settle_time: 0.5", "log_period: 0.0015\nsettle_time: 0.5"), r"log_period must be a whole multiple"),
@@ -212,6 +213,9 @@ CLI_CASES = [
     ("rate without meshcat", ["run", "quintic_ptp", "--rate", "2"], r"--rate sets up the live view; add --meshcat"),
     ("out empty", ["run", "quintic_ptp", "--out", ""], r"--out must name a folder"),
     ("out holds other files", ["run", "quintic_ptp", "--out", "{foreign}"], r"holds files that are not a drake-traj run \(notes.txt\)"),
+    ("scenario is a device", ["run", "/dev/null"], r"scenario file /dev/null is not a regular file"),
+    ("scenario is a loop of links", ["run", "{loop}.yaml"], r"is a broken link or a loop of links"),
+    ("out is a loop of links", ["run", "quintic_ptp", "--out", "{loop}"], r"output folder .* is a broken link or a loop of links"),
     ("bench count huge", ["bench", "--count", "99999999999", "--workers", "1"], r"count \(--count\) must be a whole number from 0 to 10000"),
 ]
 
@@ -225,7 +229,10 @@ def test_bad_command_lines(case, argv, pattern, tmp_path, earlier_run, capsys):
     foreign = tmp_path / "foreign"
     foreign.mkdir()
     (foreign / "notes.txt").write_text("mine")
-    argv = [arg.format(file=file, run=earlier_run, dir=tmp_path / "folder", foreign=foreign) for arg in argv]
+    for name in ("loop", "loop.yaml"):
+        (tmp_path / name).symlink_to(tmp_path / name)
+    argv = [arg.format(file=file, run=earlier_run, dir=tmp_path / "folder", foreign=foreign, loop=tmp_path / "loop")
+            for arg in argv]
     before = folder_state(earlier_run)
     assert_clean_exit(cli.main(argv), capsys, pattern)
     assert folder_state(earlier_run) == before

@@ -54,9 +54,11 @@ def _as_float_array(value, name: str) -> np.ndarray:
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise ValueError(
-            f"{name} must be a real number or an array of real numbers: {exc}"
-        ) from exc
+        reason = str(exc)
+        if "inhomogeneous" in reason:  # a ragged list: say which row is off
+            lengths = [len(row) if hasattr(row, "__len__") else 1 for row in value]
+            reason = f"its rows must have the same length, got lengths {lengths}"
+        raise ValueError(f"{name} must be a real number or an array of real numbers: {reason}") from exc
     return array
 
 
