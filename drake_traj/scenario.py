@@ -20,10 +20,11 @@ from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 
 from drake_traj.station import ControllerGains, SpeedOverride, default_plant_config, default_simulator_config
 from drake_traj.data import data_directory
-from drake_traj.planners import PlannerConfig, PlannerSystem, QuinticConfig
+from drake_traj.planners import PLANNER_CONFIGS, PlannerConfig, PlannerSystem, QuinticConfig
 from drake_traj.planners import make_planner as make_planner_from_config
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE
 from drake_traj.robots import get_robot
+from drake_traj.validation import instance_of, log_period_check, path_argument, real_array
 from drake_traj.yaml_schema import ScenarioError, checked_document, locate
 
 __all__ = [
@@ -79,9 +80,8 @@ class Scenario:
 
     def start_configuration(self) -> np.ndarray:
         """``q_initial``, or the robot's home configuration when it is empty."""
-        if np.size(self.q_initial) == 0:
-            return get_robot(self.robot).home_configuration
-        return np.asarray(self.q_initial, dtype=float)
+        q = real_array(self.q_initial, "q_initial", "rad or m")
+        return get_robot(self.robot).home_configuration if q.size == 0 else q
 
     def validate(self) -> None:
         """Raise ValueError naming the first field that is malformed (the message starts with
@@ -115,10 +115,7 @@ class Scenario:
             if not np.isfinite(value) or value < smallest_allowed:
                 unit = "metres" if label == "tracking_tolerance" else "seconds"
                 raise ValueError(f"{label} must be a finite, positive number of {unit}, got {value}")
-        steps = self.logging_period() / self.plant.time_step
-        if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
-            raise ValueError(f"log_period must be a whole multiple of plant.time_step = {self.plant.time_step} s "
-                             f"(the loggers sample the plant's steps), got {self.log_period} s")
+        log_period_check(self.logging_period(), self.plant.time_step)
         if self.logging_period() > self.max_duration:
             raise ValueError(f"log_period ({self.log_period} s) must not be longer than max_duration "
                              f"({self.max_duration} s): the run would log one sample")
@@ -212,9 +209,9 @@ def load_scenario(path, variant: str | None = None) -> Scenario:
 
     Raises :class:`ScenarioError` (a ValueError) naming the file, the line and the field.
     """
-    if not isinstance(path, (str, Path)):
-        raise TypeError(f"path must be a file path (str or Path), got {type(path).__name__}: {path!r:.80}")
-    path = Path(path)
+    path = path_argument(path, "path")
+    if variant is not None:
+        instance_of(variant, str, "variant")
     if not path.is_file():
         what = "is a folder, not a scenario file" if path.is_dir() else "not found"
         raise ScenarioError(f"scenario file {path} {what}")
@@ -242,12 +239,24 @@ def load_scenario(path, variant: str | None = None) -> Scenario:
     return scenario
 
 
-def make_planner(scenario: Scenario) -> PlannerSystem:
+def make_planner(scenario: Scenario, *others) -> PlannerSystem:
     """The planner system the scenario describes, its limits checked against the robot's rated
-    joint speeds (errors name the scenario and the ``planner`` field)."""
+    joint speeds (errors name the scenario and the ``planner`` field).
+
+    This is ``drake_traj.make_planner``; a planner from a planner config (``QuinticConfig``, ...)
+    is :func:`drake_traj.planners.make_planner` ``(config, robot, q_initial)`` (given a config or
+    more arguments, this one raises a TypeError saying so).
+    """
+    if others or isinstance(scenario, PLANNER_CONFIGS):
+        more = f" and {len(others)} more argument{'s' * (len(others) > 1)}" if others else ""
+        raise TypeError(f"scenario must be a Scenario, got {type(scenario).__name__}{more}: drake_traj.make_planner(scenario) "
+                        "makes a scenario's planner; make one from a planner config with "
+                        "drake_traj.planners.make_planner(config, robot, q_initial)")
+    instance_of(scenario, Scenario, "scenario", hint=" (load one with drake_traj.load_scenario(path, variant))")
     robot = get_robot(scenario.robot)
+    q_initial = scenario.start_configuration()  # its errors name q_initial, not the planner
     try:
-        planner = make_planner_from_config(scenario.planner, robot, scenario.start_configuration())
+        planner = make_planner_from_config(scenario.planner, robot, q_initial)
     except ValueError as error:
         field = re.match(r"[A-Za-z_]\w*(\[\d+\])?", str(error))
         raise type(error)(_where(scenario, f"planner{'.' if field else ': '}{error}")) from error
