@@ -19,8 +19,9 @@ from matplotlib.figure import Figure
 
 from drake_traj.errors import DrakeTrajError, Failure
 from drake_traj.export import export, reference_trajectory
-from drake_traj.rundir import OutputError, clear_run, holds_a_run
 from drake_traj.robots.ur10e import pose_error
+from drake_traj.rundir import OutputError, check_writable, clear_run, holds_a_run
+from drake_traj.validation import path_argument, positive_scalar, real_array
 
 __all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult"]
 
@@ -56,6 +57,23 @@ LOGGERS = {
 
 ARRAY_NAMES = ("t", "q_ref", "qd_ref", "qdd_ref", "q_meas", "qd_meas", "tau", "scaling", "tcp", "tcp_ref")
 _LIMIT_NAMES = ("velocity_limit", "acceleration_limit", "effort_limit", "waypoints")
+# The shape of each array of a result, N samples of n joints (checked by SimulationResult).
+_SHAPES = {"t": ("N",), **{name: ("N", "n") for name in ("q_ref", "qd_ref", "qdd_ref", "q_meas", "qd_meas", "tau")},
+           "scaling": ("N",), "tcp": ("N", 6), "tcp_ref": ("N", 6), "velocity_limit": ("n",),
+           "acceleration_limit": ("n",), "effort_limit": ("n",), "waypoints": (None, 3), "goal": (6,)}
+
+
+def _output_folder(directory) -> Path:
+    """``directory`` (the argument of that name) created if needed, or TypeError/ValueError naming it."""
+    folder = path_argument(directory, "directory", "folder")
+    try:
+        check_writable(folder)
+        folder.mkdir(parents=True, exist_ok=True)
+    except OutputError as error:
+        raise OutputError(f"directory: {error}") from None
+    except OSError as error:
+        raise OutputError(f"directory: output folder {folder} cannot be created: {error.strerror}") from None
+    return folder
 
 
 @dataclass(frozen=True)
@@ -123,13 +141,48 @@ class SimulationResult:
     joint_types: tuple[str, ...] = ()  # "revolute" or "prismatic" per joint; empty: all revolute
     robot: str = ""  # the robot's name (drake_traj.robots.get_robot), where known
 
+    def __post_init__(self):
+        """Every array as a float array of its shape (:data:`_SHAPES`), or ValueError naming it.
+        Non-finite values are kept (a run that went wrong logs them) and make the run fail
+        (:meth:`non_finite_failure`)."""
+        sizes = {"N": None, "n": None}
+        for name, shape in _SHAPES.items():
+            array = real_array(getattr(self, name), name, "see SimulationResult")
+            if array.ndim != len(shape):
+                raise ValueError(f"{name} must have {len(shape)} dimension(s) {shape}, got shape {array.shape}")
+            for axis, size in zip(shape, array.shape):
+                if isinstance(axis, int) and size != axis:
+                    raise ValueError(f"{name} must have shape {shape}, got shape {array.shape}")
+                if isinstance(axis, str):
+                    if sizes[axis] is None:
+                        sizes[axis] = size
+                    elif size != sizes[axis]:
+                        what = "samples (rows)" if axis == "N" else "joints"
+                        raise ValueError(f"{name} has {size} {what}, t and q_ref {sizes[axis]}: shape {array.shape}")
+            setattr(self, name, array)
+        if self.failure is not None and not isinstance(self.failure, Failure):
+            raise TypeError(f"failure must be a Failure or None, got {type(self.failure).__name__}: {self.failure!r:.80}")
+
     def joint_unit(self, j: int) -> str:
         """"rad" or "m", the position unit of joint ``j``."""
         return "m" if self.joint_types and self.joint_types[j] == "prismatic" else "rad"
 
     @property
     def succeeded(self) -> bool:
-        return self.failure is None
+        """No failure recorded and every logged value finite (:meth:`non_finite_failure`)."""
+        return self.failure is None and self.non_finite_failure() is None
+
+    def non_finite_failure(self) -> Failure | None:
+        """A :class:`Failure` (cause "non-finite") naming the first logged array and sample that
+        holds NaN or an infinity; None when every logged value is finite."""
+        for name in ARRAY_NAMES:
+            array = getattr(self, name)
+            bad = ~np.isfinite(array)
+            if bad.any():
+                row = int(np.argmax(bad.reshape(len(array), -1).any(axis=1)))
+                return Failure("non-finite", f"the log is not finite: {name}[{row}] = {array[row].tolist()} "
+                                             f"at t = {self.t[row]:.4f} s", float(self.t[row]))
+        return None
 
     @property
     def log_period(self) -> float:
@@ -144,7 +197,12 @@ class SimulationResult:
         """Whether the arm did what was planned: a :class:`Failure` when a joint's torque
         saturated at its effort limit (cause "saturation": which joint, from when, for how long)
         or the TCP strayed more than ``tracking_tolerance`` [m] from the reference (cause
-        "tracking"); None otherwise."""
+        "tracking"), or the log holds NaN or an infinity (:meth:`non_finite_failure`); None
+        otherwise."""
+        tracking_tolerance = positive_scalar(tracking_tolerance, "tracking_tolerance", "m")
+        non_finite = self.non_finite_failure()
+        if non_finite is not None:
+            return non_finite
         saturated = self._saturated()
         if saturated.any():
             j = int(np.argmax(saturated.any(axis=0)))
@@ -154,8 +212,8 @@ class SimulationResult:
                                          f"{saturated[:, j].sum() * self.log_period:.3f} s in all: the arm could not "
                                          "follow the reference", float(self.t[first]), tuple(self.q_meas[first]))
         error = np.linalg.norm(self.tcp_ref[:, :3] - self.tcp[:, :3], axis=1)
-        if len(error) and error.max() > tracking_tolerance:
-            first = int(np.argmax(error > tracking_tolerance))
+        if len(error) and not error.max() <= tracking_tolerance:  # NaN is not within the tolerance
+            first = int(np.argmax(~(error <= tracking_tolerance)))
             return Failure("tracking", f"the TCP was {1e3 * error.max():.3f} mm from the reference (tolerance "
                                        f"{1e3 * tracking_tolerance:g} mm), first over it at t = {self.t[first]:.3f} s",
                            float(self.t[first]), tuple(self.q_meas[first]))
@@ -166,7 +224,9 @@ class SimulationResult:
         return np.diff(self.qdd_ref, axis=0) / np.diff(self.t)[:, None]
 
     def metrics(self) -> Metrics:
-        """Scalar and per-joint figures of merit."""
+        """Scalar and per-joint figures of merit (NaN where the log holds NaN: a NaN is never
+        skipped; such a run has not succeeded)."""
+        failure = self.failure or self.non_finite_failure()
         tcp_error = np.linalg.norm(self.tcp_ref[:, :3] - self.tcp[:, :3], axis=1)
         simulated = float(self.t[-1]) if len(self.t) else 0.0
         jerk = self.jerk()
@@ -176,8 +236,8 @@ class SimulationResult:
             final_position, final_orientation = pose_error(self.tcp[-1], goal)
         return Metrics(
             name=self.name,
-            succeeded=self.succeeded,
-            failure=None if self.failure is None else self.failure.message,
+            succeeded=failure is None,
+            failure=None if failure is None else failure.message,
             duration_s=self.duration,
             samples=int(len(self.t)),
             log_period_s=self.log_period or None,
@@ -209,6 +269,8 @@ class SimulationResult:
         The TCP poses are computed from the logged joint positions. A run without ``failure``
         fails all the same where the arm did not do what was planned
         (:meth:`execution_failure` with ``tracking_tolerance`` [m]; None skips the check)."""
+        if tracking_tolerance is not None:
+            positive_scalar(tracking_tolerance, "tracking_tolerance", "m")
         planner = station.GetSubsystemByName("planner")
         robot = station.GetSubsystemByName("tcp_pose").robot
         logs = {}
@@ -251,13 +313,12 @@ class SimulationResult:
         """Write ``result.npz`` (arrays) and ``metrics.json`` into ``directory``; returns it. A folder
         that holds another run is refused (:class:`~drake_traj.rundir.OutputError`) unless
         ``overwrite``, which first removes that run's files."""
-        directory = Path(directory)
-        if directory.is_dir() and holds_a_run(directory):
+        directory = _output_folder(directory)
+        if holds_a_run(directory):
             if not overwrite:
                 raise OutputError(f"{directory} holds another run; save into a new folder, or pass "
                                   "overwrite=True to replace it")
             clear_run(directory)
-        directory.mkdir(parents=True, exist_ok=True)
         arrays = {name: getattr(self, name) for name in ARRAY_NAMES + _LIMIT_NAMES + ("goal",)}
         failure = None if self.failure is None else self.failure.to_dict()
         meta = {"name": self.name, "duration": self.duration, "failure": failure, "wall_time": self.wall_time,
@@ -270,7 +331,7 @@ class SimulationResult:
     def load(cls, directory) -> "SimulationResult":
         """Read a result written by :meth:`save`; raises :class:`ResultFileError` naming the file
         when it is missing, truncated, corrupted or inconsistent."""
-        path = Path(directory) / "result.npz"
+        path = path_argument(directory, "directory", "folder") / "result.npz"
         if not path.is_file():
             raise ResultFileError(f"no result file at {path}")
         names = {f.name for f in fields(cls)}
@@ -304,7 +365,10 @@ class SimulationResult:
             meta["wall_time"] = float("nan") if meta["wall_time"] is None else float(meta["wall_time"])
         except (KeyError, TypeError, ValueError) as error:
             raise ResultFileError(f"{path}: its metadata is damaged: {error}") from None
-        return cls(**meta, **arrays)
+        try:
+            return cls(**meta, **arrays)
+        except (TypeError, ValueError) as error:
+            raise ResultFileError(f"{path}: {error}") from None
 
     def reference_trajectory(self):
         """The reference as a Drake ``PiecewisePolynomial``: the cubic Hermite spline through the
@@ -314,7 +378,7 @@ class SimulationResult:
     def export(self, path, format: str, **options) -> Path:
         """Write the reference for a robot or another tool (:mod:`drake_traj.export`): ``format``
         "csv", "urscript" or "ros2"; ``options`` as :func:`drake_traj.export.export`."""
-        return export(self, path, format, **options)
+        return export(self, path_argument(path, "path"), format, **options)
 
     # --- figures -------------------------------------------------------------------------------
     def _finish_line(self, axes) -> None:
@@ -407,9 +471,9 @@ class SimulationResult:
         return figure
 
     def save_figures(self, directory) -> list[Path]:
-        """Write joints.png, tracking.png, scaling.png and tcp_path.png; returns the paths."""
-        directory = Path(directory)
-        directory.mkdir(parents=True, exist_ok=True)
+        """Write joints.png, tracking.png, scaling.png and tcp_path.png into ``directory``
+        (created if needed); returns the paths."""
+        directory = _output_folder(directory)
         paths = []
         for stem, make in (
             ("joints", self.joint_figure),

@@ -14,8 +14,8 @@ from pathlib import Path
 
 from drake_traj.errors import DrakeTrajError
 
-__all__ = ["MANIFEST", "OutputError", "add_to_manifest", "begin_output", "check_output", "clear_run", "holds_a_run",
-           "run_files", "write_manifest"]
+__all__ = ["MANIFEST", "OutputError", "add_to_manifest", "begin_output", "check_output", "check_writable", "clear_run",
+           "holds_a_run", "run_files", "write_manifest"]
 
 MANIFEST = "run.json"
 _RUN_FILES = ("result.npz", "metrics.json")  # a run written before manifests is recognised by these
@@ -30,7 +30,7 @@ def holds_a_run(directory: Path) -> bool:
     return any((directory / name).exists() for name in (MANIFEST,) + _RUN_FILES)
 
 
-def _check_writable(directory: Path) -> None:
+def check_writable(directory: Path) -> None:
     """The folder exists as a writable folder, or can be created: not a file, not below a file."""
     if directory.is_symlink() and not directory.exists():
         raise OutputError(f"output folder {directory} is a broken link or a loop of links")
@@ -53,7 +53,7 @@ def check_output(directory, *, overwrite: bool = False) -> Path:
     ``overwrite``. Raises :class:`OutputError`."""
     directory = Path(directory)
     try:
-        _check_writable(directory)
+        check_writable(directory)
         if directory.is_dir():
             if holds_a_run(directory) and not overwrite:
                 raise OutputError(f"output folder {directory} holds an earlier run (its {MANIFEST} or result.npz); "

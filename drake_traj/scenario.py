@@ -21,10 +21,11 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj.station import ControllerGains, SpeedOverride, default_plant_config, default_simulator_config
 from drake_traj.data import data_directory
-from drake_traj.planners import PlannerConfig, PlannerSystem, QuinticConfig
+from drake_traj.planners import PLANNER_CONFIGS, PlannerConfig, PlannerSystem, QuinticConfig
 from drake_traj.planners import make_planner as make_planner_from_config
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE
 from drake_traj.robots import get_robot
+from drake_traj.validation import instance_of, log_period_check, path_argument, real_array
 from drake_traj.yaml_schema import ScenarioError, checked_document, locate
 
 __all__ = [
@@ -83,9 +84,8 @@ class Scenario:
 
     def start_configuration(self) -> np.ndarray:
         """``q_initial``, or the robot's home configuration when it is empty."""
-        if np.size(self.q_initial) == 0:
-            return get_robot(self.robot).home_configuration
-        return np.asarray(self.q_initial, dtype=float)
+        q = real_array(self.q_initial, "q_initial", "rad or m")
+        return get_robot(self.robot).home_configuration if q.size == 0 else q
 
     def validate(self) -> None:
         """Raise ValueError naming the first field that is malformed (the message starts with
@@ -124,10 +124,7 @@ class Scenario:
             if value > largest:
                 raise ValueError(f"{label} must be at most {largest:g} s (the UR controller's cycle is 0.002 s, and "
                                  f"limits are checked at the logged samples), got {value:g} s")
-        steps = self.logging_period() / self.plant.time_step
-        if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
-            raise ValueError(f"log_period must be a whole multiple of plant.time_step = {self.plant.time_step} s "
-                             f"(the loggers sample the plant's steps), got {self.log_period} s")
+        log_period_check(self.logging_period(), self.plant.time_step)
         if self.logging_period() > self.max_duration:
             raise ValueError(f"max_duration ({self.max_duration:g} s) must be longer than log_period "
                              f"({self.logging_period():g} s): the run would log one sample")
@@ -229,9 +226,9 @@ def load_scenario(path, variant: str | None = None) -> Scenario:
 
     Raises :class:`ScenarioError` (a ValueError) naming the file, the line and the field.
     """
-    if not isinstance(path, (str, Path)):
-        raise TypeError(f"path must be a file path (str or Path), got {type(path).__name__}: {path!r:.80}")
-    path = Path(path)
+    path = path_argument(path, "path")
+    if variant is not None:
+        instance_of(variant, str, "variant")
     if not path.is_file():
         what = "is a folder, not a scenario file" if path.is_dir() else "not found"
         raise ScenarioError(f"scenario file {path} {what}")
@@ -259,12 +256,24 @@ def load_scenario(path, variant: str | None = None) -> Scenario:
     return scenario
 
 
-def make_planner(scenario: Scenario) -> PlannerSystem:
+def make_planner(scenario: Scenario, *others) -> PlannerSystem:
     """The planner system the scenario describes, its limits checked against the robot's rated
-    joint speeds (errors name the scenario and the ``planner`` field)."""
+    joint speeds (errors name the scenario and the ``planner`` field).
+
+    This is ``drake_traj.make_planner``; a planner from a planner config (``QuinticConfig``, ...)
+    is :func:`drake_traj.planners.make_planner` ``(config, robot, q_initial)`` (given a config or
+    more arguments, this one raises a TypeError saying so).
+    """
+    if others or isinstance(scenario, PLANNER_CONFIGS):
+        more = f" and {len(others)} more argument{'s' * (len(others) > 1)}" if others else ""
+        raise TypeError(f"scenario must be a Scenario, got {type(scenario).__name__}{more}: drake_traj.make_planner(scenario) "
+                        "makes a scenario's planner; make one from a planner config with "
+                        "drake_traj.planners.make_planner(config, robot, q_initial)")
+    instance_of(scenario, Scenario, "scenario", hint=" (load one with drake_traj.load_scenario(path, variant))")
     robot = get_robot(scenario.robot)
+    q_initial = scenario.start_configuration()  # its errors name q_initial, not the planner
     try:
-        planner = make_planner_from_config(scenario.planner, robot, scenario.start_configuration())
+        planner = make_planner_from_config(scenario.planner, robot, q_initial)
     except ValueError as error:
         first_word = re.match(r"[A-Za-z_]\w*", str(error))
         field = first_word is not None and first_word.group(0) in {item.name for item in fields(scenario.planner)}

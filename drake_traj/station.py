@@ -40,6 +40,7 @@ tcp_pose               6       the measured tool pose [x, y, z, φ_X, φ_Y, φ_Z
 =====================  ======  ===============================================================
 """
 
+import os
 import time
 from dataclasses import dataclass, field
 
@@ -68,7 +69,16 @@ from drake_traj.errors import Failure
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
 from drake_traj.robots import UR10E, Robot
-from drake_traj.validation import instance_of, positive_scalar
+from drake_traj.validation import (
+    callable_or_none,
+    flag,
+    instance_of,
+    log_period_check,
+    nonnegative_scalar,
+    positive_scalar,
+    real_array,
+    real_scalar,
+)
 
 __all__ = [
     "ControllerGains", "SpeedOverride", "Station", "add_speed_override", "add_station", "build_station",
@@ -103,17 +113,24 @@ class ControllerGains:
     kd: list[float] = field(default_factory=list)
     feedforward_acceleration: bool = True
 
+    _UNITS = {"kp": "N m/rad or N/m", "kd": "N m s/rad or N s/m"}
+
     def for_robot(self, robot: Robot) -> "ControllerGains":
         """These gains with empty lists filled from ``robot``'s defaults, validated for its joint count."""
-        kp, kd = robot.default_gains
-        gains = ControllerGains(list(self.kp) or list(kp), list(self.kd) or list(kd), self.feedforward_acceleration)
+        given = {name: real_array(getattr(self, name), f"controller.{name}", unit).tolist()
+                 for name, unit in self._UNITS.items()}
+        kp, kd = (given[name] if np.size(given[name]) else list(default)
+                  for name, default in zip(("kp", "kd"), robot.default_gains))
+        gains = ControllerGains(kp, kd, self.feedforward_acceleration)
         gains.validate(robot.num_joints)
         return gains
 
     def validate(self, num_joints: int) -> None:
-        """Raise ValueError naming the gain that is of the wrong length, non-finite or negative."""
-        for name in ("kp", "kd"):
-            gains = np.asarray(getattr(self, name), dtype=float)
+        """Raise ValueError naming the gain that is not numbers, of the wrong length, non-finite or
+        negative, or a feed-forward choice that is not True or False."""
+        flag(self.feedforward_acceleration, "controller.feedforward_acceleration")
+        for name, unit in self._UNITS.items():
+            gains = real_array(getattr(self, name), f"controller.{name}", unit)
             if gains.shape != (num_joints,):
                 raise ValueError(f"controller.{name} must have {num_joints} entries, got shape {gains.shape}")
             if not np.all(np.isfinite(gains)) or np.any(gains < 0):
@@ -133,7 +150,7 @@ class SpeedOverride:
 
     def validate(self) -> None:
         """Raise ValueError naming the field that is malformed."""
-        times, values = np.asarray(self.times, dtype=float), np.asarray(self.values, dtype=float)
+        times, values = real_array(self.times, "speed_override.times", "s"), real_array(self.values, "speed_override.values", "-")
         if times.shape != values.shape or times.ndim != 1:
             raise ValueError(f"speed_override.times and speed_override.values must be two lists of equal length, "
                              f"got {len(self.times)} and {len(self.values)} entries")
@@ -152,18 +169,25 @@ class SpeedOverride:
         return PiecewisePolynomial.ZeroOrderHold(breaks, np.array([values]))
 
 
+def speed_override_source(speed_override) -> LeafSystem | None:
+    """The source of a constant speed override in [0, 1] or of a :class:`SpeedOverride` profile;
+    None for None or an empty profile. Raises ValueError naming ``speed_override``."""
+    if speed_override is None or (isinstance(speed_override, SpeedOverride) and not np.size(speed_override.times)):
+        return None
+    if isinstance(speed_override, SpeedOverride):
+        return TrajectorySource(speed_override.trajectory())
+    value = real_scalar(speed_override, "speed_override", "a constant in [0, 1] or a SpeedOverride")
+    if not 0.0 <= value <= 1.0:
+        raise ValueError(f"speed_override must be in [0, 1], got {speed_override}")
+    return ConstantVectorSource([value])
+
+
 def add_speed_override(builder: DiagramBuilder, station: Diagram, speed_override) -> None:
     """Drive ``station``'s ``speed_override`` input from a constant in [0, 1] or a
     :class:`SpeedOverride` profile; None or an empty profile leaves it unconnected (1)."""
-    if speed_override is None or (isinstance(speed_override, SpeedOverride) and not speed_override.times):
+    source = speed_override_source(speed_override)
+    if source is None:
         return
-    if isinstance(speed_override, SpeedOverride):
-        source = TrajectorySource(speed_override.trajectory())
-    else:
-        value = float(speed_override)
-        if not 0.0 <= value <= 1.0:
-            raise ValueError(f"speed_override must be in [0, 1], got {speed_override}")
-        source = ConstantVectorSource([value])
     builder.AddNamedSystem("speed_override", source)
     builder.Connect(source.get_output_port(), station.GetInputPort("speed_override"))
 
@@ -216,9 +240,17 @@ def add_station(
         plant_config: the plant's configuration (default :func:`default_plant_config`).
         log_period: the loggers' period [s]: they sample at k * log_period from t = 0.
         meshcat: when given, the robot is drawn there.
+
+    A planner system is part of one diagram only (Drake owns it there): a second station needs a
+    new planner (``make_planner`` again); ValueError otherwise.
     """
     instance_of(planner, PlannerSystem, "planner")
+    if planner.GetSystemPathname().count("::") > 1:  # "::parent::planner" once built into a diagram
+        raise ValueError(f"planner is already part of a diagram ({planner.GetSystemPathname()}): a planner system "
+                         "can be used in one diagram (one run) only; make a new one for this run (make_planner again)")
     instance_of(robot, Robot, "robot")
+    if meshcat is not None:
+        instance_of(meshcat, Meshcat, "meshcat")
     instance_of(gains or ControllerGains(), ControllerGains, "gains")
     gains = (gains or ControllerGains()).for_robot(robot)
     plant_config = instance_of(plant_config or default_plant_config(), MultibodyPlantConfig, "plant_config")
@@ -226,7 +258,8 @@ def add_station(
     if planner.num_joints != n:
         raise ValueError(f"the planner has {planner.num_joints} joints, robot {robot.name} has {n}")
     time_step = positive_scalar(plant_config.time_step, "plant.time_step", "s")
-    positive_scalar(log_period, "log_period", "s")
+    log_period = positive_scalar(log_period, "log_period", "s")
+    log_period_check(log_period, time_step)
 
     plant, scene_graph = AddMultibodyPlant(plant_config, builder)
     instance = robot.add_to_plant(plant)
@@ -300,7 +333,13 @@ def build_station(planner: PlannerSystem, **kwargs) -> Diagram:
 def make_station(scenario, meshcat: Meshcat | None = None) -> Diagram:
     """The station of a :class:`~drake_traj.scenario.Scenario`: its planner, robot, gains, plant
     configuration and log period. Simulate it with ``ApplySimulatorConfig(scenario.simulator,
-    simulator)`` (the scenario's integration scheme, step and accuracy)."""
+    simulator)`` (the scenario's integration scheme, step and accuracy).
+
+    ``scenario`` is a Scenario object, not a file or a name: load one with
+    :func:`~drake_traj.scenario.load_scenario` (TypeError otherwise)."""
+    if not callable(getattr(scenario, "station_arguments", None)):  # a Scenario (the scenario module imports this one)
+        hint = " (load one with drake_traj.load_scenario(path, variant))" if isinstance(scenario, (str, os.PathLike)) else ""
+        raise TypeError(f"scenario must be a Scenario, got {type(scenario).__name__}: {scenario!r:.80}{hint}")
     from_scenario = scenario.station_arguments()
     return build_station(from_scenario.pop("planner"), meshcat=meshcat, **from_scenario)
 
@@ -315,9 +354,9 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
     every 10 ms of it. Returns None when the planner finished, else the :class:`Failure`
     (cause "interrupted" for Ctrl-C).
     """
-    positive_scalar(max_duration, "max_duration", "s")
-    if not np.isfinite(settle_time) or settle_time < 0:
-        raise ValueError(f"settle_time must be a non-negative number of seconds, got {settle_time}")
+    max_duration = positive_scalar(max_duration, "max_duration", "s")
+    settle_time = nonnegative_scalar(settle_time, "settle_time", "s")
+    callable_or_none(progress, "progress", "progress(t)")
     planner = station.GetSubsystemByName("planner")
     root = simulator.get_mutable_context()
     planner_context = planner.GetMyContextFromRoot(root)
@@ -377,7 +416,22 @@ def simulate(
         tracking_tolerance: the run fails if the TCP strays further from the reference [m], or
             if a joint's torque saturates (None: no such check; see
             :meth:`SimulationResult.execution_failure`).
+
+    Every argument is checked before the run (TypeError or ValueError naming it).
     """
+    # checked before the planner goes into a diagram (a planner is used in one diagram only)
+    instance_of(planner, PlannerSystem, "planner")
+    instance_of(name, str, "name")
+    if simulator_config is not None:
+        instance_of(simulator_config, SimulatorConfig, "simulator_config")
+    positive_scalar(max_duration, "max_duration", "s")
+    nonnegative_scalar(settle_time, "settle_time", "s")
+    if tracking_tolerance is not None:
+        positive_scalar(tracking_tolerance, "tracking_tolerance", "m")
+    speed_override_source(speed_override)
+    callable_or_none(progress, "progress", "progress(t)")
+    callable_or_none(add_systems, "add_systems", "add_systems(builder, station)")
+    callable_or_none(before_run, "before_run", "before_run(simulator)")
     builder = DiagramBuilder()
     station = builder.AddSystem(build_station(planner, robot=robot, gains=gains, plant_config=plant_config,
                                               log_period=log_period, meshcat=meshcat))

@@ -1,15 +1,59 @@
-"""Input checks shared by the planners. Every error is a ValueError naming the argument, the
-expected form (with the unit) and what was given."""
+"""Input checks shared by the package. Every error names the argument, the expected form (with
+the unit) and what was given: a ValueError for a malformed value (text, a boolean or None where a
+number is expected, a wrong shape, a number out of range), a TypeError for an object of the wrong
+type (:func:`instance_of`, :func:`path_argument`, :func:`callable_or_none`)."""
+
+import numbers
+import os
+from pathlib import Path
 
 import numpy as np
 
 
+def _first_non_number(value):
+    """``(entry,)`` for the first entry of ``value`` (a number or nested lists, tuples and arrays
+    of numbers) that is not a real number (text, a boolean, None, ...); None if every entry is.
+    ``np.array(..., dtype=float)`` would read the text '1.5' as 1.5 and True as 1.0."""
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind in "iuf":
+            return None
+        value = value.tolist()
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        return (value,)
+    if isinstance(value, numbers.Real):
+        return None
+    if isinstance(value, (list, tuple, range)):
+        for item in value:
+            found = _first_non_number(item)
+            if found is not None:
+                return found
+        return None
+    return (value,)
+
+
+def real_array(value, name: str, unit: str, what: str = "a real number or an array of real numbers") -> np.ndarray:
+    """``value`` (a number or nested lists of numbers) as a float array (copy); ValueError naming
+    ``name`` and saying it must be ``what`` for text, booleans, None or ragged rows. Non-finite
+    entries are kept."""
+    found = _first_non_number(value)
+    if found is not None:
+        raise ValueError(f"{name} must be {what} [{unit}], found {type(found[0]).__name__} {found[0]!r:.40}"
+                         + ("" if found[0] is value else f" in {value!r:.80}"))
+    try:
+        return np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        reason = str(exc)
+        if "inhomogeneous" in reason:  # a ragged list: say which row is off
+            reason = f"its rows must have the same length, got lengths {[len(row) for row in value]}"
+        raise ValueError(f"{name} must be an array of real numbers [{unit}]: {reason}") from exc
+
+
 def real_scalar(value, name: str, unit: str, *, minimum: float = -np.inf, strict: bool = False) -> float:
     """``value`` as a finite float >= ``minimum`` (> with ``strict``), else ValueError naming ``name``."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a real number [{unit}]: {exc}") from exc
+    array = real_array(value, name, unit, "a real number")
+    if array.size != 1:
+        raise ValueError(f"{name} must be a real number [{unit}], got shape {array.shape}")
+    number = float(array.reshape(-1)[0])
     if not np.isfinite(number):
         raise ValueError(f"{name} must be finite [{unit}], got {number}")
     if number < minimum or (strict and number == minimum):
@@ -29,10 +73,7 @@ def nonnegative_scalar(value, name: str, unit: str) -> float:
 
 def finite_array(value, name: str, unit: str, *, shape: tuple | None = None) -> np.ndarray:
     """``value`` as a float array (copy) of ``shape`` (any if None) with finite entries."""
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be an array of real numbers [{unit}]: {exc}") from exc
+    array = real_array(value, name, unit)
     if shape is not None and array.shape != shape:
         raise ValueError(f"{name} must have shape {shape} [{unit}], got shape {array.shape}")
     if not np.all(np.isfinite(array)):
@@ -44,10 +85,7 @@ def finite_array(value, name: str, unit: str, *, shape: tuple | None = None) -> 
 
 def positive_vector(value, name: str, n: int) -> np.ndarray:
     """A per-joint limit: a scalar (every joint) or n values, all finite and > 0."""
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a number or {n} numbers: {exc}") from exc
+    array = real_array(value, name, "per joint")
     if array.ndim == 0:
         array = np.full(n, float(array))
     if array.shape != (n,):
@@ -68,8 +106,52 @@ def limit_or_default(value, default, name: str, n: int) -> np.ndarray:
     return positive_vector(value, name, n)
 
 
-def instance_of(value, expected: type, name: str):
-    """``value`` if it is an ``expected``, else TypeError naming ``name`` and what was given."""
+def whole_number(value, name: str, *, minimum: int) -> int:
+    """``value`` as an int >= ``minimum`` (an int, or a float with no fraction), else ValueError
+    naming ``name``."""
+    if (isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) or not np.isfinite(value)
+            or value != int(value)):
+        raise ValueError(f"{name} must be a whole number >= {minimum}, got {value!r:.80}")
+    if int(value) < minimum:
+        raise ValueError(f"{name} must be a whole number >= {minimum}, got {int(value)}")
+    return int(value)
+
+
+def flag(value, name: str) -> bool:
+    """``value`` if it is True or False (a Python or NumPy bool), else ValueError naming ``name``
+    (a truthy text such as 'no' is not a yes)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, got {type(value).__name__} {value!r:.80}")
+    return bool(value)
+
+
+def instance_of(value, expected: type | tuple[type, ...], name: str, hint: str = ""):
+    """``value`` if it is an ``expected`` (a type or a tuple of types), else TypeError naming
+    ``name``, the expected type(s), what was given and ``hint``."""
     if not isinstance(value, expected):
-        raise TypeError(f"{name} must be a {expected.__name__}, got {type(value).__name__}: {value!r:.80}")
+        names = " or ".join(t.__name__ for t in (expected if isinstance(expected, tuple) else (expected,)))
+        raise TypeError(f"{name} must be a {names}, got {type(value).__name__}: {value!r:.80}{hint}")
     return value
+
+
+def path_argument(value, name: str, what: str = "file") -> Path:
+    """``value`` (a str or ``os.PathLike``) as a Path, else TypeError naming ``name``."""
+    if not isinstance(value, (str, os.PathLike)) or value == "":
+        raise TypeError(f"{name} must be a {what} path (str or Path), got {type(value).__name__}: {value!r:.80}")
+    return Path(value)
+
+
+def callable_or_none(value, name: str, signature: str):
+    """``value`` if it is None or callable, else TypeError naming ``name`` and the call expected."""
+    if value is not None and not callable(value):
+        raise TypeError(f"{name} must be a function {signature} or None, got {type(value).__name__}: {value!r:.80}")
+    return value
+
+
+def log_period_check(log_period: float, time_step: float) -> None:
+    """Raise ValueError unless ``log_period`` [s] is a whole multiple of the plant's ``time_step``
+    [s] (the loggers sample the plant's steps). Both already checked positive."""
+    steps = log_period / time_step
+    if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
+        raise ValueError(f"log_period must be a whole multiple of plant.time_step = {time_step} s "
+                         f"(the loggers sample the plant's steps), got {log_period} s")

@@ -3,6 +3,7 @@ nothing of an earlier run touched. Table-driven over scenario YAML, the CLI, the
 saved results; a property test mutates the shipped scenarios at random."""
 
 import contextlib
+import functools
 import io
 import json
 import math
@@ -19,14 +20,18 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+import drake_traj
 from drake_traj import (
     ControllerGains,
     PajakConfig,
     QuinticConfig,
+    Scenario,
     SimulationResult,
+    ToppraConfig,
     cli,
     get_robot,
     load_scenario,
+    make_station,
     simulate,
 )
 from drake_traj.planners import make_planner
@@ -243,6 +248,29 @@ def quintic_plan():
     return plan_synchronized_quintic(ur10e.home_configuration, [[-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]], 1.05, 1.40)
 
 
+def quintic_planner():
+    """A fresh planner system of :func:`quintic_plan` (a planner is used in one diagram only)."""
+    return QuinticPtpPlanner(quintic_plan(), 1.05, 1.4)
+
+
+@functools.cache
+def short_result() -> SimulationResult:
+    """The result of a 10 mrad move (a fraction of a second of simulation), made once."""
+    ur10e = get_robot("ur10e")
+    planner = QuinticPtpPlanner(plan_synchronized_quintic(ur10e.home_configuration, [ur10e.home_configuration + 0.01],
+                                                          1.05, 1.40), 1.05, 1.4)
+    return simulate(planner, settle_time=0.01)
+
+
+def used_twice():
+    planner = quintic_planner()
+    build_station(planner)
+    simulate(planner)
+
+
+UR10E_HOME = get_robot("ur10e").home_configuration
+GOAL = [[-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]]
+
 API_CASES = [
     ("quintic plan list", lambda: QuinticPtpPlanner(plan=[1, 2], velocity_limit=1, acceleration_limit=1), TypeError, r"plan must be a QuinticPlan"),
     ("pajak q_initial text", lambda: PajakPlanner(paper_parameters(3), ["a"] * 6), ValueError, r"q_initial"),
@@ -267,6 +295,67 @@ API_CASES = [
      r"the planner has 6 joints, robot scara has 3"),
     ("pajak on another robot", lambda: make_planner(paper_parameters(3), get_robot("li_4dof"), [0.0] * 4), ValueError,
      r"the Pająk planner runs on the UR10e"),
+    # numbers given as text or booleans are refused, not converted
+    ("quintic goals as text", lambda: make_planner(QuinticConfig(goals=[[str(v) for v in GOAL[0]]]), get_robot("ur10e"), UR10E_HOME),
+     ValueError, r"goals must be a real number or an array of real numbers .*found str '-0.9'"),
+    ("pajak waypoints as text", lambda: PajakConfig(waypoints=[["-0.175", "-0.525", "0.730", "3.14", "0.0", "2.35"]]).validate(),
+     ValueError, r"waypoints must be .*found str '-0.175'"),
+    ("limits as booleans", lambda: make_planner(QuinticConfig(goals=GOAL, velocity_limit=[True] * 6), get_robot("ur10e"), UR10E_HOME),
+     ValueError, r"velocity_limit must be .*found bool True"),
+    ("feedforward as text", lambda: ControllerGains(feedforward_acceleration="no").for_robot(get_robot("ur10e")), ValueError,
+     r"controller.feedforward_acceleration must be True or False, got str 'no'"),
+    ("gains as text", lambda: ControllerGains(kp="abc").for_robot(get_robot("ur10e")), ValueError,
+     r"controller.kp must be .*found str 'abc'"),
+    # simulate: every argument checked before the run
+    ("tracking tolerance NaN", lambda: simulate(quintic_planner(), tracking_tolerance=math.nan), ValueError,
+     r"tracking_tolerance must be finite \[m\], got nan"),
+    ("tracking tolerance negative", lambda: simulate(quintic_planner(), tracking_tolerance=-1), ValueError,
+     r"tracking_tolerance must be > 0 \[m\], got -1.0"),
+    ("tracking tolerance text", lambda: simulate(quintic_planner(), tracking_tolerance="5 mm"), ValueError,
+     r"tracking_tolerance must be a real number \[m\], found str '5 mm'"),
+    ("log period off the plant's steps", lambda: simulate(quintic_planner(), log_period=0.0015), ValueError,
+     r"log_period must be a whole multiple of plant.time_step = 0.001 s .*got 0.0015 s"),
+    ("log period text", lambda: simulate(quintic_planner(), log_period="0.001"), ValueError,
+     r"log_period must be a real number \[s\], found str '0.001'"),
+    ("speed override text", lambda: simulate(quintic_planner(), speed_override="half"), ValueError,
+     r"speed_override must be a real number .*found str 'half'"),
+    ("progress not a function", lambda: simulate(quintic_planner(), progress=5), TypeError,
+     r"progress must be a function progress\(t\) or None, got int: 5"),
+    ("add_systems not a function", lambda: simulate(quintic_planner(), add_systems=5), TypeError,
+     r"add_systems must be a function add_systems\(builder, station\) or None, got int"),
+    ("planner used twice", used_twice, ValueError,
+     r"planner is already part of a diagram .*: a planner system can be used in one diagram .*make a new one"),
+    # the scenario API
+    ("top-level make_planner given a config", lambda: drake_traj.make_planner(QuinticConfig(goals=GOAL), get_robot("ur10e"), UR10E_HOME),
+     TypeError, r"scenario must be a Scenario, got QuinticConfig and 2 more arguments: .*"
+                r"drake_traj.planners.make_planner\(config, robot, q_initial\)"),
+    ("make_planner None", lambda: drake_traj.make_planner(None), TypeError, r"scenario must be a Scenario, got NoneType"),
+    ("make_planner a name", lambda: drake_traj.make_planner("quintic_ptp"), TypeError,
+     r"scenario must be a Scenario, got str: 'quintic_ptp' \(load one with drake_traj.load_scenario"),
+    ("make_station None", lambda: make_station(None), TypeError, r"scenario must be a Scenario, got NoneType"),
+    ("make_station a file name", lambda: make_station("x.yaml"), TypeError,
+     r"scenario must be a Scenario, got str: 'x.yaml' \(load one with drake_traj.load_scenario"),
+    ("variant a list", lambda: load_scenario(DIAGRAMS / "pajak.yaml", ["sim1"]), TypeError, r"variant must be a str, got list"),
+    ("scenario log period text", lambda: make_station(Scenario(planner=QuinticConfig(goals=GOAL), log_period="0.001")), ValueError,
+     r"log_period must be a real number \[s\], found str '0.001'"),
+    ("scenario q_initial text", lambda: drake_traj.make_planner(Scenario(q_initial=["a"] * 6)), ValueError,
+     r"^q_initial must be .*found str 'a'"),
+    ("toppra grid points fraction", lambda: make_planner(ToppraConfig(path=[UR10E_HOME + 0.1], grid_points=2.5), get_robot("ur10e"),
+                                                         UR10E_HOME), ValueError, r"grid_points must be a whole number >= 3, got 2.5"),
+    ("toppra grid points two", lambda: make_planner(ToppraConfig(path=[UR10E_HOME + 0.1], grid_points=2), get_robot("ur10e"),
+                                                    UR10E_HOME), ValueError, r"grid_points must be a whole number >= 3, got 2"),
+    ("tcp_pose of None", lambda: get_robot("ur10e").tcp_pose(None), ValueError, r"q must be .*found NoneType None"),
+    ("tcp_pose short q", lambda: get_robot("scara").tcp_pose([0.0, 0.0]), ValueError, r"q must have shape \(\.\.\., 3\)"),
+    # results
+    ("result array None", lambda: SimulationResult(**{**vars(short_result()), "q_meas": None}), ValueError,
+     r"q_meas must be .*found NoneType None"),
+    ("result array short rows", lambda: SimulationResult(**{**vars(short_result()), "tau": short_result().tau[:, :3]}), ValueError,
+     r"tau has 3 joints, t and q_ref 6"),
+    ("load None", lambda: SimulationResult.load(None), TypeError, r"directory must be a folder path \(str or Path\), got NoneType"),
+    ("export to None", lambda: short_result().export(None, "csv"), TypeError, r"path must be a file path \(str or Path\), got NoneType"),
+    ("figures to None", lambda: short_result().save_figures(None), TypeError, r"directory must be a folder path"),
+    ("figures into a file", lambda: short_result().save_figures(__file__), ValueError,
+     r"directory: output folder .*test_bad_input.py is a file, not a folder"),
 ]
 
 
@@ -321,6 +410,19 @@ def test_damaged_result_files_name_the_file(saved_run, tmp_path, how, pattern):
     with pytest.raises(ResultFileError, match=pattern) as info:
         SimulationResult.load(folder)
     assert str(folder / "result.npz") in str(info.value)
+
+
+def test_a_log_with_nan_has_not_succeeded():
+    # NaN in a logged array is a failure, and the metrics carry it instead of skipping it
+    arrays = vars(short_result())
+    result = SimulationResult(**{**arrays, "q_meas": arrays["q_meas"].copy()})
+    assert result.succeeded
+    result.q_meas[5, 2] = math.nan
+    metrics = result.metrics()
+    assert not result.succeeded and not metrics.succeeded
+    assert metrics.failure.startswith("the log is not finite: q_meas[5]")
+    assert math.isnan(metrics.tracking_error_joint_max_rad)
+    assert result.execution_failure(0.005).cause == "non-finite"
 
 
 def test_missing_result_file_is_named(tmp_path):

@@ -46,6 +46,7 @@ def make_planner(config: PlannerConfig, robot: Robot, q_initial) -> PlannerSyste
     try:
         maker = _MAKERS[type(config)]
     except KeyError:
-        raise TypeError(f"config must be one of {[c.__name__ for c in PLANNER_CONFIGS]}, got {type(config).__name__}") from None
+        raise TypeError(f"config must be one of {[c.__name__ for c in PLANNER_CONFIGS]}, got {type(config).__name__} "
+                        "(a scenario's planner is drake_traj.make_planner(scenario))") from None
     instance_of(robot, Robot, "robot")
     return maker(config, robot, finite_array(q_initial, "q_initial", "rad or m", shape=(robot.num_joints,)))

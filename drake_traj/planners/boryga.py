@@ -42,7 +42,7 @@ import numpy as np
 
 from drake_traj.planners.base import HermiteLaw, TimeLawPlanner
 from drake_traj.robots import Robot
-from drake_traj.validation import finite_array, limit_or_default, positive_scalar
+from drake_traj.validation import finite_array, limit_or_default, positive_scalar, real_array
 
 __all__ = [
     "PHASES",
@@ -943,7 +943,7 @@ class BorygaConfig:
 def make(config: BorygaConfig, robot: Robot, q_initial) -> BorygaLoopPlanner:
     """The loop of ``config`` on ``robot`` (``q_initial`` gives the tool orientation, the IK
     branch and, for the default placement on robots other than Boryga's, the point B)."""
-    points = [np.asarray(getattr(config, name), dtype=float) for name in ("B", "M", "E")]
+    points = [real_array(getattr(config, name), name, "m") for name in ("B", "M", "E")]
     if any(point.size for point in points):
         if not all(point.shape == (3,) for point in points):
             raise ValueError(f"B, M and E must all be 3-vectors [m] or all empty, got {[p.tolist() for p in points]}")

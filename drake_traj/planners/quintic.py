@@ -25,7 +25,7 @@ import numpy as np
 
 from drake_traj.planners.base import TimeLawPlanner
 from drake_traj.robots import UR10E, Robot
-from drake_traj.validation import instance_of, limit_or_default
+from drake_traj.validation import instance_of, limit_or_default, real_array
 
 __all__ = [
     "QuinticPlan",
@@ -50,16 +50,9 @@ _PEAK_DDR = 10.0 / np.sqrt(3.0)  # max |r''(s)|, at s = 1/2 -+ sqrt(3)/6
 
 
 def _as_float_array(value, name: str) -> np.ndarray:
-    """``value`` as a float ndarray (copy), or ValueError naming ``name``."""
-    try:
-        array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        reason = str(exc)
-        if "inhomogeneous" in reason:  # a ragged list: say which row is off
-            lengths = [len(row) if hasattr(row, "__len__") else 1 for row in value]
-            reason = f"its rows must have the same length, got lengths {lengths}"
-        raise ValueError(f"{name} must be a real number or an array of real numbers: {reason}") from exc
-    return array
+    """``value`` as a float ndarray (copy), or ValueError naming ``name`` (text and booleans are
+    not numbers: :func:`~drake_traj.validation.real_array`)."""
+    return real_array(value, name, "rad, rad/s, rad/s^2 or s")
 
 
 def _require_finite(array: np.ndarray, name: str) -> None:

@@ -21,6 +21,7 @@ import numpy as np
 from pydrake.multibody.parsing import Parser
 
 from drake_traj.data import data_directory
+from drake_traj.validation import real_array
 
 __all__ = ["LIMIT_TOL", "PointRobot", "Robot"]
 
@@ -36,12 +37,13 @@ def point_array(position) -> np.ndarray:
     return array
 
 
-def joint_vectors(q, size: int, name: str = "q") -> np.ndarray:
-    """``q`` as a float array of shape (..., size), or ValueError naming ``name``."""
-    array = np.asarray(q, dtype=float)
+def joint_vectors(q, size: int, name: str = "q", *, finite: bool = True) -> np.ndarray:
+    """``q`` as a float array of shape (..., size) (with finite entries unless ``finite`` is
+    False), or ValueError naming ``name``."""
+    array = real_array(q, name, "rad or m")
     if array.ndim == 0 or array.shape[-1] != size:
-        raise ValueError(f"{name} must have shape (..., {size}), got {array.shape}")
-    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must have shape (..., {size}) [rad or m], got {array.shape}")
+    if finite and not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must be finite")
     return array
 
@@ -130,6 +132,12 @@ class Robot:
         return instance
 
     # ---- kinematics ----------------------------------------------------------------------------
+    def joint_positions(self, q, name: str = "q") -> np.ndarray:
+        """``q`` as joint vectors of this robot, a float array of shape (..., n), or ValueError
+        naming ``name``: the check of :meth:`tcp_pose`'s and :meth:`tool_position`'s ``q`` (non-finite
+        entries pass it: a log with NaN rows gives NaN poses on the UR10e)."""
+        return joint_vectors(q, self.num_joints, name, finite=False)
+
     def tcp_pose(self, q) -> np.ndarray:  # pragma: no cover - abstract
         """[x, y, z, phi_X, phi_Y, phi_Z] of the tool in the base frame [m, rad], (..., 6) for q of
         shape (..., n); Z-Y-X Euler angles, zeros where the robot only places a point."""
@@ -194,11 +202,11 @@ class PointRobot(Robot):
         return 0.5 * (self.lower_limits + self.upper_limits)
 
     def tcp_pose(self, q) -> np.ndarray:
-        position = self.fk(q)
+        position = self.fk(self.joint_positions(q))
         return np.concatenate([position, np.zeros(position.shape[:-1] + (3,))], axis=-1)
 
     def tool_position(self, q) -> np.ndarray:
-        return self.fk(q)
+        return self.fk(self.joint_positions(q))
 
     def tool_motion(self, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
         jacobian = self.jacobian(q)

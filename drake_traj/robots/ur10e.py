@@ -20,6 +20,7 @@ import numpy as np
 from drake_traj.compiled import compiled
 from drake_traj.errors import SingularConfigurationError
 from drake_traj.robots.base import Robot
+from drake_traj.validation import real_array
 
 __all__ = ["UR10E", "UR10e"]
 
@@ -65,10 +66,7 @@ def model_path() -> Path:
 
 
 def _as_joint_vector(q, name: str = "q") -> np.ndarray:
-    try:
-        q = np.asarray(q, dtype=float)
-    except (TypeError, ValueError) as error:
-        raise ValueError(f"{name} must be {NUM_JOINTS} joint positions [rad]: {error}") from None
+    q = real_array(q, name, "rad")
     if q.shape != (NUM_JOINTS,):
         raise ValueError(f"{name} must have shape ({NUM_JOINTS},), got {q.shape}")
     if not np.all(np.isfinite(q)):
@@ -750,13 +748,13 @@ class UR10e(Robot):
 
     def tcp_pose(self, q) -> np.ndarray:
         """:func:`task_pose` for one q; the closed form of :func:`ur10e_kinematics` for many."""
-        q = np.asarray(q, dtype=float)
+        q = self.joint_positions(q)
         if q.ndim == 1:
             return task_pose(q)
         return ur10e_kinematics(q, np.zeros_like(q))[0]
 
     def tool_position(self, q) -> np.ndarray:
-        q = np.asarray(q, dtype=float)
+        q = self.joint_positions(q)
         return ur10e_kinematics(q, np.zeros_like(q))[0][..., :3]
 
     def tool_motion(self, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:

@@ -35,7 +35,7 @@ from pydrake.trajectories import PathParameterizedTrajectory, PiecewisePolynomia
 
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.robots import Robot
-from drake_traj.validation import limit_or_default, positive_vector
+from drake_traj.validation import limit_or_default, positive_vector, real_array, whole_number
 
 __all__ = [
     "ToppraLaw",
@@ -147,7 +147,7 @@ def time_optimal_along_path(
         velocity_limit, acceleration_limit: per joint [rad/s, rad/s^2], > 0 (scalar or (n,)).
         plant: a finalized MultibodyPlant with n positions (q = v); default a plain n-joint chain.
         grid_points: None (Drake's ``CalcGridPoints`` with max_err 1e-4, at least 200 points and
-            segments <= L / 200), an int (that many points evenly spaced in s) or an increasing
+            segments <= L / 200), an int >= 3 (that many points evenly spaced in s) or an increasing
             array from path.start_time() to path.end_time().
         discretization: Toppra's constraint discretisation.
 
@@ -176,14 +176,13 @@ def time_optimal_along_path(
         options = CalcGridPointsOptions(max_err=1e-4, max_iter=100, max_seg_length=(s1 - s0) / 200, min_points=200)
         grid = np.asarray(Toppra.CalcGridPoints(path, options), dtype=float).ravel()
     elif np.ndim(grid_points) == 0:
-        if int(grid_points) < 2:
-            raise ValueError(f"grid_points must be at least 2, got {grid_points}")
-        grid = np.linspace(s0, s1, int(grid_points))
+        # two points (the path's ends) leave Toppra no interval to move in: an infinite duration
+        grid = np.linspace(s0, s1, whole_number(grid_points, "grid_points", minimum=3))
     else:
-        grid = np.asarray(grid_points, dtype=float).ravel()
-        if len(grid) < 2 or np.any(np.diff(grid) <= 0) or not np.isclose(grid[0], s0) or not np.isclose(grid[-1], s1):
+        grid = real_array(grid_points, "grid_points", "path parameter s").ravel()
+        if len(grid) < 3 or np.any(np.diff(grid) <= 0) or not np.isclose(grid[0], s0) or not np.isclose(grid[-1], s1):
             raise ValueError(
-                f"grid_points must increase strictly from the path start {s0} to its end {s1}, "
+                f"grid_points must be at least 3 points increasing strictly from the path start {s0} to its end {s1}, "
                 f"got {len(grid)} points from {grid[0] if len(grid) else None} to {grid[-1] if len(grid) else None}"
             )
         grid[0], grid[-1] = s0, s1
@@ -339,13 +338,20 @@ class ToppraConfig:
         path: joint samples after the start [rad], one row of n per sample, dense enough to
             define the path (:func:`geometric_path_from_samples` smooths and decimates them).
         velocity_limit, acceleration_limit: per joint; empty: the robot's joint-move limits.
-        grid_points: Toppra grid points evenly spaced in arc length; 0: Drake's CalcGridPoints.
+        grid_points: Toppra grid points evenly spaced in arc length, at least 3; 0: Drake's
+            CalcGridPoints.
     """
 
     path: list[list[float]] = field(default_factory=list)
     velocity_limit: list[float] = field(default_factory=list)
     acceleration_limit: list[float] = field(default_factory=list)
     grid_points: int = 0
+
+
+def _grid_points(value):
+    """The config's ``grid_points`` for :func:`time_optimal_along_path`: 0 is None (Drake's
+    CalcGridPoints); anything else is checked there."""
+    return None if not isinstance(value, bool) and isinstance(value, (int, float)) and value == 0 else value
 
 
 def make(config: ToppraConfig, robot: Robot, q_initial) -> ToppraPlanner:
@@ -355,5 +361,5 @@ def make(config: ToppraConfig, robot: Robot, q_initial) -> ToppraPlanner:
     velocity = limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", n)
     acceleration = limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit", n)
     path = geometric_path_from_samples(start_and_goals(q_initial, config.path, n))
-    _, trajectory = time_optimal_along_path(path, velocity, acceleration, grid_points=config.grid_points or None)
+    _, trajectory = time_optimal_along_path(path, velocity, acceleration, grid_points=_grid_points(config.grid_points))
     return ToppraPlanner(ToppraLaw(trajectory), velocity, acceleration)

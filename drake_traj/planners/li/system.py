@@ -10,7 +10,7 @@ from drake_traj.planners.base import TimeLawPlanner
 from drake_traj.planners.li.plan import LiPlan, plan_li_path
 from drake_traj.planners.li.repair import tool_speed_and_acceleration
 from drake_traj.robots import LI_4DOF, Robot
-from drake_traj.validation import instance_of, limit_or_default
+from drake_traj.validation import instance_of, limit_or_default, real_array
 
 __all__ = ["CARTESIAN_ACCELERATION_LIMIT", "CARTESIAN_VELOCITY_LIMIT", "LiConfig", "LiPathPlanner", "li_closed_path",
            "make"]
@@ -178,7 +178,7 @@ def make(config: LiConfig, robot: Robot, q_initial) -> LiPathPlanner:
     """The planner of ``config`` on ``robot`` (``q_initial``: see :class:`LiConfig`)."""
     q_initial = np.asarray(q_initial, dtype=float)
     if np.size(config.points):
-        points = np.asarray(config.points, dtype=float).reshape(-1, 3)
+        points = real_array(config.points, "points", "m").reshape(-1, 3)
     else:
         points = li_closed_path()
         if robot.name != LI_4DOF.name:

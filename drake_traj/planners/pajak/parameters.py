@@ -6,7 +6,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from drake_traj.robots import ur10e as robot
-from drake_traj.validation import positive_vector
+from drake_traj.validation import flag, positive_vector, real_array
 
 __all__ = ["PAPER_METHOD", "PajakConfig", "paper_initial_configuration", "paper_parameters"]
 
@@ -107,10 +107,7 @@ class PajakConfig:
         """Check every field; return a copy with arrays normalised ((w, 6) waypoints, (6,) gains
         and limits). Raises ValueError naming the field."""
         n = robot.NUM_JOINTS
-        try:
-            waypoints = np.array(self.waypoints, dtype=float)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"waypoints must be an array of numbers of shape (w, 6): {exc}") from exc
+        waypoints = real_array(self.waypoints, "waypoints", "m and rad, shape (w, 6)")
         if waypoints.ndim == 1 and waypoints.shape == (6,):
             waypoints = waypoints[None, :]
         if waypoints.ndim != 2 or waypoints.shape[1] != 6 or waypoints.shape[0] == 0:
@@ -162,12 +159,11 @@ class PajakConfig:
                 f"waypoints[{k}] and waypoints[{k + 1}] are {steps[k]:.4f} m apart, closer than the "
                 f"neighbourhood {values['neighbourhood']} m"
             )
-        for flag in (
+        for name in (
             "limit_velocity", "limit_acceleration", "blend_waypoints", "smooth_penalty",
             "continuous_switching", "bounded_scaling", "damped_inverse", "preserve_damping",
         ):
-            if not isinstance(getattr(self, flag), (bool, np.bool_)):
-                raise ValueError(f"{flag} must be True or False, got {getattr(self, flag)!r}")
+            flag(getattr(self, name), name)
         return replace(self, waypoints=waypoints, vartheta=float(vartheta), **values)
 
 
