@@ -463,7 +463,7 @@ def test_bad_v_max_is_rejected(v_max, match):
     [
         (([0.5, 0.5], M, E), r"B must have shape \(3,\)"),
         ((B, [0.54, np.nan, 1.0], E), r"M\[1\] must be finite"),
-        ((B, M, "E"), "E must be an array of real numbers"),
+        ((B, M, "E"), r"E must be a real number or an array of real numbers \[m\], found str 'E'"),
     ],
 )
 def test_bad_points_are_rejected(points, match):
