@@ -2,25 +2,29 @@
 
     python examples/bench_planner_cost.py [--repeats 3] [--time-step 0.001] [--pajak-law-only]
 
-All in one process, floor first:
+All in one process; for each shipped scenario, ``--repeats`` times in turn:
 
 1. the floor: the same discrete robot plant (SAP, PD actuators, gravity compensation, three
    loggers) driven by a ``ConstantVectorSource`` at the start configuration, simulated for 5 s;
-2. each shipped scenario's station under its own ``SimulatorConfig`` (``simulate``): the
-   real-time factor (simulated seconds per wall-clock second) and its ratio to the floor of the
-   same robot;
-3. the planner's cost per evaluation of its law at mid-motion (``evaluate``, uncached; median of
-   7 batches of 500) and, for the Pająk planner, its law integrated alone (``preflight``: RK4 at
-   1 ms) against the floor's wall time for the same simulated time;
-4. the Pająk law (Pająk 2024, sim 3): one evaluation of q̈ and c from Python (``PajakLaw.acceleration``,
-   median of 9 batches of 2000 calls), ``integrate`` of the whole task (best of ``--repeats``)
-   against the floor simulating the same time (best of ``--repeats``) in this process, and the
-   compiled kernels' first-call cost: a fresh process with an empty numba cache (compiles and
-   writes the cache), then a second one reading it.
+2. the moving floor: the same plant following the scenario's own reference motion from Drake's
+   C++ ``TrajectorySource`` (one step ahead, inverse dynamics): what the motion costs the plant;
+3. the scenario's station under its own ``SimulatorConfig`` (``run_station``).
 
-Best of ``--repeats`` runs for the real-time factors (the machine is shared; the best run is the
-one least disturbed). Prints Markdown tables. A benchmark, not a test: numbers depend on the
-machine.
+It prints the medians of the real-time factors (simulated seconds per wall-clock second), the
+median (and range) of the station's ratio to the floor measured next to it, the moving floor's
+ratio to the floor, and the station's ratio to the moving floor: what the planner and its Python
+calls cost. Then the planner's cost per evaluation of its law at mid-motion (``evaluate`` at a
+new time per call; median of 7 batches of 500) and, for the Pająk planner, its law integrated
+alone (``preflight``: RK4 at 1 ms) against the floor's wall time for the same simulated time.
+
+Last, the Pająk law (Pająk 2024, sim 3): one evaluation of q̈ and c from Python
+(``PajakLaw.acceleration``, median of 9 batches of 2000 calls), ``integrate`` of the whole task
+(best of ``--repeats``) against the floor simulating the same time (best of ``--repeats``), and
+the compiled kernels' first-call cost: a fresh process with an empty numba cache (compiles and
+writes the cache), then a second one reading it.
+
+The machine is shared and its speed drifts: ratios are taken between runs made next to each
+other. Prints Markdown tables. A benchmark, not a test: numbers depend on the machine.
 """
 
 import argparse
@@ -37,22 +41,24 @@ from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.controllers import InverseDynamics
 from pydrake.systems.framework import DiagramBuilder, TriggerType
-from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
+from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, MatrixGain, TrajectorySource
 
 from drake_traj.planners import pajak
 from drake_traj.robots import get_robot
 from drake_traj.scenario import default_scenario_path, load_scenario
-from drake_traj.station import build_station, run_station
+from drake_traj.station import build_station, run_station, simulate
 
 SCENARIOS = (("quintic_ptp.yaml", None), ("pajak.yaml", "sim3"), ("boryga_loop.yaml", "ur10e"),
              ("li_closed_path.yaml", "ur10e"), ("li_closed_path.yaml", "4dof"))
 FLOOR_DURATION = 5.0  # [s] simulated
 
 
-def floor_real_time_factor(scenario, duration: float = FLOOR_DURATION) -> float:
-    """Real-time factor of the plant alone: the scenario's robot, plant config and gains, held at
-    its start by a constant desired state, gravity compensation, three loggers; ``duration`` [s]
-    simulated."""
+def floor_real_time_factor(scenario, duration: float = FLOOR_DURATION, reference=None) -> float:
+    """Real-time factor of the plant alone: the scenario's robot, plant config and gains, three
+    loggers, ``duration`` [s] simulated. Held at its start by a constant desired state with
+    gravity compensation; or, given ``reference`` (a PiecewisePolynomial of q), moving along it:
+    Drake's C++ ``TrajectorySource`` gives q, q̇, q̈, one step ahead, with inverse dynamics, as
+    the station does (the arm's motion costs the plant's solver too)."""
     robot = get_robot(scenario.robot)
     gains = scenario.controller.for_robot(robot)
     builder = DiagramBuilder()
@@ -63,11 +69,23 @@ def floor_real_time_factor(scenario, duration: float = FLOOR_DURATION) -> float:
     plant.Finalize()
     q0 = scenario.start_configuration()
     plant.SetDefaultPositions(instance, q0)
-    source = builder.AddSystem(ConstantVectorSource(np.concatenate([q0, np.zeros_like(q0)])))
-    builder.Connect(source.get_output_port(), plant.get_desired_state_input_port(instance))
-    gravity = builder.AddSystem(InverseDynamics(plant, InverseDynamics.InverseDynamicsMode.kGravityCompensation))
-    builder.Connect(plant.get_state_output_port(instance), gravity.get_input_port_estimated_state())
-    builder.Connect(gravity.get_output_port_generalized_force(), plant.get_actuation_input_port(instance))
+    n = robot.num_joints
+    if reference is None:
+        source = builder.AddSystem(ConstantVectorSource(np.concatenate([q0, np.zeros_like(q0)])))
+        builder.Connect(source.get_output_port(), plant.get_desired_state_input_port(instance))
+        feedforward = builder.AddSystem(InverseDynamics(plant, InverseDynamics.InverseDynamicsMode.kGravityCompensation))
+    else:
+        source = builder.AddSystem(TrajectorySource(reference, output_derivative_order=2))  # [q; q̇; q̈]
+        h, eye, zero = scenario.plant.time_step, np.eye(n), np.zeros((n, n))
+        lookahead = builder.AddSystem(MatrixGain(np.block([[eye, h * eye, 0.5 * h * h * eye], [zero, eye, h * eye]])))
+        builder.Connect(source.get_output_port(), lookahead.get_input_port())
+        builder.Connect(lookahead.get_output_port(), plant.get_desired_state_input_port(instance))
+        acceleration = builder.AddSystem(MatrixGain(np.hstack([zero, zero, eye])))
+        builder.Connect(source.get_output_port(), acceleration.get_input_port())
+        feedforward = builder.AddSystem(InverseDynamics(plant, InverseDynamics.InverseDynamicsMode.kInverseDynamics))
+        builder.Connect(acceleration.get_output_port(), feedforward.get_input_port_desired_acceleration())
+    builder.Connect(plant.get_state_output_port(instance), feedforward.get_input_port_estimated_state())
+    builder.Connect(feedforward.get_output_port_generalized_force(), plant.get_actuation_input_port(instance))
     for port in (source.get_output_port(), plant.get_state_output_port(instance),
                  plant.get_net_actuation_output_port(instance)):
         LogVectorOutput(port, builder, {TriggerType.kPeriodic}, scenario.logging_period())
@@ -135,7 +153,7 @@ def pajak_first_call_s() -> tuple[float, float]:
 
 
 def pajak_law_cost(scenario, repeats: int) -> None:
-    """Print the Pająk law's cost (item 4 of the module docstring) on the scenario's task."""
+    """Print the Pająk law's cost (the last table of the module docstring) on the scenario's task."""
     law = pajak.PajakLaw(scenario.planner)
     q0 = scenario.start_configuration()
     run = pajak.integrate(law, q0)
@@ -169,9 +187,9 @@ def pajak_law_cost(scenario, repeats: int) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=3, help="runs per measurement (the best is kept)")
+    parser.add_argument("--repeats", type=int, default=3, help="runs per measurement (their median is kept)")
     parser.add_argument("--time-step", type=float, default=None, help="plant time step [s] (default: the scenario's)")
-    parser.add_argument("--pajak-law-only", action="store_true", help="only item 4, the Pająk law's cost")
+    parser.add_argument("--pajak-law-only", action="store_true", help="only the last table, the Pająk law's cost")
     args = parser.parse_args()
     scenarios = [load_scenario(default_scenario_path().parent / path, variant) for path, variant in SCENARIOS]
     if args.time_step is not None:
@@ -182,17 +200,22 @@ def main() -> None:
     if args.pajak_law_only:
         pajak_law_cost(pajak_scenario, args.repeats)
         return
-    floors = {}
-    print("| robot | floor real-time factor |\n|---|---|")
+    print("| scenario | floor, arm at rest | station | station / floor | moving floor / floor | station / moving floor "
+          "| planner evaluation [µs] | law alone / floor |")
+    print("|---|---|---|---|---|---|---|---|")
     for scenario in scenarios:
-        if scenario.robot not in floors:
-            floors[scenario.robot] = max(floor_real_time_factor(scenario) for _ in range(args.repeats))
-            print(f"| {scenario.robot} | {floors[scenario.robot]:.2f} |", flush=True)
-    print("\n| scenario | real-time factor | ratio to the floor | planner evaluation [µs] | law alone / floor |")
-    print("|---|---|---|---|---|")
-    for scenario in scenarios:
-        runs = [station_real_time_factor(scenario) for _ in range(args.repeats)]
-        rtf = max(rate for rate, _ in runs)
+        arguments = scenario.station_arguments()
+        reference = simulate(arguments.pop("planner"), simulator_config=scenario.simulator, settle_time=scenario.settle_time,
+                             max_duration=scenario.max_duration, **arguments).reference_trajectory()
+        # floor, moving floor and station measured in turn, ``repeats`` times: ratios of neighbours
+        floors, movings, stations = [], [], []
+        for _ in range(args.repeats):
+            floors.append(floor_real_time_factor(scenario))
+            movings.append(floor_real_time_factor(scenario, reference.end_time(), reference))
+            stations.append(station_real_time_factor(scenario))
+        floor, moving = statistics.median(floors), statistics.median(movings)
+        station = statistics.median(rate for rate, _ in stations)
+        ratios = [rate / f for (rate, _), f in zip(stations, floors)]
         cost = evaluation_cost_us(scenario)
         law = "–"
         planner = build_station(**scenario.station_arguments()).GetSubsystemByName("planner")
@@ -202,8 +225,9 @@ def main() -> None:
                 start = time.perf_counter()
                 planner.preflight()
                 walls.append(time.perf_counter() - start)
-            law = f"{min(walls) / (runs[0][1] / floors[scenario.robot]):.2f}"
-        print(f"| {scenario.name} | {rtf:.2f} | {rtf / floors[scenario.robot]:.2f} | {cost:.0f} | {law} |", flush=True)
+            law = f"{statistics.median(walls) / (stations[0][1] / floor):.2f}"
+        print(f"| {scenario.name} | {floor:.2f} | {station:.2f} | {statistics.median(ratios):.2f} ({min(ratios):.2f}-"
+              f"{max(ratios):.2f}) | {moving / floor:.2f} | {station / moving:.2f} | {cost:.0f} | {law} |", flush=True)
     pajak_law_cost(pajak_scenario, args.repeats)
 
 
