@@ -136,6 +136,9 @@ class _Checker:
     def check_record(self, node, schema, field: str) -> None:
         if not isinstance(node, yaml.MappingNode):
             self.fail(node, field, f"expected a mapping of {schema.__name__}'s fields, found {_describe(node)}")
+        if node.tag.startswith("!") and not node.tag.startswith("!!") and node.tag[1:] != schema.__name__:
+            self.fail(node, field, f"the tag {node.tag} does not belong here: this field is a {schema.__name__} "
+                                   "(tags choose a planner's type under planner:); remove the tag")
         fields = _fields(schema)
         for key, value in self.mapping_items(node, field):
             name = f"{field}.{key.value}" if field else key.value

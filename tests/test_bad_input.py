@@ -116,6 +116,8 @@ YAML_CASES = [
     ("NUL byte", quintic("name: quintic_ptp", "name: quintic_ptp\x00"), r"the character '\\x00' at offset \d+ is not allowed"),
     ("nested too deeply", "a: " + "[" * 3000 + "]" * 3000 + "\n", r"nested too deeply"),
     ("merge of a list", "name: q\nq_initial: &l [1, 2]\nplanner: !QuinticConfig\n  <<: *l\n", r"expected a mapping for merging"),
+    ("planner tag on the controller", quintic("controller:", "controller: !QuinticConfig"),
+     r"controller: the tag !QuinticConfig does not belong here: this field is a ControllerGains"),
     ("key that is a list", "? [a, b]\n: 1\n", r"a key must be a plain name, found a list of 2 entries"),
     ("goal of five numbers", quintic("    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]", "    - [-0.9, -1.9, -1.9, -0.9, 1.2]"),
      r"planner.goals must be .*: its rows must have the same length, got lengths \[5, 6, 6\]"),
