@@ -23,6 +23,7 @@ from hypothesis import strategies as st
 import drake_traj
 from drake_traj import (
     ControllerGains,
+    LiConfig,
     PajakConfig,
     QuinticConfig,
     Scenario,
@@ -295,6 +296,9 @@ API_CASES = [
      r"plant_config must be a MultibodyPlantConfig"),
     ("station robot mismatch", lambda: build_station(QuinticPtpPlanner(quintic_plan(), 1.05, 1.4), robot=get_robot("scara")), ValueError,
      r"the planner has 6 joints, robot scara has 3"),
+    ("li points of two numbers", lambda: make_planner(LiConfig(points=[[0.1, 0.2], [0.3, 0.4]]), get_robot("ur10e"),
+                                                      get_robot("ur10e").home_configuration), ValueError,
+     r"points must be a list of at least two \[x, y, z\] rows \[m\], got shape \(2, 2\)"),
     ("pajak on another robot", lambda: make_planner(paper_parameters(3), get_robot("li_4dof"), [0.0] * 4), ValueError,
      r"the Pająk planner runs on the UR10e"),
     # numbers given as text or booleans are refused, not converted

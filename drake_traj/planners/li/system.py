@@ -178,7 +178,9 @@ def make(config: LiConfig, robot: Robot, q_initial) -> LiPathPlanner:
     """The planner of ``config`` on ``robot`` (``q_initial``: see :class:`LiConfig`)."""
     q_initial = np.asarray(q_initial, dtype=float)
     if np.size(config.points):
-        points = real_array(config.points, "points", "m").reshape(-1, 3)
+        points = real_array(config.points, "points", "m")
+        if points.ndim != 2 or points.shape[1] != 3 or len(points) < 2:
+            raise ValueError(f"points must be a list of at least two [x, y, z] rows [m], got shape {points.shape}")
     else:
         points = li_closed_path()
         if robot.name != LI_4DOF.name:
