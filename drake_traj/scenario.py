@@ -11,6 +11,7 @@ file and the field.
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
+import numbers
 import re
 
 import numpy as np
@@ -116,6 +117,8 @@ class Scenario:
                              ("simulator.max_step_size", self.simulator.max_step_size),
                              ("tracking_tolerance", self.tracking_tolerance)):
             smallest_allowed = 0.0 if label == "settle_time" else np.nextafter(0.0, 1.0)
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
+                raise ValueError(f"{label} must be a number, got {type(value).__name__} {value!r:.40}")
             if not np.isfinite(value) or value < smallest_allowed:
                 unit = "metres" if label == "tracking_tolerance" else "seconds"
                 raise ValueError(f"{label} must be a finite, positive number of {unit}, got {value}")
@@ -184,6 +187,14 @@ def find_scenario(reference: str, variant: str | None = None) -> tuple[Path, str
     """(file, variant) of a scenario given as a path, or as the name of a shipped scenario
     (``pajak_sim3``) or of a shipped file (``pajak``, with ``variant``)."""
     path = Path(reference)
+    try:
+        return _find_scenario(path, reference, variant)
+    except OSError as error:  # a name too long, ...
+        raise ScenarioError(f"scenario file {str(path)[:80]}{'...' if len(str(path)) > 80 else ''} cannot be "
+                            f"used: {error.strerror}") from None
+
+
+def _find_scenario(path: Path, reference: str, variant: str | None) -> tuple[Path, str | None]:
     if path.is_file():
         return path, variant
     if path.is_symlink() and not path.exists():

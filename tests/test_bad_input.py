@@ -224,6 +224,7 @@ CLI_CASES = [
     ("scenario is a device", ["run", "/dev/null"], r"scenario file /dev/null is not a regular file"),
     ("scenario is a loop of links", ["run", "{loop}.yaml"], r"is a broken link or a loop of links"),
     ("out is a loop of links", ["run", "quintic_ptp", "--out", "{loop}"], r"output folder .* is a broken link or a loop of links"),
+    ("scenario path too long", ["run", "a" * 6000 + ".yaml"], r"scenario file a{80}\.\.\. cannot be used: File name too long"),
     ("bench count huge", ["bench", "--count", "99999999999", "--workers", "1"], r"count \(--count\) must be a whole number from 0 to 10000"),
 ]
 
@@ -296,6 +297,8 @@ API_CASES = [
      r"plant_config must be a MultibodyPlantConfig"),
     ("station robot mismatch", lambda: build_station(QuinticPtpPlanner(quintic_plan(), 1.05, 1.4), robot=get_robot("scara")), ValueError,
      r"the planner has 6 joints, robot scara has 3"),
+    ("scenario duration as text", lambda: Scenario(max_duration="10").validate(), ValueError,
+     r"max_duration must be a number, got str '10'"),
     ("li points of two numbers", lambda: make_planner(LiConfig(points=[[0.1, 0.2], [0.3, 0.4]]), get_robot("ur10e"),
                                                       get_robot("ur10e").home_configuration), ValueError,
      r"points must be a list of at least two \[x, y, z\] rows \[m\], got shape \(2, 2\)"),
