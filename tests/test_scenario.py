@@ -73,7 +73,7 @@ def test_a_shipped_name_is_found_beside_a_folder_of_that_name(tmp_path, monkeypa
     monkeypatch.chdir(tmp_path)
     (tmp_path / "quintic_ptp").mkdir()
     (tmp_path / "mine").mkdir()
-    assert find_scenario("quintic_ptp") == (DIAGRAMS / "quintic_ptp.yaml", None)
+    assert find_scenario("quintic_ptp") == (default_scenario_path().parent / "quintic_ptp.yaml", None)  # the shipped one
     with pytest.raises(ValueError, match="mine is a folder, not a scenario file"):
         find_scenario("mine")
 
