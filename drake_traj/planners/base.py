@@ -173,8 +173,8 @@ class TimeLawPlanner(PlannerSystem):
     anywhere), a fixed step integrates the jump with an error that would stay: the update after
     it sets the reference back on the law, (q_law(tau), q_law'(tau) c), as does every update that
     changes the clock, and the one that records the exact finish time (so the motion ends exactly
-    at the law's end). While c is at its goal and nothing jumps, the update changes nothing (no
-    write, so the evaluation cache stays valid).
+    at the law's end). While c is at its goal and nothing jumps, the update changes nothing. q̈
+    and c depend on the time and the clock only, and the last evaluation is kept by that key.
 
     Discrete state: ``scaling`` = [c, t0, c0] (c at the last update t0, c0 = c there), ``clock``
     = [tau at t0, ċ] and ``finish``.
@@ -245,7 +245,9 @@ class TimeLawPlanner(PlannerSystem):
             t, c0, t0, tau0, c_rate = key
             tau, c = clock_at(t - t0, tau0, c0, c_rate)
             qd_law, qdd_law = self.law.rates_at(tau)
-            self._last_evaluation = (key, (qdd_law * c**2 + qd_law * c_rate, c))
+            qdd = qdd_law * c**2 + qd_law * c_rate
+            qdd.flags.writeable = False  # shared by every caller with this key
+            self._last_evaluation = (key, (qdd, c))
         return self._last_evaluation[1]
 
     def finished(self, context) -> bool:

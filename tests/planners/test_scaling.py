@@ -3,6 +3,8 @@
 import numpy as np
 import pytest
 
+from drake_traj import QuinticConfig, get_robot
+from drake_traj.planners import make_planner
 from drake_traj.planners.scaling import admissible_clock_rate, clock_at, next_clock_rate, relaxed_scaling
 
 
@@ -46,3 +48,24 @@ def test_admissible_rates_keep_the_limits_and_never_exclude_holding_the_clock():
             q_ddot = c * c * qdd + (high + 1e-6) * qd
             assert np.any(np.abs(q_ddot) > np.maximum(0.999 * limit, np.abs(c * c * qdd)))
     assert admissible_clock_rate(0.5, np.zeros(6), np.ones(6), limit) == (-np.inf, np.inf)
+
+
+def test_time_law_evaluation_is_kept_by_time_and_clock_state():
+    # the planner keeps its last q̈ by (time, clock state): contexts that differ in either get
+    # their own value, and the kept array cannot be changed by a caller
+    ur10e = get_robot("ur10e")
+    planner = make_planner(QuinticConfig(goals=[(ur10e.home_configuration + 0.3).tolist()]), ur10e,
+                           ur10e.home_configuration)
+    full, half = planner.CreateDefaultContext(), planner.CreateDefaultContext()
+    for context in (full, half):
+        context.SetTime(0.5)
+    half.get_mutable_discrete_state(planner.scaling_state_index).SetFromVector([0.5, 0.0, 0.5])  # c = 0.5 since t = 0
+    qdd_full = planner.evaluate(full)[0].copy()
+    qdd_half, c_half = planner.evaluate(half)
+    np.testing.assert_allclose(qdd_full, planner.law.rates_at(0.5)[1], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(qdd_half, 0.25 * planner.law.rates_at(0.25)[1], rtol=0, atol=1e-15)  # q_law'' c²
+    assert c_half == 0.5 and np.array_equal(planner.evaluate(full)[0], qdd_full)
+    full.SetTime(0.6)
+    np.testing.assert_allclose(planner.evaluate(full)[0], planner.law.rates_at(0.6)[1], rtol=0, atol=1e-15)
+    with pytest.raises(ValueError):
+        planner.evaluate(full)[0][0] = 1.0
