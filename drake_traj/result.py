@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 from drake_traj.errors import DrakeTrajError, Failure
 from drake_traj.export import export, reference_trajectory
 from drake_traj.robots.ur10e import pose_error
-from drake_traj.rundir import OutputError, check_writable, clear_run, holds_a_run
+from drake_traj.rundir import OutputError, clear_run, create_folder, holds_a_run
 from drake_traj.validation import path_argument, positive_scalar, real_array
 
 __all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult"]
@@ -65,15 +65,10 @@ _SHAPES = {"t": ("N",), **{name: ("N", "n") for name in ("q_ref", "qd_ref", "qdd
 
 def _output_folder(directory) -> Path:
     """``directory`` (the argument of that name) created if needed, or TypeError/ValueError naming it."""
-    folder = path_argument(directory, "directory", "folder")
     try:
-        check_writable(folder)
-        folder.mkdir(parents=True, exist_ok=True)
+        return create_folder(path_argument(directory, "directory", "folder"))
     except OutputError as error:
         raise OutputError(f"directory: {error}") from None
-    except OSError as error:
-        raise OutputError(f"directory: output folder {folder} cannot be created: {error.strerror}") from None
-    return folder
 
 
 @dataclass(frozen=True)

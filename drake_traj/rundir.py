@@ -15,7 +15,7 @@ from pathlib import Path
 from drake_traj.errors import DrakeTrajError
 
 __all__ = ["MANIFEST", "OutputError", "add_to_manifest", "begin_output", "check_output", "check_writable", "clear_run",
-           "holds_a_run", "run_files", "write_manifest"]
+           "create_folder", "holds_a_run", "run_files", "write_manifest"]
 
 MANIFEST = "run.json"
 _RUN_FILES = ("result.npz", "metrics.json")  # a run written before manifests is recognised by these
@@ -75,7 +75,13 @@ def begin_output(directory, *, overwrite: bool = False) -> Path:
     directory = check_output(directory, overwrite=overwrite)
     if directory.is_dir() and holds_a_run(directory):
         clear_run(directory)
+    return create_folder(directory)
+
+
+def create_folder(directory: Path) -> Path:
+    """``directory`` created if needed (:func:`check_writable` first); OutputError naming it."""
     try:
+        check_writable(directory)
         directory.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise OutputError(f"output folder {directory} cannot be created: {error.strerror}") from None

@@ -44,7 +44,8 @@ def real_array(value, name: str, unit: str, what: str = "a real number or an arr
     except (TypeError, ValueError) as exc:
         reason = str(exc)
         if "inhomogeneous" in reason:  # a ragged list: say which row is off
-            reason = f"its rows must have the same length, got lengths {[len(row) for row in value]}"
+            lengths = [len(row) if hasattr(row, "__len__") else 1 for row in value]
+            reason = f"its rows must have the same length, got lengths {lengths}"
         raise ValueError(f"{name} must be an array of real numbers [{unit}]: {reason}") from exc
 
 
