@@ -19,9 +19,11 @@ dynamics M(q) q̈_ref + C(q, q̇) q̇ - τ_g(q) (Drake's ``InverseDynamics``). O
 Python system in the per-step path; the TCP pose is an output computed when asked for, and the
 result computes it from the logged states after the run.
 
-Subsystems by name: ``planner``, ``plant``, ``scene_graph``, ``lookahead_mux`` and
-``lookahead`` (the one-step lookahead), ``feedforward`` (inverse dynamics), ``tcp_pose``, the
-loggers of :data:`drake_traj.result.LOGGERS` and, with Meshcat, ``visualizer``.
+Subsystems by name: ``planner``, ``plant``, ``scene_graph``, ``acceleration_and_scaling`` (a
+``Demultiplexer`` of the planner's [q̈; c] port: one Python call per step serves the plant, the
+loggers and the exported ports), ``lookahead_mux`` and ``lookahead`` (the one-step lookahead),
+``feedforward`` (inverse dynamics), ``tcp_pose``, the loggers of
+:data:`drake_traj.result.LOGGERS` and, with Meshcat, ``visualizer``.
 
 Exported ports of the station:
 
@@ -58,6 +60,7 @@ from pydrake.systems.controllers import InverseDynamics
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, TriggerType
 from pydrake.systems.primitives import (
     ConstantVectorSource,
+    Demultiplexer,
     LogVectorOutput,
     MatrixGain,
     Multiplexer,
@@ -279,8 +282,12 @@ def add_station(
     zero = np.zeros((n, n))
     lookahead = builder.AddNamedSystem("lookahead", MatrixGain(np.block([[eye, h * eye, 0.5 * h * h * eye],
                                                                            [zero, eye, h * eye]])))
+    # q̈ and c from one Python call per step, split in C++ for the plant and the loggers
+    split = builder.AddNamedSystem("acceleration_and_scaling", Demultiplexer([n, 1]))
+    builder.Connect(planner.GetOutputPort("acceleration_and_scaling"), split.get_input_port())
+    acceleration, scaling = split.get_output_port(0), split.get_output_port(1)
     builder.Connect(planner.GetOutputPort("desired_state"), mux.get_input_port(0))
-    builder.Connect(planner.GetOutputPort("desired_acceleration"), mux.get_input_port(1))
+    builder.Connect(acceleration, mux.get_input_port(1))
     builder.Connect(mux.get_output_port(), lookahead.get_input_port())
     builder.Connect(lookahead.get_output_port(), plant.get_desired_state_input_port(instance))
     mode = (InverseDynamics.InverseDynamicsMode.kInverseDynamics if gains.feedforward_acceleration
@@ -288,15 +295,15 @@ def add_station(
     feedforward = builder.AddNamedSystem("feedforward", InverseDynamics(plant, mode))
     builder.Connect(plant.get_state_output_port(instance), feedforward.get_input_port_estimated_state())
     if gains.feedforward_acceleration:
-        builder.Connect(planner.GetOutputPort("desired_acceleration"), feedforward.get_input_port_desired_acceleration())
+        builder.Connect(acceleration, feedforward.get_input_port_desired_acceleration())
     builder.Connect(feedforward.get_output_port_generalized_force(), plant.get_actuation_input_port(instance))
     tcp = builder.AddNamedSystem("tcp_pose", TcpPose(robot))
     builder.Connect(plant.get_state_output_port(instance), tcp.get_input_port())
 
     sources = {
         "reference_logger": planner.GetOutputPort("desired_state"),
-        "acceleration_logger": planner.GetOutputPort("desired_acceleration"),
-        "scaling_logger": planner.GetOutputPort("scaling"),
+        "acceleration_logger": acceleration,
+        "scaling_logger": scaling,
         "measured_logger": plant.get_state_output_port(instance),
         "torque_logger": plant.get_net_actuation_output_port(instance),
     }
@@ -320,8 +327,10 @@ def build_station(planner: PlannerSystem, **kwargs) -> Diagram:
     parts = add_station(builder, planner, **kwargs)
     builder.ExportInput(planner.GetInputPort("speed_override"), "speed_override")
     builder.ExportInput(parts.plant.get_applied_generalized_force_input_port(), "applied_generalized_force")
-    for name in ("desired_state", "desired_acceleration", "scaling"):
-        builder.ExportOutput(planner.GetOutputPort(name), name)
+    builder.ExportOutput(planner.GetOutputPort("desired_state"), "desired_state")
+    split = builder.GetSubsystemByName("acceleration_and_scaling")
+    builder.ExportOutput(split.get_output_port(0), "desired_acceleration")
+    builder.ExportOutput(split.get_output_port(1), "scaling")
     builder.ExportOutput(parts.plant.get_state_output_port(parts.instance), "measured_state")
     builder.ExportOutput(parts.plant.get_net_actuation_output_port(parts.instance), "torque")
     builder.ExportOutput(parts.tcp_pose.get_output_port(), "tcp_pose")

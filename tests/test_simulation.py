@@ -10,7 +10,7 @@ from pydrake.systems.primitives import ConstantVectorSource
 
 from drake_traj.robots import ur10e as robot
 from drake_traj.station import ControllerGains, simulate
-from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
+from drake_traj.planners.quintic import QuinticPlan, QuinticPtpPlanner, plan_synchronized_quintic
 from drake_traj.result import ARRAY_NAMES, SimulationResult
 from drake_traj.scenario import load_scenario, make_planner
 
@@ -97,22 +97,23 @@ def test_gravity_compensation_alone_tracks_worse_than_inverse_dynamics_feedforwa
     assert gravity_only.tracking_error_joint_max_rad < 5e-3  # measured 1.05e-3: still a usable PD loop
 
 
-class PlannerFailingAt(QuinticPtpPlanner):
-    """A quintic planner whose acceleration raises after ``fail_time`` (a stand-in for any fault)."""
+class PlanFailingAt(QuinticPlan):
+    """A quintic plan whose rates raise after law time ``fail_time`` [s] (a stand-in for any
+    fault in a planner's law)."""
 
-    def __init__(self, fail_time, *args, **kwargs):
-        super().__init__(*args, **kwargs)
-        self.fail_time = fail_time
+    def __init__(self, fail_time, plan):
+        super().__init__(plan.segments)
+        object.__setattr__(self, "fail_time", fail_time)
 
-    def evaluate(self, context):
-        if context.get_time() > self.fail_time:
+    def rates_at(self, t):
+        if t > self.fail_time:
             raise ValueError("singular configuration (test fault)")
-        return super().evaluate(context)
+        return super().rates_at(t)
 
 
 def test_a_run_that_fails_part_way_keeps_its_log_and_the_reason(tmp_path):
     plan = short_move().law
-    result = simulate(PlannerFailingAt(0.4, plan, 1.05, 1.40))
+    result = simulate(QuinticPtpPlanner(PlanFailingAt(0.4, plan), 1.05, 1.40))
     assert not result.succeeded
     assert "singular configuration (test fault)" in result.failure.message and "t = 0.4" in result.failure.message
     assert result.failure.cause == "error" and 0.4 <= result.failure.time <= 0.402

@@ -38,6 +38,25 @@ def test_station_is_named_with_named_parts_and_ports(scenario):
     assert station.num_input_ports() == len(PORTS_IN) and station.num_output_ports() == len(PORTS_OUT)
 
 
+@pytest.mark.parametrize("name, variant", [("quintic_ptp", None), ("pajak", "sim3")])
+def test_the_stations_acceleration_and_scaling_are_the_planners_own_ports(name, variant):
+    # the station splits the planner's one-call [q̈; c] port in C++ for the plant and the loggers:
+    # mid-motion (c below 1 on the Pająk task) its ports equal the planner's separate ports
+    station = make_station(load_scenario(*find_scenario(name, variant)))
+    simulator = Simulator(station)
+    simulator.AdvanceTo(1.5)
+    context = simulator.get_context()
+    planner = station.GetSubsystemByName("planner")
+    planner_context = planner.GetMyContextFromRoot(context)
+    acceleration = station.GetOutputPort("desired_acceleration").Eval(context)
+    assert np.max(np.abs(acceleration)) > 0.01  # moving
+    np.testing.assert_array_equal(acceleration, planner.GetOutputPort("desired_acceleration").Eval(planner_context))
+    np.testing.assert_array_equal(station.GetOutputPort("scaling").Eval(context),
+                                  planner.GetOutputPort("scaling").Eval(planner_context))
+    np.testing.assert_array_equal(planner.GetOutputPort("acceleration_and_scaling").Eval(planner_context),
+                                  np.r_[acceleration, station.GetOutputPort("scaling").Eval(context)])
+
+
 def test_a_fresh_context_starts_at_the_planners_start(scenario):
     station = make_station(scenario)
     context = station.CreateDefaultContext()

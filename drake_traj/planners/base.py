@@ -8,12 +8,16 @@ Every planner is a LeafSystem with
   relaxation (eq. 18 of Pająk 2024), a group ``finish`` = [the time the task finished, NaN
   before] that subclasses record from their own update events, plus planner-specific discrete
   groups declared by subclasses;
-- output ports ``desired_state`` [q; qd], ``desired_acceleration`` qdd and ``scaling`` c;
+- output ports ``desired_state`` [q; qd], ``desired_acceleration`` qdd, ``scaling`` c and
+  ``acceleration_and_scaling`` [qdd; c] (both from one Python call per evaluation: the station
+  splits it with a C++ ``Demultiplexer`` for the plant and the loggers);
 - an optional input port ``speed_override`` (a value in [0, 1]; unconnected means 1).
 
 Subclasses implement :meth:`PlannerSystem.evaluate` (qdd and c from the context) and
 :meth:`PlannerSystem.finished`, and declare their own update events. The evaluation is cached
 per context, so the derivatives and the output ports at one context share a single call.
+:class:`TimeLawPlanner` (a law on a scaled clock) keeps its own, cheaper evaluation: its
+subclasses provide the law, not ``evaluate``.
 """
 
 from __future__ import annotations
@@ -26,6 +30,8 @@ from pydrake.systems.framework import BasicVector, ContinuousStateIndex, EventSt
 
 from drake_traj.planners.scaling import admissible_clock_rate, clock_at, next_clock_rate
 from drake_traj.validation import finite_array
+
+_DID_NOTHING = EventStatus.DidNothing()  # returned by the time-law update in the common case
 
 
 class PlannerSystem(LeafSystem):
@@ -58,6 +64,7 @@ class PlannerSystem(LeafSystem):
         self.DeclareStateOutputPort("desired_state", ContinuousStateIndex(0))  # [q; q̇], no Python call
         self.DeclareVectorOutputPort("desired_acceleration", n, self._calc_desired_acceleration)
         self.DeclareVectorOutputPort("scaling", 1, self._calc_scaling_output)
+        self.DeclareVectorOutputPort("acceleration_and_scaling", n + 1, self._calc_acceleration_and_scaling)
         self._evaluation = self.DeclareCacheEntry(
             "reference acceleration and scaling [qdd; c]",
             ValueProducer(allocate=AbstractValue.Make(BasicVector(n + 1)).Clone, calc=self._calc_evaluation),
@@ -152,6 +159,9 @@ class PlannerSystem(LeafSystem):
     def _calc_scaling_output(self, context, output):
         output.SetAtIndex(0, self.scaling(context))
 
+    def _calc_acceleration_and_scaling(self, context, output):
+        output.SetFromVector(self._evaluation.Eval(context).get_value())
+
 
 class TimeLawPlanner(PlannerSystem):
     """A planner that follows a closed-form joint time law on a scaled planner clock.
@@ -168,16 +178,19 @@ class TimeLawPlanner(PlannerSystem):
     :mod:`drake_traj.planners.scaling`), and never faster than the joint acceleration limits
     allow at that point of the law (checked at both ends of the period).
 
-    The Simulator integrates the reference [q; qd] from qdd. Where the law's acceleration jumps
-    (its ``acceleration_jumps``, law times; a law without that attribute is taken to jump
-    anywhere), a fixed step integrates the jump with an error that would stay: the update after
-    it sets the reference back on the law, (q_law(tau), q_law'(tau) c), as does every update that
-    changes the clock, and the one that records the exact finish time (so the motion ends exactly
-    at the law's end). While c is at its goal and nothing jumps, the update changes nothing. q̈
-    and c depend on the time and the clock only, and the last evaluation is kept by that key.
+    The Simulator integrates the reference [q; qd] from the law's rates, q' = q_law'(tau) c and
+    qd' = qdd (so q follows the law's own velocity, not the integrated one). Where the law's
+    acceleration jumps (its ``acceleration_jumps``, law times; a law without that attribute is
+    taken to jump anywhere), a fixed step integrates the jump with an error that would stay: the
+    update after it sets the reference back on the law, (q_law(tau), q_law'(tau) c), as does every
+    update that changes the clock, and the one that records the exact finish time (so the motion
+    ends exactly at the law's end). While c is at its goal and nothing jumps, the update changes
+    nothing. The rates depend on the time and the clock only, and the last ones are kept by that
+    key: the derivatives, both outputs and the update of one step share one law evaluation.
 
-    Discrete state: ``scaling`` = [c, t0, c0] (c at the last update t0, c0 = c there), ``clock``
-    = [tau at t0, ċ] and ``finish``.
+    Discrete state: ``clock`` = [tau, ċ, c, t0]: the law time, the clock's rate and c at the last
+    update t0 (the clock's truth); ``scaling`` = [c, t0, c] (the contract's view of the same
+    clock) and ``finish``.
 
     Args:
         law: the time law (see above).
@@ -211,44 +224,61 @@ class TimeLawPlanner(PlannerSystem):
         self.clock_jerk = float(clock_jerk)
         self.velocity_limit = np.asarray(velocity_limit, dtype=float)
         self.acceleration_limit = np.asarray(acceleration_limit, dtype=float)
-        self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, 0.0]))
+        self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, 0.0, self.speed_cap, 0.0]))
         self.DeclarePeriodicUnrestrictedUpdateEvent(update_period, 0.0, self._update)
-        self._last_evaluation = (None, None)  # (key, (q̈, c)) of evaluate
+        self._kept = (None, None)  # (key, (rates [q'; q̈], q̈, [q̈; c], c)) of _rates
         jumps = getattr(law, "acceleration_jumps", None)  # law times where q_law'' jumps (None: anywhere)
         self._acceleration_jumps = None if jumps is None else sorted(np.asarray(jumps, dtype=float).tolist())
 
-    def _clock_state(self, context) -> tuple[float, float, float, float]:
-        """(c0, t0 [s], tau0 [s], ċ [1/s]) of the discrete state: the clock at the last update."""
-        discrete = context.get_discrete_state()
-        c0, t0, _ = discrete.value(self.scaling_state_index).tolist()
-        tau0, c_rate = discrete.value(self.clock_state_index).tolist()
-        return c0, t0, tau0, c_rate
+    def _clock_state(self, context) -> list[float]:
+        """[tau0 [s], ċ [1/s], c0, t0 [s]]: the clock at the last update (one read of the state)."""
+        return context.get_discrete_state(self.clock_state_index).get_value().tolist()
 
     def _clock(self, context):
         """(tau [s], c, ċ [1/s]) at the context's time."""
-        c0, t0, tau0, c_rate = self._clock_state(context)
+        tau0, c_rate, c0, t0 = self._clock_state(context)
         tau, c = clock_at(context.get_time() - t0, tau0, c0, c_rate)
         return tau, c, c_rate
 
-    def acceleration(self, context) -> np.ndarray:
-        return self.evaluate(context)[0]  # kept by value below, cheaper than the context's cache here
+    def _rates(self, context) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """(the time derivative of [q; q̇] = [q_law' c; q̈], q̈, [q̈; c], c) at the context's time.
 
-    def scaling(self, context) -> float:
-        return self.evaluate(context)[1]
-
-    def evaluate(self, context) -> tuple[np.ndarray, float]:
-        # q̈ depends on the time and the clock state only. Drake recomputes it at the start of
-        # every integration step (the step's updates mark all discrete state changed), so the
-        # last result is kept by value: one law evaluation per (time, clock state).
+        They depend on the time and the clock state only. Drake asks for them at both stages of
+        every step, for the outputs and again after the step's updates mark the state changed, so
+        the last result is kept by value: one law evaluation per (time, clock state). The arrays
+        are read-only views of one (shared by every caller with that key)."""
         key = (context.get_time(), *self._clock_state(context))
-        if key != self._last_evaluation[0]:
-            t, c0, t0, tau0, c_rate = key
+        if key != self._kept[0]:
+            t, tau0, c_rate, c0, t0 = key
             tau, c = clock_at(t - t0, tau0, c0, c_rate)
             qd_law, qdd_law = self.law.rates_at(tau)
-            qdd = qdd_law * c**2 + qd_law * c_rate
-            qdd.flags.writeable = False  # shared by every caller with this key
-            self._last_evaluation = (key, (qdd, c))
-        return self._last_evaluation[1]
+            values = np.concatenate((qd_law * c, qdd_law * c**2 + qd_law * c_rate, (c,)))
+            values.flags.writeable = False
+            n = self.num_joints
+            self._kept = (key, (values[: 2 * n], values[n : 2 * n], values[n:], c))
+        return self._kept[1]
+
+    def evaluate(self, context) -> tuple[np.ndarray, float]:
+        _, qdd, _, c = self._rates(context)
+        return qdd, c
+
+    def acceleration(self, context) -> np.ndarray:
+        return self._rates(context)[1]
+
+    def scaling(self, context) -> float:
+        return self._rates(context)[3]
+
+    def DoCalcTimeDerivatives(self, context, derivatives):
+        derivatives.SetFromVector(self._rates(context)[0])
+
+    def _calc_desired_acceleration(self, context, output):
+        output.SetFromVector(self._rates(context)[1])
+
+    def _calc_scaling_output(self, context, output):
+        output.SetAtIndex(0, self._rates(context)[3])
+
+    def _calc_acceleration_and_scaling(self, context, output):
+        output.SetFromVector(self._rates(context)[2])
 
     def finished(self, context) -> bool:
         return self._clock(context)[0] >= self.law.duration
@@ -268,17 +298,24 @@ class TimeLawPlanner(PlannerSystem):
         low_end, high_end = admissible_clock_rate(c_end, *self.law.rates_at(tau_end), self.acceleration_limit)
         return min(max(candidate, max(low, low_end)), min(high, high_end))  # both intervals contain 0
 
+    def _jumped(self, tau: float, tau_before: float) -> bool:
+        """True where the law's acceleration jumps in (tau_before, tau] (anywhere for a law that
+        does not say)."""
+        jumps = self._acceleration_jumps
+        return jumps is None or bisect_right(jumps, tau) > bisect_right(jumps, tau_before)
+
     def _update(self, context, state):
         t, h = context.get_time(), self.update_period
-        c0, t0, tau0, c_rate = self._clock_state(context)
+        tau0, c_rate, c0, t0 = self._clock_state(context)
         tau, c = clock_at(t - t0, tau0, c0, c_rate)
         goal = self.speed_cap * self.speed_override(context)
-        finishing = tau >= self.law.duration and np.isnan(self.finish_time(context))
+        steady = c_rate == 0.0 and c == goal
         tau_before = clock_at(max(t - h, t0) - t0, tau0, c0, c_rate)[0]
-        jumps = self._acceleration_jumps
-        jumped = jumps is None or bisect_right(jumps, tau) > bisect_right(jumps, tau_before)
-        if c_rate == 0.0 and c == goal and not (jumped or finishing):
-            return EventStatus.DidNothing()  # the clock runs on as it is: nothing to write
+        if steady and tau < self.law.duration and not self._jumped(tau, tau_before):
+            return _DID_NOTHING  # the clock runs on as it is: nothing to write (the common case)
+        finishing = tau >= self.law.duration and np.isnan(self.finish_time(context))
+        if steady and not (finishing or self._jumped(tau, tau_before)):
+            return _DID_NOTHING
         discrete = state.get_mutable_discrete_state()
         if finishing:  # finished in (t0, t]: tau0 + c0 s + ċ s² / 2 = duration
             roots = np.roots([0.5 * c_rate, c0, tau0 - self.law.duration]) if c_rate else [(self.law.duration - tau0) / c0]
@@ -289,7 +326,7 @@ class TimeLawPlanner(PlannerSystem):
         else:
             c_rate = self._next_clock_rate(tau, c, c_rate, goal)
         discrete.get_mutable_vector(self.scaling_state_index).SetFromVector([c, t, c])
-        discrete.get_mutable_vector(self.clock_state_index).SetFromVector([tau, c_rate])
+        discrete.get_mutable_vector(self.clock_state_index).SetFromVector([tau, c_rate, c, t])
         q_law, qd_law, _ = self.law.sample(tau)
         state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(np.concatenate([q_law, qd_law * c]))
         return EventStatus.Succeeded()

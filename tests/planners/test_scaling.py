@@ -51,15 +51,15 @@ def test_admissible_rates_keep_the_limits_and_never_exclude_holding_the_clock():
 
 
 def test_time_law_evaluation_is_kept_by_time_and_clock_state():
-    # the planner keeps its last q̈ by (time, clock state): contexts that differ in either get
-    # their own value, and the kept array cannot be changed by a caller
+    # the planner keeps its last rates by (time, clock state): contexts that differ in either get
+    # their own value, and the kept arrays cannot be changed by a caller
     ur10e = get_robot("ur10e")
     planner = make_planner(QuinticConfig(goals=[(ur10e.home_configuration + 0.3).tolist()]), ur10e,
                            ur10e.home_configuration)
     full, half = planner.CreateDefaultContext(), planner.CreateDefaultContext()
     for context in (full, half):
         context.SetTime(0.5)
-    half.get_mutable_discrete_state(planner.scaling_state_index).SetFromVector([0.5, 0.0, 0.5])  # c = 0.5 since t = 0
+    half.get_mutable_discrete_state(planner.clock_state_index).SetFromVector([0.0, 0.0, 0.5, 0.0])  # c = 0.5 since t = 0
     qdd_full = planner.evaluate(full)[0].copy()
     qdd_half, c_half = planner.evaluate(half)
     np.testing.assert_allclose(qdd_full, planner.law.rates_at(0.5)[1], rtol=0, atol=1e-15)
@@ -69,3 +69,20 @@ def test_time_law_evaluation_is_kept_by_time_and_clock_state():
     np.testing.assert_allclose(planner.evaluate(full)[0], planner.law.rates_at(0.6)[1], rtol=0, atol=1e-15)
     with pytest.raises(ValueError):
         planner.evaluate(full)[0][0] = 1.0
+
+
+def test_time_law_derivatives_are_the_laws_rates_on_the_clock():
+    # d/dt [q; q̇] = [q_law'(tau) c; q_law''(tau) c² + q_law'(tau) ċ] on the clock of the state
+    ur10e = get_robot("ur10e")
+    planner = make_planner(QuinticConfig(goals=[(ur10e.home_configuration + 0.3).tolist()]), ur10e,
+                           ur10e.home_configuration)
+    context = planner.CreateDefaultContext()
+    context.SetTime(0.7)
+    context.get_mutable_discrete_state(planner.clock_state_index).SetFromVector([0.3, -0.2, 0.6, 0.5])
+    elapsed = 0.2
+    tau, c = 0.3 + 0.6 * elapsed - 0.1 * elapsed**2, 0.6 - 0.2 * elapsed
+    qd_law, qdd_law = planner.law.rates_at(tau)
+    derivatives = planner.EvalTimeDerivatives(context).CopyToVector()
+    np.testing.assert_allclose(derivatives, np.r_[qd_law * c, qdd_law * c**2 - 0.2 * qd_law], rtol=0, atol=1e-14)
+    np.testing.assert_allclose(planner.GetOutputPort("acceleration_and_scaling").Eval(context), np.r_[derivatives[6:], c],
+                               rtol=0, atol=1e-15)
