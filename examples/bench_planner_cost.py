@@ -2,7 +2,8 @@
 
     python examples/bench_planner_cost.py [--repeats 3] [--time-step 0.001] [--pajak-law-only]
 
-All in one process; for each shipped scenario, ``--repeats`` times in turn:
+All in one process; for each shipped scenario, ``--repeats`` times in turn (and the floor once more
+at the end, so that every station run has a floor measured just before and just after it):
 
 1. the floor: the same discrete robot plant (SAP, PD actuators, gravity compensation, three
    loggers) driven by a ``ConstantVectorSource`` at the start configuration, simulated for 5 s;
@@ -11,7 +12,7 @@ All in one process; for each shipped scenario, ``--repeats`` times in turn:
 3. the scenario's station under its own ``SimulatorConfig`` (``run_station``).
 
 It prints the medians of the real-time factors (simulated seconds per wall-clock second), the
-median (and range) of the station's ratio to the floor measured next to it, the moving floor's
+median (and range) of the station's ratio to the mean of the floors measured just before and after it, the moving floor's
 ratio to the floor, and the station's ratio to the moving floor: what the planner and its Python
 calls cost. Then the planner's cost per evaluation of its law at mid-motion (``evaluate`` at a
 new time per call; median of 7 batches of 500) and, for the Pająk planner, its law integrated
@@ -207,15 +208,17 @@ def main() -> None:
         arguments = scenario.station_arguments()
         reference = simulate(arguments.pop("planner"), simulator_config=scenario.simulator, settle_time=scenario.settle_time,
                              max_duration=scenario.max_duration, **arguments).reference_trajectory()
-        # floor, moving floor and station measured in turn, ``repeats`` times: ratios of neighbours
+        # floor, moving floor and station measured in turn, ``repeats`` times, and a last floor:
+        # each station against the mean of the floors just before and just after it
         floors, movings, stations = [], [], []
         for _ in range(args.repeats):
             floors.append(floor_real_time_factor(scenario))
             movings.append(floor_real_time_factor(scenario, reference.end_time(), reference))
             stations.append(station_real_time_factor(scenario))
+        floors.append(floor_real_time_factor(scenario))
         floor, moving = statistics.median(floors), statistics.median(movings)
         station = statistics.median(rate for rate, _ in stations)
-        ratios = [rate / f for (rate, _), f in zip(stations, floors)]
+        ratios = [rate / (0.5 * (before + after)) for (rate, _), before, after in zip(stations, floors, floors[1:])]
         cost = evaluation_cost_us(scenario)
         law = "–"
         planner = build_station(**scenario.station_arguments()).GetSubsystemByName("planner")
