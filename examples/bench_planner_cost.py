@@ -12,9 +12,9 @@ at the end, so that every station run has a floor measured just before and just 
 3. the scenario's station under its own ``SimulatorConfig`` (``run_station``).
 
 It prints the medians of the real-time factors (simulated seconds per wall-clock second), the
-median (and range) of the station's ratio to the mean of the floors measured just before and after it, the moving floor's
-ratio to the floor, and the station's ratio to the moving floor: what the planner and its Python
-calls cost. Then the planner's cost per evaluation of its law at mid-motion (``evaluate`` at a
+median (and range) of the station's ratio to the mean of the floors measured just before and
+after it, the moving floor's ratio to the floor, and the station's ratio to the moving floor:
+what the planner and its Python calls cost. Then the planner's cost per evaluation of its law at mid-motion (``evaluate`` at a
 new time per call; median of 7 batches of 500) and, for the Pająk planner, its law integrated
 alone (``preflight``: RK4 at 1 ms) against the floor's wall time for the same simulated time.
 
