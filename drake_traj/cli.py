@@ -13,8 +13,9 @@ every planner and baseline on Pająk 2024's task and N seeded tasks and writes D
 bench.md and bench.png.
 
 Exit codes: 0 success; 1 the run failed (its log is kept in the output folder); 2 bad input
-(nothing was run); 130 interrupted by Ctrl-C or SIGTERM (what was logged is kept). ``--debug``
-shows the traceback of an error.
+(nothing was run); 130 interrupted by Ctrl-C, 143 stopped by SIGTERM (in both, what was logged is
+kept). ``--debug`` shows the traceback of an error. Text the terminal's encoding cannot show is
+printed as escapes (``\u0105``), never an error.
 """
 
 import argparse
@@ -41,7 +42,7 @@ from drake_traj.scenario import (DEFAULT_SCENARIO, ScenarioError, default_scenar
                                  locate_in_scenario, shipped_scenarios)
 from drake_traj.station import simulate
 
-EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_TERMINATED = 0, 1, 2, 130, 143
 SUMMARY = ("name", "succeeded", "failure", "duration_s", "max_velocity_over_limit", "max_acceleration_over_limit",
            "tracking_error_joint_max_rad", "tracking_error_tcp_max_m", "real_time_factor")
 
@@ -179,7 +180,7 @@ def run(args) -> int:
             pass
     if interrupts:
         print("drake-traj: interrupted while writing; the run's files were completed first", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return EXIT_TERMINATED if signal.SIGTERM in interrupts else EXIT_INTERRUPTED
     if result.succeeded:
         return EXIT_OK
     return EXIT_INTERRUPTED if result.failure.cause == "interrupted" else EXIT_RUN_FAILED
@@ -243,7 +244,8 @@ def check_options(args) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="drake-traj", description=__doc__.splitlines()[0],
-                                     epilog="exit codes: 0 success, 1 run failed (log kept), 2 bad input, 130 interrupted")
+                                     epilog="exit codes: 0 success, 1 run failed (log kept), 2 bad input, 130 interrupted (Ctrl-C), "
+                                            "143 terminated (SIGTERM)")
     parser.add_argument("--version", action="version", version=f"drake-traj {__version__}")
     parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     commands = parser.add_subparsers(dest="command", required=True)
@@ -297,15 +299,25 @@ def main(argv=None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as done:  # --help, --version, or a usage error argparse printed (code 2)
         return done.code
+    for stream in (sys.stdout, sys.stderr):  # e.g. PYTHONIOENCODING=ascii: print "ą" as \u0105
+        with contextlib.suppress(AttributeError, ValueError):
+            stream.reconfigure(errors="backslashreplace")
     on_main_thread = threading.current_thread() is threading.main_thread()
-    if on_main_thread:  # SIGTERM (a job scheduler, kill) stops a run like Ctrl-C: its log is kept
-        previous_sigterm = signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
+    terminated = []  # SIGTERM (a job scheduler, kill) stops a run like Ctrl-C: its log is kept
+
+    def terminate(signum, frame):
+        terminated.append(signum)
+        raise KeyboardInterrupt
+
+    if on_main_thread:
+        previous_sigterm = signal.signal(signal.SIGTERM, terminate)
     try:
         check_options(args)
-        return args.handler(args)
+        code = args.handler(args)
+        return EXIT_TERMINATED if code == EXIT_INTERRUPTED and terminated else code
     except KeyboardInterrupt:
-        print("drake-traj: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        print("drake-traj: terminated (SIGTERM)" if terminated else "drake-traj: interrupted", file=sys.stderr)
+        return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED
     except (DrakeTrajError, ValueError) as error:  # bad input: one paragraph, no traceback
         kind = "the task cannot be done" if isinstance(error, PlanningError) else "error"
         print(f"drake-traj: {kind}: {error}", file=sys.stderr)
@@ -319,10 +331,6 @@ def main(argv=None) -> int:
     if args.debug:
         traceback.print_exception(failure)
     return code
-
-
-def _raise_keyboard_interrupt(signum, frame):
-    raise KeyboardInterrupt
 
 
 if __name__ == "__main__":

@@ -10,6 +10,8 @@ import math
 import os
 import re
 import signal
+import subprocess
+import sys
 import time
 import zipfile
 from pathlib import Path
@@ -151,6 +153,14 @@ YAML_CASES = [
     ("pajak vartheta out of range", pajak(PAJAK_WAYPOINTS + "  vartheta: 0.7\n"), r"vartheta must be a number in \(0, 0.5\)"),
     ("pajak waypoint short row", pajak("  waypoints:\n    - [-0.175, -0.525, 0.730]\n"), r"waypoints must have shape \(w, 6\)"),
     ("boryga only B", "name: b\nrobot: scara\nplanner: !BorygaConfig\n  B: [0.5, 0.5, 0.265]\n", r"B, M and E must all be 3-vectors"),
+    ("boryga M out of reach", "name: b\nrobot: ur10e\nplanner: !BorygaConfig\n  B: [0.5, 0.3, 0.5]\n  M: [3.0, 0.3, 0.5]\n"
+     "  E: [0.5, 0.5, 0.5]\n", r"line 5, column 6: planner.M is out of reach: pose \(x, y, z\) = \(3, 0.3, 0.5\) m"),
+    ("boryga loop beyond reach", "name: b\nrobot: ur10e\nplanner: !BorygaConfig\n  B: [0.5, 0.3, 0.5]\n  M: [1.18, 0.3, 0.5]\n"
+     "  E: [0.5, 0.5, 0.5]\n", r"planner: the loop path leaves the ur10e's reach at law time 4.542 s of 9.311 s, at \[1.1998, 0.3, 0.5\] m"),
+    ("li point out of reach", "name: l\nrobot: ur10e\nplanner: !LiConfig\n  points: [[0.5, 0.2, 0.5], [0.7, 0.2, 0.5], [3.0, 0.2, 0.5]]\n",
+     r"line 4, column 46: planner.points\[2\] is out of reach: pose \(x, y, z\) = \(3, 0.2, 0.5\) m"),
+    ("li point out of reach of the 4-dof robot", "name: l\nrobot: li_4dof\nplanner: !LiConfig\n  points: [[0.3, 0, 0], [0.5, 0.2, 0]]\n",
+     r"planner.points\[1\] is out of reach: point 0 at \[0.5, 0.2, 0\] m is out of reach of the li_4dof robot"),
     ("li tool acceleration zero", "name: l\nrobot: li_4dof\nplanner: !LiConfig\n  tool_acceleration_limit: 0.0\n", r"a_max"),
     ("li on a robot without acceleration limits", "name: l\nrobot: scara\nplanner: !LiConfig {}\n",
      r"acceleration_limit must be given: the robot has no default"),
@@ -622,16 +632,24 @@ def test_signals_while_writing_wait_until_the_files_are_written():
     assert received == [signal.SIGINT, signal.SIGTERM]
 
 
-def test_sigterm_stops_a_run_like_ctrl_c(tmp_path, monkeypatch, capsys):
+def test_sigterm_stops_a_run_like_ctrl_c_with_its_own_exit_code(tmp_path, monkeypatch, capsys):
     def terminated(*args, **kwargs):
         os.kill(os.getpid(), signal.SIGTERM)
         time.sleep(1.0)  # the SIGTERM handler raises KeyboardInterrupt here
         raise AssertionError("SIGTERM did not stop the run")
 
     monkeypatch.setattr(cli, "simulate", terminated)
-    assert cli.main(["run", "quintic_ptp", "--out", str(tmp_path / "x")]) == cli.EXIT_INTERRUPTED
-    assert "interrupted" in capsys.readouterr().err
+    assert cli.main(["run", "quintic_ptp", "--out", str(tmp_path / "x")]) == cli.EXIT_TERMINATED == 143
+    assert "terminated (SIGTERM)" in capsys.readouterr().err
     assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # restored
+
+
+def test_a_terminal_that_cannot_show_a_character_gets_an_escape_not_an_error(tmp_path):
+    # PYTHONIOENCODING=ascii (an old terminal, a pipe into a legacy tool): "Pająk" has an "ą"
+    listed = subprocess.run([sys.executable, "-m", "drake_traj.cli", "list"], capture_output=True, cwd=tmp_path,
+                            env=dict(os.environ, PYTHONIOENCODING="ascii"), timeout=120)
+    assert listed.returncode == cli.EXIT_OK, listed.stderr
+    assert b"Paj\\u0105k 2024 simulation 3" in listed.stdout and not listed.stderr
 
 
 def test_debug_shows_the_traceback(tmp_path, capsys):

@@ -42,6 +42,7 @@ import numpy as np
 
 from drake_traj.planners.base import HermiteLaw, TimeLawPlanner
 from drake_traj.robots import Robot
+from drake_traj.robots.base import format_point
 from drake_traj.validation import finite_array, limit_or_default, positive_scalar, real_array
 
 __all__ = [
@@ -728,7 +729,17 @@ class RobotLoopLaw(HermiteLaw):
         self.robot = robot
         self.reference = np.asarray(reference, dtype=float)
         coarse = np.union1d(np.linspace(0.0, plan.duration, 201), plan.breakpoints)
-        robot.point_ik(plan.sample(coarse)[0].reshape(-1, 3), self.reference)  # out of reach: a ValueError now
+        positions = plan.sample(coarse)[0].reshape(-1, 3)
+        try:
+            robot.point_ik(positions, self.reference)  # out of reach: a ValueError now
+        except ValueError:
+            for tau, position in zip(coarse, positions):  # the first sample out of reach, named
+                try:
+                    robot.point_ik(position[None], self.reference)
+                except ValueError as error:
+                    raise ValueError(f"the loop path leaves the {robot.name}'s reach at law time {tau:.4g} s of "
+                                     f"{plan.duration:.4g} s, at {format_point(position)} m: {error}") from error
+            raise
         knots = np.union1d(np.linspace(0.0, plan.duration, int(np.ceil(plan.duration / knot_step)) + 1),
                            plan.breakpoints)
         right = np.array([self.exact(tau, "right") for tau in knots])
@@ -947,6 +958,11 @@ def make(config: BorygaConfig, robot: Robot, q_initial) -> BorygaLoopPlanner:
     if any(point.size for point in points):
         if not all(point.shape == (3,) for point in points):
             raise ValueError(f"B, M and E must all be 3-vectors [m] or all empty, got {[p.tolist() for p in points]}")
+        for name, point in zip(("B", "M", "E"), points):  # named before the path between them is solved
+            try:
+                robot.point_ik(point[None], q_initial)
+            except ValueError as error:
+                raise ValueError(f"{name} is out of reach: {error}") from error
     elif robot.name in _PLACEMENT:
         placement = paper_loop_placement(robot.name)
         points = [placement.B, placement.M, placement.E]

@@ -181,6 +181,11 @@ def make(config: LiConfig, robot: Robot, q_initial) -> LiPathPlanner:
         points = real_array(config.points, "points", "m")
         if points.ndim != 2 or points.shape[1] != 3 or len(points) < 2:
             raise ValueError(f"points must be a list of at least two [x, y, z] rows [m], got shape {points.shape}")
+        for index, point in enumerate(points):  # named by its index before the path between them is solved
+            try:
+                robot.point_ik(point[None], q_initial)
+            except ValueError as error:
+                raise ValueError(f"points[{index}] is out of reach: {error}") from error
     else:
         points = li_closed_path()
         if robot.name != LI_4DOF.name:
