@@ -23,11 +23,13 @@ subclasses provide the law, not ``evaluate``.
 from __future__ import annotations
 
 from bisect import bisect_right
+from math import comb
 
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, ContinuousStateIndex, EventStatus, LeafSystem, ValueProducer
 
+from drake_traj.planners.polynomials import rate_peaks
 from drake_traj.planners.scaling import admissible_clock_rate, clock_at, next_clock_rate
 from drake_traj.validation import finite_array
 
@@ -370,6 +372,26 @@ class HermiteLaw:
         second = np.arange(1, 5)[None, :, None] * first[:, 1:]
         self._rate_coefficients = np.concatenate([first, np.pad(second, ((0, 0), (0, 1), (0, 0)))], axis=2)
         self._end = left[-1].copy()
+
+    def interval_polynomials(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """q̇ and q̈ on each knot interval as polynomials in sigma in [-1, 1] (tau = mid + sigma
+        half): (mid [s] (K-1,), half [s] (K-1,), q̇ coefficients (5, K-1, n), q̈ coefficients
+        (4, K-1, n)), for :func:`~drake_traj.planners.polynomials.rate_peaks`."""
+        half = 0.5 * np.diff(self.knots)
+        scale = half[:, None]
+        # q(sigma) = sum_k e_k sigma^k with s = half (1 + sigma): e_k = sum_j C(j, k) c_j half^j
+        position = np.stack([sum(comb(j, k) * self._coefficients[:, j] * scale**j for j in range(k, 6))
+                             for k in range(6)])
+        velocity = np.stack([(k + 1) * position[k + 1] / scale for k in range(5)])
+        acceleration = np.stack([(k + 1) * velocity[k + 1] / scale for k in range(4)])
+        return self.knots[:-1] + half, half, velocity, acceleration
+
+    def peak_rates(self) -> tuple[np.ndarray, np.ndarray]:
+        """(max |q̇|, max |q̈|) over the whole law per joint, exact to round-off (interval ends,
+        both sides of every jump, and the extrema inside each interval)."""
+        _, _, velocity, acceleration = self.interval_polynomials()
+        v_peak, _, a_peak, _ = rate_peaks(velocity, acceleration)
+        return v_peak.max(axis=0), a_peak.max(axis=0)
 
     def _interval(self, tau: float) -> tuple[int, float]:
         k = min(max(bisect_right(self.knots, tau) - 1, 0), len(self.knots) - 2)

@@ -7,7 +7,8 @@ from drake_traj.robots import UR10E, boryga_robots
 from drake_traj.robots import ur10e as robot
 from drake_traj.station import simulate
 from drake_traj.robots import get_robot
-from drake_traj.planners.boryga import RobotLoopLaw, joint_speed_cap, paper_loop_placement, plan_loop_path
+from drake_traj.planners import make_planner as make_planner_from_config
+from drake_traj.planners.boryga import BorygaConfig, RobotLoopLaw, joint_speed_cap, paper_loop_placement, plan_loop_path
 from drake_traj.scenario import load_scenario, make_planner
 
 from conftest import DIAGRAMS
@@ -101,3 +102,59 @@ def test_cli_writes_the_loop_path_figure(tmp_path):
     assert cli.main(["run", str(DIAGRAMS / "boryga_loop.yaml"), "--variant", "cartesian", "--out", str(tmp_path)]) == 0
     for stem in ("loop_path", "joints", "tcp_path"):
         assert (tmp_path / f"{stem}.png").stat().st_size > 10_000
+
+
+def random_loops(count: int, seed: int = 11) -> list[BorygaConfig]:
+    """Seeded loops of a user's own on the UR10e: B at the tool at home, M and E random steps of up
+    to 0.3 m (0.09 m in z), random Δ (5-50 mm) and path speed (0.05-0.5 m/s)."""
+    rng = np.random.default_rng(seed)
+    tool = UR10E.tool_position(UR10E.home_configuration)
+    loops = []
+    for _ in range(count):
+        corner = tool + rng.uniform(-0.3, 0.3, 3) * [1, 1, 0.3]
+        end = corner + rng.uniform(-0.3, 0.3, 3) * [1, 1, 0.3]
+        loops.append(BorygaConfig(B=tool.tolist(), M=corner.tolist(), E=end.tolist(),
+                                  delta=float(rng.uniform(0.005, 0.05)), v_max=float(rng.uniform(0.05, 0.5))))
+    return loops
+
+
+def test_a_users_loop_keeps_the_ur10es_joint_move_limits_at_every_instant():
+    # no limits given: the UR10e's joint-move limits (1.05 rad/s, 1.40 rad/s²; with none, 3 of 12
+    # such loops drove a joint into its torque limit). The cap uses the law's exact peaks: a
+    # sampled peak let loops 6 and 13 of these exceed 1.40 rad/s² by up to 0.07 %.
+    loops = random_loops(14)
+    for index in (0, 3, 6, 13):
+        config = loops[index]
+        planner = make_planner_from_config(config, UR10E, UR10E.home_configuration)
+        np.testing.assert_array_equal(planner.acceleration_limit, 1.40)
+        np.testing.assert_array_equal(planner.velocity_limit, 1.05)
+        c = planner.speed_cap
+        tau = np.arange(0.0, planner.law.duration, 1e-3 * c)  # the reference's 1 ms samples
+        rates = np.array([np.concatenate(planner.law.rates_at(t)) for t in tau])
+        assert np.abs(rates[:, :6]).max() * c <= 1.05 * (1 + 1e-9), index
+        assert np.abs(rates[:, 6:]).max() * c**2 <= 1.40 * (1 + 1e-9), index
+        assert c == 1.0 or max(np.abs(rates[:, :6]).max() * c / 1.05, np.abs(rates[:, 6:]).max() * c**2 / 1.40) > 0.999
+
+
+def test_a_users_loop_runs_within_the_limits_and_ends_at_e():
+    config = random_loops(14)[13]
+    result = simulate(make_planner_from_config(config, UR10E, UR10E.home_configuration), settle_time=0.1)
+    assert result.succeeded, result.failure
+    metrics = result.metrics()
+    assert metrics.max_acceleration_over_limit <= 1 + 1e-9 and metrics.max_velocity_over_limit <= 1 + 1e-9
+    np.testing.assert_allclose(result.tcp[-1, :3], config.E, atol=1e-6)
+
+
+def test_the_hermite_laws_interval_polynomials_and_exact_peaks():
+    law = make_planner_from_config(random_loops(14)[13], UR10E, UR10E.home_configuration).law
+    mid, half, velocity, acceleration = law.interval_polynomials()
+    rng = np.random.default_rng(5)
+    for k in rng.integers(0, len(mid), 20):
+        for sigma in (-1.0, rng.uniform(-1, 1), 1.0 - 1e-9):
+            qd, qdd = law.rates_at(mid[k] + sigma * half[k])
+            np.testing.assert_allclose(np.polynomial.polynomial.polyval(sigma, velocity[:, k]), qd, rtol=1e-9, atol=1e-9)
+            np.testing.assert_allclose(np.polynomial.polynomial.polyval(sigma, acceleration[:, k]), qdd, rtol=1e-7, atol=1e-7)
+    peak_qd, peak_qdd = law.peak_rates()
+    dense = np.array([np.concatenate(law.rates_at(t)) for t in np.linspace(0.0, law.duration, 100001)])
+    assert np.all(peak_qd >= np.abs(dense[:, :6]).max(axis=0)) and np.all(peak_qdd >= np.abs(dense[:, 6:]).max(axis=0))
+    np.testing.assert_allclose(peak_qdd, np.abs(dense[:, 6:]).max(axis=0), rtol=1e-5, atol=1e-9)  # and no larger than the law's

@@ -33,6 +33,7 @@ import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
 from drake_traj.planners.li.cartesian import acc_dec_profile
+from drake_traj.planners.polynomials import rate_peaks
 
 __all__ = [
     "JointSplineLaw",
@@ -49,7 +50,6 @@ DEGREE = 5  # quintic B-spline (section 3.2)
 # take a sample over the limit itself.
 LIMIT_MARGIN = 1e-9
 DEFAULT_SAMPLES_PER_INTERVAL = 16
-_BISECTION_STEPS = 60
 
 
 # --------------------------------------------------------------------------------------------
@@ -390,48 +390,6 @@ class JointSplineLaw:
 # --------------------------------------------------------------------------------------------
 
 
-def _quadratic_roots(a, b, c):
-    """Real roots in [-1, 1] of a x^2 + b x + c (arrays), shape (..., 2); NaN where none."""
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        disc = b * b - 4.0 * a * c
-        sq = np.sqrt(np.where(disc >= 0.0, disc, np.nan))
-        qq = -0.5 * (b + np.where(b >= 0.0, 1.0, -1.0) * sq)  # the stable form
-        roots = np.stack([qq / a, c / qq], axis=-1)
-    return np.where(np.abs(roots) <= 1.0, roots, np.nan)
-
-
-def _poly(coeffs, x):
-    """sum_p coeffs[p] x^p by Horner; coeffs (P, ...), x broadcastable to coeffs[0]."""
-    value = np.zeros(np.broadcast(coeffs[0], x).shape)
-    for c in coeffs[::-1]:
-        value = value * x + c
-    return value
-
-
-def _cubic_roots(coeffs):
-    """Real roots in [-1, 1] of sum_p coeffs[p] x^p (coeffs (4, ...)), shape (..., 3); NaN if none.
-
-    The cubic is monotone between the roots of its derivative (closed form), so each of the three
-    pieces holds at most one root; a sign change is bisected to full precision.
-    """
-    c0, c1, c2, c3 = coeffs
-    turning = _quadratic_roots(3.0 * c3, 2.0 * c2, c1)
-    turning = np.sort(np.where(np.isnan(turning), 1.0, turning), axis=-1)  # NaN -> empty piece
-    lo = np.concatenate([np.full(turning.shape[:-1] + (1,), -1.0), turning], axis=-1)
-    hi = np.concatenate([turning, np.ones(turning.shape[:-1] + (1,))], axis=-1)
-    expanded = coeffs[..., None]
-    f_lo = _poly(expanded, lo)
-    f_hi = _poly(expanded, hi)
-    bracket = f_lo * f_hi <= 0.0
-    rising = f_hi >= f_lo
-    for _ in range(_BISECTION_STEPS):
-        mid = 0.5 * (lo + hi)
-        left = (_poly(expanded, mid) >= 0.0) == rising  # the root is at or left of mid
-        hi = np.where(left, mid, hi)
-        lo = np.where(left, lo, mid)
-    return np.where(bracket, 0.5 * (lo + hi), np.nan)
-
-
 @dataclass(frozen=True)
 class LimitReport:
     """Peak joint velocity and acceleration of a law against the limits.
@@ -510,17 +468,6 @@ class LimitReport:
         return "; ".join(lines) if lines else "all limits hold"
 
 
-def _interval_peaks(coeffs: np.ndarray, s_candidates: np.ndarray):
-    """max |poly| over the candidate sigma per (interval, joint) (NaN = no candidate), and where."""
-    values = np.abs(_poly(coeffs[..., None], s_candidates))
-    values = np.where(np.isnan(values), -1.0, values)
-    index = np.argmax(values, axis=-1)
-    peak = np.take_along_axis(values, index[..., None], axis=-1)[..., 0]
-    candidates = np.nan_to_num(s_candidates, nan=0.0)
-    where = np.take_along_axis(candidates, index[..., None], axis=-1)[..., 0]
-    return peak, where
-
-
 def check_limits(
     law: JointSplineLaw,
     velocity_limit,
@@ -561,16 +508,7 @@ def check_limits(
     if not 0.0 <= margin < 1.0:
         raise ValueError(f"margin must be in [0, 1), got {margin}")
     mid, half, qd, qdd = law.interval_polynomials()  # in sigma in [-1, 1] per knot interval
-    count = int(samples_per_interval)
-    grid = np.broadcast_to(np.linspace(-1.0, 1.0, count), qd.shape[1:] + (count,))
-    # Velocity extrema: roots of qdd (a cubic in sigma); acceleration extrema: roots of its
-    # sigma-derivative (a quadratic).
-    v_candidates = np.concatenate([grid, _cubic_roots(qdd)], axis=-1)
-    a_candidates = np.concatenate(
-        [grid, _quadratic_roots(3.0 * qdd[3], 2.0 * qdd[2], qdd[1])], axis=-1
-    )
-    v_peak, v_s = _interval_peaks(qd, v_candidates)
-    a_peak, a_s = _interval_peaks(qdd, a_candidates)
+    v_peak, v_s, a_peak, a_s = rate_peaks(qd, qdd, int(samples_per_interval))
     mid, half = mid[:, None], half[:, None]
     rows = np.argmax(v_peak, axis=0)
     arows = np.argmax(a_peak, axis=0)
