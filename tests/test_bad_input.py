@@ -154,13 +154,13 @@ YAML_CASES = [
     ("pajak waypoint short row", pajak("  waypoints:\n    - [-0.175, -0.525, 0.730]\n"), r"waypoints must have shape \(w, 6\)"),
     ("boryga only B", "name: b\nrobot: scara\nplanner: !BorygaConfig\n  B: [0.5, 0.5, 0.265]\n", r"B, M and E must all be 3-vectors"),
     ("boryga M out of reach", "name: b\nrobot: ur10e\nplanner: !BorygaConfig\n  B: [0.5, 0.3, 0.5]\n  M: [3.0, 0.3, 0.5]\n"
-     "  E: [0.5, 0.5, 0.5]\n", r"line 5, column 6: planner.M is out of reach: pose \(x, y, z\) = \(3, 0.3, 0.5\) m"),
+     "  E: [0.5, 0.5, 0.5]\n", r"line 5, column 6: planner.M: pose \(x, y, z\) = \(3, 0.3, 0.5\) m, .* is out of reach"),
     ("boryga loop beyond reach", "name: b\nrobot: ur10e\nplanner: !BorygaConfig\n  B: [0.5, 0.3, 0.5]\n  M: [1.18, 0.3, 0.5]\n"
      "  E: [0.5, 0.5, 0.5]\n", r"planner: the loop path leaves the ur10e's reach at law time 4.542 s of 9.311 s, at \[1.1998, 0.3, 0.5\] m"),
     ("li point out of reach", "name: l\nrobot: ur10e\nplanner: !LiConfig\n  points: [[0.5, 0.2, 0.5], [0.7, 0.2, 0.5], [3.0, 0.2, 0.5]]\n",
-     r"line 4, column 46: planner.points\[2\] is out of reach: pose \(x, y, z\) = \(3, 0.2, 0.5\) m"),
+     r"line 4, column 46: planner.points\[2\]: pose \(x, y, z\) = \(3, 0.2, 0.5\) m, .* is out of reach"),
     ("li point out of reach of the 4-dof robot", "name: l\nrobot: li_4dof\nplanner: !LiConfig\n  points: [[0.3, 0, 0], [0.5, 0.2, 0]]\n",
-     r"planner.points\[1\] is out of reach: point 0 at \[0.5, 0.2, 0\] m is out of reach of the li_4dof robot"),
+     r"planner.points\[1\]: point at \[0.5, 0.2, 0\] m is out of reach of the li_4dof robot: the wrist"),
     ("li tool acceleration zero", "name: l\nrobot: li_4dof\nplanner: !LiConfig\n  tool_acceleration_limit: 0.0\n", r"a_max"),
     ("li on a robot without acceleration limits", "name: l\nrobot: scara\nplanner: !LiConfig {}\n",
      r"acceleration_limit must be given: the robot has no default"),

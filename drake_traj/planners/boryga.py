@@ -960,7 +960,7 @@ def make(config: BorygaConfig, robot: Robot, q_initial) -> BorygaLoopPlanner:
             try:
                 robot.point_ik(point[None], q_initial)
             except ValueError as error:
-                raise ValueError(f"{name} is out of reach: {error}") from error
+                raise ValueError(f"{name}: {error}") from error
     elif robot.name in _PLACEMENT:
         placement = paper_loop_placement(robot.name)
         points = [placement.B, placement.M, placement.E]

@@ -282,10 +282,9 @@ class PointRobot(Robot):
         index, reason = problems[0]
         at = "" if times is None else f" (t = {float(np.ravel(times)[index]):.6g} s)"
         more = "" if len(problems) == 1 else f"; {len(problems)} of {len(p)} {label}s are out of reach"
-        return (
-            f"{label} {index}{at} at {format_point(p[index])} m is out of reach of the {self.name} robot: "
-            f"{reason}{more}"
-        )
+        name = label if len(p) == 1 else f"{label} {index}"  # a single point has no index
+        return f"{name}{at} at {format_point(p[index])} m is out of reach of the {self.name} robot: {reason}{more}"
+
 
     def _solve(self, p: np.ndarray):
         q, problems = self._ik_raw(p)

@@ -185,7 +185,7 @@ def make(config: LiConfig, robot: Robot, q_initial) -> LiPathPlanner:
             try:
                 robot.point_ik(point[None], q_initial)
             except ValueError as error:
-                raise ValueError(f"points[{index}] is out of reach: {error}") from error
+                raise ValueError(f"points[{index}]: {error}") from error
     else:
         points = li_closed_path()
         if robot.name != LI_4DOF.name:
