@@ -209,6 +209,9 @@ class TimeLawPlanner(PlannerSystem):
 
     def __init__(self, law, velocity_limit, acceleration_limit, *, speed_cap: float = 1.0, update_period: float = 0.001,
                  scaling_rate: float = 4.0, clock_jerk: float = 20.0):
+        if type(self).evaluate is not TimeLawPlanner.evaluate:  # the hot path never calls it
+            raise TypeError(f"{type(self).__name__} overrides evaluate, which a TimeLawPlanner does not use (its "
+                            "rates come from the law): change the law, or derive from PlannerSystem")
         missing = [name for name in ("q_start", "duration", "rates_at", "sample") if not hasattr(law, name)]
         if missing:
             raise TypeError(f"law must be a time law with q_start, duration, rates_at and sample; "

@@ -86,3 +86,18 @@ def test_time_law_derivatives_are_the_laws_rates_on_the_clock():
     np.testing.assert_allclose(derivatives, np.r_[qd_law * c, qdd_law * c**2 - 0.2 * qd_law], rtol=0, atol=1e-14)
     np.testing.assert_allclose(planner.GetOutputPort("acceleration_and_scaling").Eval(context), np.r_[derivatives[6:], c],
                                rtol=0, atol=1e-15)
+
+
+def test_a_time_law_planner_that_overrides_evaluate_is_refused():
+    # its evaluate would never run (the derivatives and outputs come from the law): say so
+    from drake_traj.planners.quintic import QuinticPtpPlanner
+
+    class Custom(QuinticPtpPlanner):
+        def evaluate(self, context):
+            return super().evaluate(context)
+
+    ur10e = get_robot("ur10e")
+    plan = make_planner(QuinticConfig(goals=[(ur10e.home_configuration + 0.3).tolist()]), ur10e,
+                        ur10e.home_configuration).law
+    with pytest.raises(TypeError, match="Custom overrides evaluate, which a TimeLawPlanner does not use"):
+        Custom(plan, 1.05, 1.40)
