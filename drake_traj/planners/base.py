@@ -315,11 +315,11 @@ class TimeLawPlanner(PlannerSystem):
         tau, c = clock_at(t - t0, tau0, c0, c_rate)
         goal = self.speed_cap * self.speed_override(context)
         steady = c_rate == 0.0 and c == goal
-        tau_before = clock_at(max(t - h, t0) - t0, tau0, c0, c_rate)[0]
-        if steady and tau < self.law.duration and not self._jumped(tau, tau_before):
+        jumped = self._jumped(tau, clock_at(max(t - h, t0) - t0, tau0, c0, c_rate)[0])
+        if steady and not jumped and tau < self.law.duration:
             return _DID_NOTHING  # the clock runs on as it is: nothing to write (the common case)
         finishing = tau >= self.law.duration and np.isnan(self.finish_time(context))
-        if steady and not (finishing or self._jumped(tau, tau_before)):
+        if steady and not (jumped or finishing):
             return _DID_NOTHING
         discrete = state.get_mutable_discrete_state()
         if finishing:  # finished in (t0, t]: tau0 + c0 s + ċ s² / 2 = duration
