@@ -792,7 +792,7 @@ class BorygaLoopPlanner(TimeLawPlanner):
         super().__init__(law, velocity_limit, acceleration_limit, speed_cap=cap, update_period=update_period)
 
     def figures(self) -> dict:
-        return {"loop_path": loop_path_figure(self.law.plan)}
+        return {"loop_path": loop_path_figure(self.law.plan, clock_rate=self.speed_cap)}
 
     def task_waypoints(self) -> np.ndarray:
         """B, M and E [m]."""
@@ -800,13 +800,18 @@ class BorygaLoopPlanner(TimeLawPlanner):
         return np.array([geometry.B, geometry.M, geometry.E])
 
 
-def loop_path_figure(plan: LoopPathPlan, *, samples: int = 4001):
-    """The paper's figs. 5-7 for ``plan``: position, velocity and acceleration per axis and their
-    norms (speed along the path, acceleration magnitude) against time, junctions marked."""
+def loop_path_figure(plan: LoopPathPlan, *, clock_rate: float = 1.0, samples: int = 4001):
+    """The paper's figs. 5-7 for ``plan`` as run at the constant clock rate ``clock_rate`` (the
+    planner's speed cap; 1: the path's own profile at v_max): position, velocity and acceleration
+    per axis and their norms (speed along the path, acceleration magnitude) against time, junctions
+    marked. At rate c the tool is at the path's point tau at t = tau / c, with velocity × c and
+    acceleration × c²."""
     from matplotlib.figure import Figure
 
-    t = np.linspace(0.0, plan.duration, samples)
-    position, velocity, acceleration = plan.sample(t)[:3]
+    c = positive_scalar(clock_rate, "clock_rate", "")
+    tau = np.linspace(0.0, plan.duration, samples)
+    position, velocity, acceleration = plan.sample(tau)[:3]
+    t, velocity, acceleration = tau / c, velocity * c, acceleration * c * c
     figure = Figure(figsize=(9, 8), layout="constrained")
     axes = figure.subplots(3, 1, sharex=True)
     for ax, data, label, norm_label in (
@@ -818,14 +823,18 @@ def loop_path_figure(plan: LoopPathPlan, *, samples: int = 4001):
             ax.plot(t, data[:, k], label=axis)
         if norm_label:
             ax.plot(t, np.linalg.norm(data, axis=1), "k--", label=norm_label)
-        for time, name in zip(plan.breakpoints, ("B", "M", "T1", "T2", "M", "E")):
+        for index, (time, name) in enumerate(zip(plan.breakpoints / c, ("B", "M", "T1", "T2", "M", "E"))):
             ax.axvline(time, color="grey", linewidth=0.6)
-            if ax is axes[0]:
-                ax.annotate(name, (time, 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom")
+            if ax is axes[0]:  # alternate heights: M and T1 (T2 and M) are close on a small loop
+                ax.annotate(name, (time, 1.0 + 0.07 * (index % 2)), xycoords=("data", "axes fraction"), ha="center",
+                            va="bottom")
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
         ax.legend(ncol=4, fontsize="small")
     axes[-1].set_xlabel("t [s]")
+    if c < 1.0:
+        figure.suptitle(f"as run: the path's profile at v_max slowed to c = {c:.4g} by the joint limits "
+                        "(t = τ / c, velocity × c, acceleration × c²)", fontsize="medium")
     return figure
 
 

@@ -158,3 +158,17 @@ def test_the_hermite_laws_interval_polynomials_and_exact_peaks():
     dense = np.array([np.concatenate(law.rates_at(t)) for t in np.linspace(0.0, law.duration, 100001)])
     assert np.all(peak_qd >= np.abs(dense[:, :6]).max(axis=0)) and np.all(peak_qdd >= np.abs(dense[:, 6:]).max(axis=0))
     np.testing.assert_allclose(peak_qdd, np.abs(dense[:, 6:]).max(axis=0), rtol=1e-5, atol=1e-9)  # and no larger than the law's
+
+
+def test_the_loop_figure_shows_the_motion_as_run(ur10e_run):
+    # the UR10e runs the loop at the speed cap c: the figure's time axis ends at the run's finish
+    # (t = τ / c) and its speed peaks at v_max c, not at the path's own v_max
+    planner, result = ur10e_run
+    c = planner.speed_cap
+    assert c < 0.31
+    figure = planner.figures()["loop_path"]
+    speed = next(line for line in figure.axes[1].lines if line.get_label() == "speed")
+    assert speed.get_xdata()[-1] == pytest.approx(planner.law.duration / c, rel=1e-12)
+    assert speed.get_xdata()[-1] == pytest.approx(result.duration, abs=2e-3)
+    assert max(speed.get_ydata()) == pytest.approx(0.25 * c, rel=1e-3)
+    assert "slowed to c = 0.3023" in figure.get_suptitle()
