@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from bisect import bisect_right
 from math import comb
+from typing import NamedTuple
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -165,6 +166,15 @@ class PlannerSystem(LeafSystem):
         output.SetFromVector(self._evaluation.Eval(context).get_value())
 
 
+class _Rates(NamedTuple):
+    """A time-law planner's rates at one instant (views of one read-only array)."""
+
+    derivatives: np.ndarray  # d/dt [q; q̇] = [q_law'(tau) c; q̈], (2n,)
+    acceleration: np.ndarray  # q̈ = q_law'' c² + q_law' ċ [rad/s²], (n,)
+    acceleration_and_scaling: np.ndarray  # [q̈; c], (n + 1,)
+    scaling: float  # c
+
+
 class TimeLawPlanner(PlannerSystem):
     """A planner that follows a closed-form joint time law on a scaled planner clock.
 
@@ -231,7 +241,7 @@ class TimeLawPlanner(PlannerSystem):
         self.acceleration_limit = np.asarray(acceleration_limit, dtype=float)
         self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, 0.0, self.speed_cap, 0.0]))
         self.DeclarePeriodicUnrestrictedUpdateEvent(update_period, 0.0, self._update)
-        self._kept = (None, None)  # (key, (rates [q'; q̈], q̈, [q̈; c], c)) of _rates
+        self._kept = (None, None)  # (key, _Rates) of _rates
         jumps = getattr(law, "acceleration_jumps", None)  # law times where q_law'' jumps (None: anywhere)
         self._acceleration_jumps = None if jumps is None else sorted(np.asarray(jumps, dtype=float).tolist())
 
@@ -245,13 +255,13 @@ class TimeLawPlanner(PlannerSystem):
         tau, c = clock_at(context.get_time() - t0, tau0, c0, c_rate)
         return tau, c, c_rate
 
-    def _rates(self, context) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-        """(the time derivative of [q; q̇] = [q_law' c; q̈], q̈, [q̈; c], c) at the context's time.
+    def _rates(self, context) -> _Rates:
+        """The law's rates at the context's time (:class:`_Rates`).
 
-        They depend on the time and the clock state only. Drake asks for them at both stages of
-        every step, for the outputs and again after the step's updates mark the state changed, so
-        the last result is kept by value: one law evaluation per (time, clock state). The arrays
-        are read-only views of one (shared by every caller with that key)."""
+        They depend on the time and the clock state only, so the last ones are kept by that key.
+        Per step Drake asks at t (first RK2 stage), at t + h (second stage) and for the output at
+        t + h at the step's end: one law evaluation per step (counted on Li 4-DOF). The arrays are
+        read-only views of one (shared by every caller with that key)."""
         key = (context.get_time(), *self._clock_state(context))
         if key != self._kept[0]:
             t, tau0, c_rate, c0, t0 = key
@@ -260,30 +270,30 @@ class TimeLawPlanner(PlannerSystem):
             values = np.concatenate((qd_law * c, qdd_law * c**2 + qd_law * c_rate, (c,)))
             values.flags.writeable = False
             n = self.num_joints
-            self._kept = (key, (values[: 2 * n], values[n : 2 * n], values[n:], c))
+            self._kept = (key, _Rates(values[: 2 * n], values[n : 2 * n], values[n:], c))
         return self._kept[1]
 
     def evaluate(self, context) -> tuple[np.ndarray, float]:
-        _, qdd, _, c = self._rates(context)
-        return qdd, c
+        rates = self._rates(context)
+        return rates.acceleration, rates.scaling
 
     def acceleration(self, context) -> np.ndarray:
-        return self._rates(context)[1]
+        return self._rates(context).acceleration
 
     def scaling(self, context) -> float:
-        return self._rates(context)[3]
+        return self._rates(context).scaling
 
     def DoCalcTimeDerivatives(self, context, derivatives):
-        derivatives.SetFromVector(self._rates(context)[0])
+        derivatives.SetFromVector(self._rates(context).derivatives)
 
     def _calc_desired_acceleration(self, context, output):
-        output.SetFromVector(self._rates(context)[1])
+        output.SetFromVector(self._rates(context).acceleration)
 
     def _calc_scaling_output(self, context, output):
-        output.SetAtIndex(0, self._rates(context)[3])
+        output.SetAtIndex(0, self._rates(context).scaling)
 
     def _calc_acceleration_and_scaling(self, context, output):
-        output.SetFromVector(self._rates(context)[2])
+        output.SetFromVector(self._rates(context).acceleration_and_scaling)
 
     def finished(self, context) -> bool:
         return self._clock(context)[0] >= self.law.duration
