@@ -21,7 +21,6 @@ printed as escapes (``\u0105``), never an error.
 import argparse
 import contextlib
 import json
-import re
 import signal
 import sys
 import threading
@@ -33,17 +32,17 @@ from tqdm import tqdm
 
 from drake_traj.version import __version__
 from drake_traj.bench import BenchSetupError, bench
-from drake_traj.errors import DrakeTrajError, PlanningError
+from drake_traj.errors import Cause, DrakeTrajError, PlanningError
 from drake_traj.export import FORMATS, UR_CYCLE, ExportError
 from drake_traj.meshcat import add_live_view, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
 from drake_traj.result import SimulationResult
 from drake_traj.rundir import MANIFEST, add_to_manifest, begin_output, check_output, run_files, write_manifest
 from drake_traj.scenario import (DEFAULT_SCENARIO, ScenarioError, default_scenario_path, find_scenario, load_scenario,
-                                 locate_in_scenario, shipped_scenarios)
+                                 locate_in_scenario, preflight, shipped_scenarios)
 from drake_traj.station import simulate
 
 EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_TERMINATED = 0, 1, 2, 130, 143
-SUMMARY = ("name", "succeeded", "failure", "duration_s", "max_velocity_over_limit", "max_acceleration_over_limit",
+SUMMARY = ("name", "succeeded", "failure", "failure_cause", "duration_s", "max_velocity_over_limit", "max_acceleration_over_limit",
            "tracking_error_joint_max_rad", "tracking_error_tcp_max_m", "real_time_factor")
 
 
@@ -92,23 +91,11 @@ def _interrupts_deferred():
             signal.signal(number, handler)
 
 
-def _preflight(planner, scenario):
-    """The planner's preflight; its PlanningError located in the scenario file (a waypoint it
-    names, as ``planner.waypoints[i]``)."""
-    try:
-        return planner.preflight()
-    except PlanningError as error:
-        waypoint = re.search(r"waypoint (\d+)", str(error))
-        field = f"planner.waypoints[{waypoint.group(1)}]" if waypoint else "planner"
-        raise PlanningError(locate_in_scenario(scenario, f"{field}: {error}"), time=None, cause=error.cause,
-                            partial=error.partial) from error
-
-
 def run(args) -> int:
     """``drake-traj run``: simulate one scenario and write its outputs; returns the exit code."""
     scenario = load_scenario(*_scenario_reference(args))
     if args.out == "":
-        raise ValueError("--out must name a folder, got empty text")
+        raise DrakeTrajError("--out must name a folder, got empty text")
     progress = Progress(scenario.max_duration, enabled=sys.stderr.isatty())
     interrupts = []
     try:
@@ -117,12 +104,13 @@ def run(args) -> int:
         planned_path = None
         if args.preflight:
             progress.stage("preflight")
-            planned_path = _preflight(planner, scenario)
+            planned_path = preflight(scenario, planner)
         duration = planner.planned_duration()
         if np.isfinite(duration) and duration > scenario.max_duration:
             raise ScenarioError(locate_in_scenario(
-                scenario, f"max_duration ({scenario.max_duration:g} s) is shorter than the planned motion "
-                          f"({duration:.3f} s at the planner's limits); raise max_duration or the limits"))
+                scenario, ("max_duration",), f"max_duration ({scenario.max_duration:g} s) is shorter than the planned "
+                                             f"motion ({duration:.3f} s at the planner's limits); raise max_duration "
+                                             "or the limits"), field=("max_duration",), cause=Cause.INFEASIBLE)
         # checked before the simulation; written (an earlier run replaced, with --overwrite) only
         # once there are results
         out_dir = check_output(Path(args.out) if args.out else Path("out") / scenario.name, overwrite=args.overwrite)
@@ -153,7 +141,7 @@ def run(args) -> int:
                           settle_time=scenario.settle_time, max_duration=scenario.max_duration,
                           speed_override=None if args.meshcat else scenario.speed_override, meshcat=meshcat,
                           progress=progress.simulated, add_systems=add_systems, before_run=before_run,
-                          tracking_tolerance=scenario.tracking_tolerance, **arguments)
+                          tracking_tolerance=scenario.tracking_tolerance, preflight=False, **arguments)
         progress.stage("writing figures")
         with _interrupts_deferred() as interrupts:  # a second Ctrl-C must not leave half a run
             out_dir = begin_output(out_dir, overwrite=args.overwrite)
@@ -183,7 +171,7 @@ def run(args) -> int:
         return EXIT_TERMINATED if signal.SIGTERM in interrupts else EXIT_INTERRUPTED
     if result.succeeded:
         return EXIT_OK
-    return EXIT_INTERRUPTED if result.failure.cause == "interrupted" else EXIT_RUN_FAILED
+    return EXIT_INTERRUPTED if result.failure.cause is Cause.INTERRUPTED else EXIT_RUN_FAILED
 
 
 def list_scenarios(args) -> int:
@@ -236,10 +224,10 @@ def check_options(args) -> None:
         live_only = [option for option, given in (("--rate", args.rate != 1.0), ("--port", args.port is not None),
                                                   ("--no-wait", not args.wait)) if given]
         if live_only and not args.meshcat:
-            raise ValueError(f"{live_only[0]} sets up the live view; add --meshcat (or leave {live_only[0]} out)")
+            raise DrakeTrajError(f"{live_only[0]} sets up the live view; add --meshcat (or leave {live_only[0]} out)")
     for option, ok, value, expected in checks:
         if not ok:
-            raise ValueError(f"{option} must be {expected}, got {value}")
+            raise DrakeTrajError(f"{option} must be {expected}, got {value}")
 
 
 def build_parser() -> argparse.ArgumentParser:

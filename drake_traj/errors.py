@@ -1,27 +1,115 @@
-"""The package's exceptions and the record of a run that failed.
+"""The package's exceptions, their causes and locations as data, and the record of a failed run.
 
 Every error drake_traj raises on purpose derives from :class:`DrakeTrajError`, itself a
 ``ValueError``: bad input (a malformed argument, an unreachable pose, infeasible limits) and a
-task the planner cannot complete alike. A simulation that stops early keeps what it logged and
-describes why in a :class:`Failure`.
+task the planner cannot complete alike. Each carries
+
+- ``field``: where the input that caused it is, as a path of names and indices, e.g.
+  ``("planner", "waypoints", 3)`` (empty where no one input is to blame);
+- ``cause``: a :class:`Cause`, what went wrong.
+
+The command line and the scenario reader locate an error in a YAML file from ``field``, and decide
+what to do from ``cause``: no message text is ever parsed. A simulation that stops early keeps
+what it logged and describes why in a :class:`Failure`, whose ``cause`` is a :class:`Cause` too.
 """
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["DrakeTrajError", "Failure", "PlanningError", "SingularConfigurationError"]
+__all__ = [
+    "Cause", "DrakeTrajError", "Failure", "Field", "PlanningError", "SingularConfigurationError", "field_text",
+    "joint_label",
+]
+
+Field = tuple  # tuple[str | int, ...]: field names and list indices, outermost first
+
+
+class Cause(str, enum.Enum):
+    """Why an input was refused or a run stopped. A ``str`` (``Cause.STALL == "stall"``):
+    ``metrics.json`` and ``run.json`` write its value."""
+
+    INVALID = "invalid"  # a malformed argument or field: type, shape, range, unknown name
+    UNREACHABLE = "unreachable"  # a pose outside the robot's reach, or an IK branch that does not exist
+    SINGULAR = "singular"  # a singular configuration, or the law stalled at one
+    INFEASIBLE = "infeasible"  # limits or geometry the task cannot meet
+    STALL = "stall"  # the online law stopped making progress
+    PLANNING = "planning"  # the planner could not complete the task for another reason
+    NON_FINITE = "non-finite"  # NaN or an infinity in the law or the log
+    TIMEOUT = "timeout"  # not finished within the run's or the preflight's time
+    INTERRUPTED = "interrupted"  # Ctrl-C or SIGTERM
+    SATURATION = "saturation"  # a joint's torque reached its effort limit
+    TRACKING = "tracking"  # the arm strayed further than the tolerance from the reference
+    OUTPUT = "output"  # an output folder or file that cannot be written
+    ERROR = "error"  # any other exception during a run
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __format__(self, spec: str) -> str:
+        return format(self.value, spec)
+
+
+def field_text(field: Field) -> str:
+    """The field path as it is written in a scenario file: ``("planner", "waypoints", 3)`` ->
+    ``planner.waypoints[3]``."""
+    text = ""
+    for part in field:
+        text += f"[{part}]" if isinstance(part, int) else f"{'.' if text else ''}{part}"
+    return text
+
+
+def joint_label(j: int, names=None) -> str:
+    """Joint ``j`` (0-based index) as every message names it: ``joint 2 (shoulder_lift_joint)``,
+    1-based, with its name where known."""
+    return f"joint {j + 1}" + (f" ({names[j]})" if names is not None else "")
+
+
+def _restore(cls, message: str, state: dict):
+    """Unpickle a :class:`DrakeTrajError` (its attributes travel with it, e.g. from a Dask worker)."""
+    error = cls.__new__(cls)
+    Exception.__init__(error, message)
+    error.__dict__.update(state)
+    return error
 
 
 class DrakeTrajError(ValueError):
-    """Base of every error raised by drake_traj on purpose."""
+    """Base of every error raised by drake_traj on purpose.
+
+    Args:
+        message: what is wrong, naming the input and the reason.
+        field: where the input is (:data:`Field`), e.g. ``("waypoints", 3)``; a caller that knows
+            the enclosing field re-raises it there (:meth:`relocated`).
+        cause: what went wrong; default the class's ``default_cause``.
+    """
+
+    default_cause = Cause.INVALID
+
+    def __init__(self, message: str, *, field: Field = (), cause: Cause | None = None):
+        super().__init__(message)
+        self.field = tuple(field)
+        self.cause = Cause(cause) if cause is not None else self.default_cause
+
+    def __reduce__(self):
+        return _restore, (type(self), str(self), dict(self.__dict__))
+
+    def relocated(self, field: Field, message: str) -> "DrakeTrajError":
+        """A copy of this error (same type, cause and other attributes) at ``field`` with the text
+        ``message``: how a caller that knows the enclosing field (a scenario's ``planner``)
+        passes the error on."""
+        error = _restore(type(self), message, dict(self.__dict__))
+        error.field = tuple(field)
+        return error
 
 
 class SingularConfigurationError(DrakeTrajError):
     """A kinematic quantity is undefined at this configuration or pose (a singular Jacobian,
     Euler-angle gimbal lock, an IK branch that does not exist there)."""
+
+    default_cause = Cause.SINGULAR
 
 
 class PlanningError(DrakeTrajError):
@@ -30,20 +118,23 @@ class PlanningError(DrakeTrajError):
     Attributes:
         time: simulation time [s] (None if not known).
         configuration: q [rad] at that time (None if not known).
-        cause: short machine-readable cause ("stall", "singular", "non-finite", "timeout", ...).
+        cause: a :class:`Cause` (STALL, SINGULAR, NON_FINITE, TIMEOUT, UNREACHABLE, ...).
+        field: the input to blame where there is one, e.g. ``("waypoints", 2)``.
         partial: what was computed before the failure (dict of arrays), where a caller keeps it.
     """
 
-    def __init__(self, message: str, *, time=None, configuration=None, cause: str = "", partial=None):
+    default_cause = Cause.PLANNING
+
+    def __init__(self, message: str, *, time=None, configuration=None, cause: Cause | None = None,
+                 field: Field = (), partial=None):
         where = ""
         if time is not None:
             where = f"at t = {float(time):.4f} s"
         if configuration is not None:
             where += f"{', ' if where else 'at '}q = {np.round(np.asarray(configuration, float), 4).tolist()}"
-        super().__init__(f"{message} ({where})" if where else message)
+        super().__init__(f"{message} ({where})" if where else message, field=field, cause=cause)
         self.time = time
         self.configuration = None if configuration is None else np.array(configuration, dtype=float)
-        self.cause = cause
         self.partial = partial
 
 
@@ -52,30 +143,34 @@ class Failure:
     """Why a simulated run stopped before its planner finished.
 
     Attributes:
-        cause: machine-readable cause: a :class:`PlanningError` cause ("stall", "singular", ...),
-            "timeout" (``max_duration`` reached) or "error" (any other exception).
+        cause: a :class:`Cause`: a :class:`PlanningError`'s (STALL, SINGULAR, ...), TIMEOUT
+            (``max_duration`` reached), INTERRUPTED, SATURATION, TRACKING, NON_FINITE, or ERROR
+            (any other exception).
         message: the human-readable reason (for an exception: its type, time and text).
         time: simulation time of the failure [s], if known.
         configuration: the reference q at that time [rad], if known.
     """
 
-    cause: str
+    cause: Cause
     message: str
     time: float | None = None
     configuration: tuple[float, ...] | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "cause", Cause(self.cause))  # a value read back from a file, too
 
     def __str__(self) -> str:
         return self.message
 
     def to_dict(self) -> dict:
         """JSON-ready form (see :meth:`from_dict`)."""
-        return {"cause": self.cause, "message": self.message, "time": self.time,
+        return {"cause": self.cause.value, "message": self.message, "time": self.time,
                 "configuration": None if self.configuration is None else list(self.configuration)}
 
     @classmethod
     def from_dict(cls, data: dict) -> "Failure":
         configuration = data.get("configuration")
-        return cls(str(data["cause"]), str(data["message"]), data.get("time"),
+        return cls(Cause(data["cause"]), str(data["message"]), data.get("time"),
                    None if configuration is None else tuple(float(v) for v in configuration))
 
     @classmethod
@@ -84,5 +179,5 @@ class Failure:
         message = f"{type(error).__name__} at t = {time:.4f} s: {error}"
         if isinstance(error, PlanningError):
             configuration = None if error.configuration is None else tuple(error.configuration.tolist())
-            return cls(error.cause or "planning", message, time, configuration)
-        return cls("error", message, time)
+            return cls(error.cause, message, time, configuration)
+        return cls(Cause.ERROR, message, time)

@@ -17,11 +17,12 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from drake_traj.errors import DrakeTrajError, Failure
+from drake_traj.errors import Cause, DrakeTrajError, Failure, joint_label
 from drake_traj.export import export, reference_trajectory
+from drake_traj.robots import get_robot
 from drake_traj.robots.ur10e import pose_error
 from drake_traj.rundir import OutputError, clear_run, create_folder, holds_a_run
-from drake_traj.validation import path_argument, positive_scalar, real_array
+from drake_traj.validation import invalid, path_argument, positive_scalar, real_array
 
 __all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult"]
 
@@ -76,7 +77,8 @@ class Metrics:
     """Figures of merit of a run (:meth:`SimulationResult.metrics`); :meth:`to_dict` is the
     content of ``metrics.json``. Joint quantities are per joint, in rad, rad/s, rad/s^2 (m, m/s,
     m/s^2 for prismatic joints); ``*_over_limit`` are ratios to the planner's promised limits (the
-    effort limit for torques); ``failure`` is the failure's message (None on success); the final
+    effort limit for torques); ``failure`` is the failure's message and ``failure_cause`` its
+    :class:`~drake_traj.errors.Cause` value ("stall", "timeout", ...; both None on success); the final
     errors are those of the measured tool pose at the end of the log against the task's goal (the
     reference's last pose where the task is given in joint space), the orientation error the angle
     of R_goalᵀ R."""
@@ -84,6 +86,7 @@ class Metrics:
     name: str
     succeeded: bool
     failure: str | None
+    failure_cause: str | None
     duration_s: float
     samples: int
     log_period_s: float | None
@@ -144,16 +147,16 @@ class SimulationResult:
         for name, shape in _SHAPES.items():
             array = real_array(getattr(self, name), name, "see SimulationResult")
             if array.ndim != len(shape):
-                raise ValueError(f"{name} must have {len(shape)} dimension(s) {shape}, got shape {array.shape}")
+                raise invalid(name, f"{name} must have {len(shape)} dimension(s) {shape}, got shape {array.shape}")
             for axis, size in zip(shape, array.shape):
                 if isinstance(axis, int) and size != axis:
-                    raise ValueError(f"{name} must have shape {shape}, got shape {array.shape}")
+                    raise invalid(name, f"{name} must have shape {shape}, got shape {array.shape}")
                 if isinstance(axis, str):
                     if sizes[axis] is None:
                         sizes[axis] = size
                     elif size != sizes[axis]:
                         what = "samples (rows)" if axis == "N" else "joints"
-                        raise ValueError(f"{name} has {size} {what}, t and q_ref {sizes[axis]}: shape {array.shape}")
+                        raise invalid(name, f"{name} has {size} {what}, t and q_ref {sizes[axis]}: shape {array.shape}")
             setattr(self, name, array)
         if self.failure is not None and not isinstance(self.failure, Failure):
             raise TypeError(f"failure must be a Failure or None, got {type(self.failure).__name__}: {self.failure!r:.80}")
@@ -167,6 +170,11 @@ class SimulationResult:
         """No failure recorded and every logged value finite (:meth:`non_finite_failure`)."""
         return self.failure is None and self.non_finite_failure() is None
 
+    @property
+    def joint_names(self) -> tuple[str, ...] | None:
+        """The robot's joint names, where the robot is known (messages name joints by them)."""
+        return tuple(get_robot(self.robot).joint_names) if self.robot else None
+
     def non_finite_failure(self) -> Failure | None:
         """A :class:`Failure` (cause "non-finite") naming the first logged array and sample that
         holds NaN or an infinity; None when every logged value is finite."""
@@ -175,7 +183,7 @@ class SimulationResult:
             bad = ~np.isfinite(array)
             if bad.any():
                 row = int(np.argmax(bad.reshape(len(array), -1).any(axis=1)))
-                return Failure("non-finite", f"the log is not finite: {name}[{row}] = {array[row].tolist()} "
+                return Failure(Cause.NON_FINITE, f"the log is not finite: {name}[{row}] = {array[row].tolist()} "
                                              f"at t = {self.t[row]:.4f} s", float(self.t[row]))
         return None
 
@@ -202,14 +210,14 @@ class SimulationResult:
         if saturated.any():
             j = int(np.argmax(saturated.any(axis=0)))
             first = int(np.argmax(saturated[:, j]))
-            return Failure("saturation", f"joint {j + 1}'s torque reached its effort limit {self.effort_limit[j]:g} "
-                                         f"at t = {self.t[first]:.3f} s and stayed there "
-                                         f"{saturated[:, j].sum() * self.log_period:.3f} s in all: the arm could not "
-                                         "follow the reference", float(self.t[first]), tuple(self.q_meas[first]))
+            return Failure(Cause.SATURATION, f"{joint_label(j, self.joint_names)}'s torque reached its effort limit "
+                                             f"{self.effort_limit[j]:g} at t = {self.t[first]:.3f} s and stayed there "
+                                             f"{saturated[:, j].sum() * self.log_period:.3f} s in all: the arm could "
+                                             "not follow the reference", float(self.t[first]), tuple(self.q_meas[first]))
         error = np.linalg.norm(self.tcp_ref[:, :3] - self.tcp[:, :3], axis=1)
         if len(error) and not error.max() <= tracking_tolerance:  # NaN is not within the tolerance
             first = int(np.argmax(~(error <= tracking_tolerance)))
-            return Failure("tracking", f"the TCP was {1e3 * error.max():.3f} mm from the reference (tolerance "
+            return Failure(Cause.TRACKING, f"the TCP was {1e3 * error.max():.3f} mm from the reference (tolerance "
                                        f"{1e3 * tracking_tolerance:g} mm), first over it at t = {self.t[first]:.3f} s",
                            float(self.t[first]), tuple(self.q_meas[first]))
         return None
@@ -233,6 +241,7 @@ class SimulationResult:
             name=self.name,
             succeeded=failure is None,
             failure=None if failure is None else failure.message,
+            failure_cause=None if failure is None else failure.cause.value,
             duration_s=self.duration,
             samples=int(len(self.t)),
             log_period_s=self.log_period or None,

@@ -1,11 +1,19 @@
-"""Typed scenarios, loaded from YAML with pydrake's ``yaml_load_typed`` (files in ``diagrams/``).
+"""Scenarios: the typed description of a run, loaded from YAML with pydrake's ``yaml_load_typed``
+(files in ``diagrams/``), and the types it is made of.
 
 A scenario names the robot, its start configuration, the planner and its parameters (one of the
 planners' config dataclasses, chosen by a YAML tag such as ``planner: !PajakConfig``), the PD
-controller and the simulation settings. A file holds either one scenario or several named
-variants (top-level keys; keys starting with ``_`` hold shared YAML anchors and are not variants).
-Unknown keys, wrong lengths and non-finite or out-of-range numbers raise ValueError naming the
-file and the field.
+controller (:class:`ControllerGains`), a speed-override profile (:class:`SpeedOverride`) and the
+simulation settings (Drake's ``MultibodyPlantConfig`` and ``SimulatorConfig``). A file holds
+either one scenario or several named variants (top-level keys; keys starting with ``_`` hold
+shared YAML anchors and are not variants). Unknown keys, wrong lengths and non-finite or
+out-of-range numbers raise :class:`ScenarioError` naming the file, the line and the field (its
+``field`` attribute holds the field's path).
+
+:func:`load_scenario` takes a file or a shipped scenario's name, as ``drake-traj run`` does;
+:func:`make_planner` builds its planner and :func:`preflight` checks the whole task before the
+motion, both with errors located in the file. The station (``drake_traj.station``) is built from
+these types.
 """
 
 from dataclasses import dataclass, field, fields
@@ -19,19 +27,21 @@ from pydrake.common.yaml import yaml_load_typed
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
+from pydrake.trajectories import PiecewisePolynomial
 
-from drake_traj.station import ControllerGains, SpeedOverride, default_plant_config, default_simulator_config
 from drake_traj.data import data_directory
+from drake_traj.errors import Cause, DrakeTrajError, Field, field_text, joint_label
 from drake_traj.planners import PLANNER_CONFIGS, PlannerConfig, PlannerSystem, QuinticConfig
 from drake_traj.planners import make_planner as make_planner_from_config
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE
-from drake_traj.robots import get_robot
-from drake_traj.validation import instance_of, log_period_check, path_argument, real_array
+from drake_traj.robots import Robot, get_robot
+from drake_traj.validation import flag, instance_of, invalid, log_period_check, path_argument, real_array
 from drake_traj.yaml_schema import ScenarioError, checked_document, locate
 
 __all__ = [
-    "Scenario", "ScenarioError", "ShippedScenario", "default_scenario_path", "find_scenario", "load_scenario",
-    "locate_in_scenario", "make_planner", "scenario_variants", "shipped_scenarios",
+    "ControllerGains", "Scenario", "ScenarioError", "ScenarioSource", "ShippedScenario", "SpeedOverride",
+    "default_plant_config", "default_scenario_path", "default_simulator_config", "find_scenario", "load_scenario",
+    "locate_in_scenario", "make_planner", "preflight", "scenario_variants", "shipped_scenarios",
 ]
 
 DEFAULT_SCENARIO = ("pajak.yaml", "sim3")  # what ``drake-traj run`` runs when given no scenario
@@ -39,6 +49,89 @@ _PLAIN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}")
 # The coarsest plant step and log period a run is checked with [s]: the UR controller runs at
 # 2 ms, and the limits and the continuity of q̈ are checked at the logged samples.
 MAX_TIME_STEP = MAX_LOG_PERIOD = 0.01
+
+
+def default_plant_config() -> MultibodyPlantConfig:
+    """The plant we simulate: discrete at 1 ms, SAP (implicit PD actuators)."""
+    return MultibodyPlantConfig(time_step=1e-3, discrete_contact_approximation="sap")
+
+
+def default_simulator_config() -> SimulatorConfig:
+    """Fixed-step second-order Runge-Kutta at 1 ms for the planner's continuous reference.
+
+    Chosen by measurement (README "Speed"): it evaluates the planner twice per millisecond (the
+    error-controlled default RK3 3.75-4.2 times), keeps every Table 2 duration of Pająk 2024 to the
+    millisecond and the reference within 2e-6 rad of RK3 at accuracy 1e-8; semi-explicit Euler
+    (one evaluation) moved sim 3's T by 5 ms and the reference by 2.3e-4 rad.
+    """
+    return SimulatorConfig(integration_scheme="runge_kutta2", max_step_size=1e-3, use_error_control=False)
+
+
+@dataclass
+class ControllerGains:
+    """PD gains of the simulated joint controller and the feed-forward choice.
+
+    Empty ``kp`` / ``kd`` take the robot's defaults (:attr:`Robot.default_gains`).
+    """
+
+    kp: list[float] = field(default_factory=list)
+    kd: list[float] = field(default_factory=list)
+    feedforward_acceleration: bool = True
+
+    _UNITS = {"kp": "N m/rad or N/m", "kd": "N m s/rad or N s/m"}
+
+    def for_robot(self, robot: Robot) -> "ControllerGains":
+        """These gains with empty lists filled from ``robot``'s defaults, validated for its joint count."""
+        given = {name: real_array(getattr(self, name), f"controller.{name}", unit).tolist()
+                 for name, unit in self._UNITS.items()}
+        kp, kd = (given[name] if np.size(given[name]) else list(default)
+                  for name, default in zip(("kp", "kd"), robot.default_gains))
+        gains = ControllerGains(kp, kd, self.feedforward_acceleration)
+        gains.validate(robot.num_joints)
+        return gains
+
+    def validate(self, num_joints: int) -> None:
+        """Raise ValueError naming the gain that is not numbers, of the wrong length, non-finite or
+        negative, or a feed-forward choice that is not True or False."""
+        flag(self.feedforward_acceleration, "controller.feedforward_acceleration")
+        for name, unit in self._UNITS.items():
+            gains = real_array(getattr(self, name), f"controller.{name}", unit)
+            if gains.shape != (num_joints,):
+                raise invalid(f"controller.{name}", f"controller.{name} must have {num_joints} entries, got shape {gains.shape}")
+            if not np.all(np.isfinite(gains)) or np.any(gains < 0):
+                raise invalid(f"controller.{name}", f"controller.{name} must be finite and non-negative, got {gains.tolist()}")
+        if not np.all(np.asarray(self.kp) > 0):
+            raise invalid("controller.kp", f"controller.kp must be positive, got {self.kp}")
+
+
+@dataclass
+class SpeedOverride:
+    """A speed-override profile, like a UR pendant's speed slider: ``values[k]`` in [0, 1] from
+    ``times[k]`` [s] on (held until the next time), 1 before the first time. Empty: no override.
+    """
+
+    times: list[float] = field(default_factory=list)
+    values: list[float] = field(default_factory=list)
+
+    def validate(self) -> None:
+        """Raise ValueError naming the field that is malformed."""
+        times, values = real_array(self.times, "speed_override.times", "s"), real_array(self.values, "speed_override.values", "-")
+        if times.shape != values.shape or times.ndim != 1:
+            raise invalid("speed_override.values", f"speed_override.times and speed_override.values must be two lists of equal length, "
+                             f"got {len(self.times)} and {len(self.values)} entries")
+        if not np.all(np.isfinite(times)) or np.any(times < 0) or np.any(np.diff(times) <= 0):
+            raise invalid("speed_override.times", f"speed_override.times must be finite, >= 0 and increasing [s], got {self.times}")
+        if not np.all(np.isfinite(values)) or np.any((values < 0) | (values > 1)):
+            raise invalid("speed_override.values", f"speed_override.values must be in [0, 1], got {self.values}")
+
+    def trajectory(self) -> PiecewisePolynomial:
+        """The profile as a zero-order hold (1 before the first time)."""
+        self.validate()
+        breaks = [0.0] + [t for t in self.times if t > 0.0]
+        values = ([1.0] if self.times[0] > 0.0 else []) + list(self.values)
+        breaks.append(breaks[-1] + 1.0)  # a zero-order hold ignores its last sample: repeat the last value
+        values.append(values[-1])
+        return PiecewisePolynomial.ZeroOrderHold(breaks, np.array([values]))
 
 
 @dataclass
@@ -83,6 +176,10 @@ class Scenario:
     settle_time: float = 0.5
     max_duration: float = 120.0
 
+    def __post_init__(self) -> None:
+        # where the scenario was read from (set by load_scenario; not a YAML field): locates errors
+        self.source: ScenarioSource | None = None
+
     def start_configuration(self) -> np.ndarray:
         """``q_initial``, or the robot's home configuration when it is empty."""
         q = real_array(self.q_initial, "q_initial", "rad or m")
@@ -92,52 +189,51 @@ class Scenario:
         """Raise ValueError naming the first field that is malformed (the message starts with
         the field's path)."""
         if not _PLAIN_NAME.fullmatch(self.name) or ".." in self.name:
-            raise ValueError(f"name must be a plain name (letters, digits, _ . -; no path; at most 100 characters), "
+            raise invalid("name", f"name must be a plain name (letters, digits, _ . -; no path; at most 100 characters), "
                              f"got {self.name[:120]!r}: it names the default output folder out/<name>")
         try:
             robot = get_robot(self.robot)
         except ValueError as error:
-            raise ValueError(f"robot: {error}") from None
+            raise invalid("robot", f"robot: {error}") from None
         n = robot.num_joints
         q = self.start_configuration()
         if q.shape != (n,):
-            raise ValueError(f"q_initial must have {n} entries for robot {robot.name}, got shape {q.shape}")
+            raise invalid("q_initial", f"q_initial must have {n} entries for robot {robot.name}, got shape {q.shape}")
         if not np.all(np.isfinite(q)):
-            raise ValueError(f"q_initial must be finite, got {self.q_initial}")
+            raise invalid("q_initial", f"q_initial must be finite, got {self.q_initial}")
         lower, upper = robot.lower_limits, robot.upper_limits
         outside = np.flatnonzero((q < lower) | (q > upper))
         if len(outside):
             j = outside[0]
             unit = robot.joint_unit(j)
-            raise ValueError(
-                f"q_initial[{j}] = {q[j]} {unit} is outside the joint range [{lower[j]:.6f}, {upper[j]:.6f}] {unit}"
-            )
+            raise invalid("q_initial", f"q_initial[{j}] = {q[j]} {unit} is outside the joint range "
+                                       f"[{lower[j]:.6f}, {upper[j]:.6f}] {unit} of {joint_label(j, robot.joint_names)}", j)
         for label, value in (("plant.time_step", self.plant.time_step), ("log_period", self.logging_period()),
                              ("max_duration", self.max_duration), ("settle_time", self.settle_time),
                              ("simulator.max_step_size", self.simulator.max_step_size),
                              ("tracking_tolerance", self.tracking_tolerance)):
             smallest_allowed = 0.0 if label == "settle_time" else np.nextafter(0.0, 1.0)
             if isinstance(value, bool) or not isinstance(value, numbers.Real):
-                raise ValueError(f"{label} must be a number, got {type(value).__name__} {value!r:.40}")
+                raise invalid(label, f"{label} must be a number, got {type(value).__name__} {value!r:.40}")
             if not np.isfinite(value) or value < smallest_allowed:
                 unit = "metres" if label == "tracking_tolerance" else "seconds"
-                raise ValueError(f"{label} must be a finite, positive number of {unit}, got {value}")
+                raise invalid(label, f"{label} must be a finite, positive number of {unit}, got {value}")
         for label, value, largest in (("plant.time_step", self.plant.time_step, MAX_TIME_STEP),
                                       ("log_period", self.logging_period(), MAX_LOG_PERIOD)):
             if value > largest:
-                raise ValueError(f"{label} must be at most {largest:g} s (the UR controller's cycle is 0.002 s, and "
+                raise invalid(label, f"{label} must be at most {largest:g} s (the UR controller's cycle is 0.002 s, and "
                                  f"limits are checked at the logged samples), got {value:g} s")
         log_period_check(self.logging_period(), self.plant.time_step)
         if self.logging_period() > self.max_duration:
-            raise ValueError(f"max_duration ({self.max_duration:g} s) must be longer than log_period "
+            raise invalid("max_duration", f"max_duration ({self.max_duration:g} s) must be longer than log_period "
                              f"({self.logging_period():g} s): the run would log one sample")
         if self.simulator.integration_scheme not in GetIntegrationSchemes():
-            raise ValueError(f"simulator.integration_scheme must be one of {GetIntegrationSchemes()}, "
+            raise invalid("simulator.integration_scheme", f"simulator.integration_scheme must be one of {GetIntegrationSchemes()}, "
                              f"got {self.simulator.integration_scheme!r}")
         try:  # Drake checks the plant's options (contact model, approximation, ...) when it adds the plant
             AddMultibodyPlant(self.plant, DiagramBuilder())
         except RuntimeError as error:
-            raise ValueError(f"plant: {error}") from None
+            raise invalid("plant", f"plant: {error}") from None
         self.controller.for_robot(robot)
         self.speed_override.validate()
 
@@ -150,6 +246,16 @@ class Scenario:
     def logging_period(self) -> float:
         """``log_period``, or the plant's time step where it is 0 [s]."""
         return self.log_period if self.log_period != 0 else self.plant.time_step
+
+
+@dataclass(frozen=True)
+class ScenarioSource:
+    """Where a :class:`Scenario` was read from: its file, variant (None for a file of one
+    scenario) and the YAML node of each field path, for locating later errors."""
+
+    path: Path
+    variant: str | None
+    marks: dict
 
 
 def shipped_directory() -> Path:
@@ -207,7 +313,7 @@ def _find_scenario(path: Path, reference: str, variant: str | None) -> tuple[Pat
     if path.is_dir() and not (bare_name and _is_shipped_name(reference)):
         raise ScenarioError(f"scenario file {path} is a folder, not a scenario file")
     if not bare_name:
-        raise ValueError(f"scenario file {path} not found")
+        raise ScenarioError(f"scenario file {path} not found")
     shipped = shipped_scenarios()
     for entry in shipped:
         if entry.name == reference and variant in (None, entry.variant):
@@ -216,7 +322,7 @@ def _find_scenario(path: Path, reference: str, variant: str | None) -> tuple[Pat
     if stem.is_file():
         return stem, variant
     names = ", ".join(entry.name for entry in shipped)
-    raise ValueError(f"no scenario file {reference!r} and no shipped scenario of that name; "
+    raise ScenarioError(f"no scenario file {reference!r} and no shipped scenario of that name; "
                      f"shipped: {names} (drake-traj list)")
 
 
@@ -231,18 +337,19 @@ def scenario_variants(path) -> list[str]:
     return list(checked_document(Path(path), Scenario)[1])
 
 
-def load_scenario(path, variant: str | None = None) -> Scenario:
-    """Read and validate a scenario YAML file (``variant``: the named child of a file of
-    variants; it may be left out when the file is one scenario or has a single variant).
+def load_scenario(name_or_path, variant: str | None = None) -> Scenario:
+    """Read and validate a scenario: a YAML file, or the name of a shipped scenario
+    (``"quintic_ptp"``, ``"pajak_sim3"``) or of a shipped file (``"pajak"``, with ``variant``),
+    as ``drake-traj run`` takes it (:func:`find_scenario`). ``variant``: the named child of a file
+    of variants; it may be left out when the file is one scenario or has a single variant.
 
-    Raises :class:`ScenarioError` (a ValueError) naming the file, the line and the field.
+    Raises :class:`ScenarioError` (a ValueError) naming the file, the line and the field (its
+    ``field`` attribute holds the field's path).
     """
-    path = path_argument(path, "path")
+    reference = path_argument(name_or_path, "name_or_path")
     if variant is not None:
         instance_of(variant, str, "variant")
-    if not path.is_file():
-        what = "is a folder, not a scenario file" if path.is_dir() else "not found"
-        raise ScenarioError(f"scenario file {path} {what}")
+    path, variant = find_scenario(str(reference), variant)
     root, variants, check = checked_document(path, Scenario)
     if variants:
         if variant is None and len(variants) == 1:
@@ -262,14 +369,16 @@ def load_scenario(path, variant: str | None = None) -> Scenario:
     try:
         scenario.validate()
     except ValueError as error:
-        raise ScenarioError(locate(marks, path, str(error))) from None
-    scenario.source = (path, marks)  # for later messages (make_planner); not a YAML field
+        field = error.field if isinstance(error, DrakeTrajError) else ()
+        raise ScenarioError(locate(marks, path, field, str(error)), field=field) from None
+    scenario.source = ScenarioSource(path, variant, marks)
     return scenario
 
 
 def make_planner(scenario: Scenario, *others) -> PlannerSystem:
     """The planner system the scenario describes, its limits checked against the robot's rated
-    joint speeds (errors name the scenario and the ``planner`` field).
+    joint speeds (errors name the scenario and the ``planner`` field; their ``field`` starts
+    with ``"planner"``).
 
     This is ``drake_traj.make_planner``; a planner from a planner config (``QuinticConfig``, ...)
     is :func:`drake_traj.planners.make_planner` ``(config, robot, q_initial)`` (given a config or
@@ -280,29 +389,54 @@ def make_planner(scenario: Scenario, *others) -> PlannerSystem:
         raise TypeError(f"scenario must be a Scenario, got {type(scenario).__name__}{more}: drake_traj.make_planner(scenario) "
                         "makes a scenario's planner; make one from a planner config with "
                         "drake_traj.planners.make_planner(config, robot, q_initial)")
-    instance_of(scenario, Scenario, "scenario", hint=" (load one with drake_traj.load_scenario(path, variant))")
+    instance_of(scenario, Scenario, "scenario", hint=" (load one with drake_traj.load_scenario(name_or_path, variant))")
     robot = get_robot(scenario.robot)
     q_initial = scenario.start_configuration()  # its errors name q_initial, not the planner
     try:
         planner = make_planner_from_config(scenario.planner, robot, q_initial)
     except ValueError as error:
-        first_word = re.match(r"[A-Za-z_]\w*", str(error))
-        field = first_word is not None and first_word.group(0) in {item.name for item in fields(scenario.planner)}
-        raise type(error)(locate_in_scenario(scenario, f"planner{'.' if field else ': '}{error}")) from error
+        raise _in_planner_field(scenario, error) from error
     velocity = np.broadcast_to(planner.velocity_limit, (robot.num_joints,))
     above = np.flatnonzero(velocity > robot.velocity_limits * (1 + 1e-9))
     if len(above):
         j = int(above[0])
         unit = robot.joint_unit(j)
-        raise ValueError(locate_in_scenario(scenario,
+        field = ("planner", "velocity_limit", j)
+        raise DrakeTrajError(locate_in_scenario(scenario, field,
             f"planner.velocity_limit[{j}] = {velocity[j]:g} {unit}/s is above the rated "
-            f"speed of the {robot.name}'s joint {j + 1} ({robot.joint_names[j]}), {robot.velocity_limits[j]:g} {unit}/s: "
-            "the arm could not follow"))
+            f"speed of the {robot.name}'s {joint_label(j, robot.joint_names)}, {robot.velocity_limits[j]:g} {unit}/s: "
+            "the arm could not follow"), field=field, cause=Cause.INFEASIBLE)
     return planner
 
 
-def locate_in_scenario(scenario: Scenario, message: str) -> str:
-    """``message`` located in the scenario's file (and the line of the field it starts with, e.g.
-    ``planner.waypoints[1]: ...``) when it was loaded from one."""
-    source = getattr(scenario, "source", None)
-    return locate(source[1], source[0], message) if source else f"scenario {scenario.name!r}: {message}"
+def preflight(scenario: Scenario, planner: PlannerSystem) -> np.ndarray | None:
+    """``planner.preflight()`` (the whole task checked before t = 0), its errors located in the
+    scenario as :func:`make_planner`'s are (e.g. at ``planner.waypoints[2]``'s line).
+
+    Returns the planned tool path [m], shape (N, 3) in the base frame, where the planner
+    computes one, else None."""
+    try:
+        return planner.preflight()
+    except ValueError as error:
+        raise _in_planner_field(scenario, error) from error
+
+
+def _in_planner_field(scenario: Scenario, error: ValueError) -> DrakeTrajError:
+    """``error`` from the scenario's planner, located at the planner field it names (a field of
+    the planner's config) or at ``planner``."""
+    if not isinstance(error, DrakeTrajError):
+        error = DrakeTrajError(str(error))
+    inside = bool(error.field) and error.field[0] in {item.name for item in fields(scenario.planner)}
+    field = ("planner",) + (error.field if inside else ())
+    # a message that begins with its field's name ("waypoints[2] must ...") is continued from it
+    named = inside and str(error).startswith(field_text(error.field))
+    text = f"planner.{error}" if named else f"{field_text(field)}: {error}"
+    return error.relocated(field, locate_in_scenario(scenario, field, text))
+
+
+def locate_in_scenario(scenario: Scenario, field: Field, message: str) -> str:
+    """``message`` located in the scenario's file at the line of ``field`` (a path such as
+    ``("planner", "waypoints", 1)``) when it was loaded from one, else naming the scenario."""
+    if scenario.source is None:
+        return f"scenario {scenario.name!r}: {message}"
+    return locate(scenario.source.marks, scenario.source.path, field, message)

@@ -44,7 +44,7 @@ tcp_pose               6       the measured tool pose [x, y, z, φ_X, φ_Y, φ_Z
 
 import os
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from pydrake.geometry import (
@@ -66,110 +66,28 @@ from pydrake.systems.primitives import (
     Multiplexer,
     TrajectorySource,
 )
-from pydrake.trajectories import PiecewisePolynomial
 
-from drake_traj.errors import Failure
+from drake_traj.errors import Cause, Failure
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
-from drake_traj.robots import UR10E, Robot
+from drake_traj.robots import UR10E, Robot, get_robot
+from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, default_plant_config,
+                                 default_simulator_config, make_planner)
+from drake_traj.scenario import preflight as scenario_preflight
 from drake_traj.validation import (
     callable_or_none,
     flag,
     instance_of,
+    invalid,
     log_period_check,
     nonnegative_scalar,
     positive_scalar,
-    real_array,
     real_scalar,
 )
 
 __all__ = [
-    "ControllerGains", "SpeedOverride", "Station", "add_speed_override", "add_station", "build_station",
-    "default_plant_config", "default_simulator_config", "make_station", "run_station", "simulate",
+    "Station", "add_speed_override", "add_station", "build_station", "make_station", "run_station", "simulate",
 ]
-
-
-def default_plant_config() -> MultibodyPlantConfig:
-    """The plant we simulate: discrete at 1 ms, SAP (implicit PD actuators)."""
-    return MultibodyPlantConfig(time_step=1e-3, discrete_contact_approximation="sap")
-
-
-def default_simulator_config() -> SimulatorConfig:
-    """Fixed-step second-order Runge-Kutta at 1 ms for the planner's continuous reference.
-
-    Chosen by measurement (README "Speed"): it evaluates the planner twice per millisecond (the
-    error-controlled default RK3 3.75-4.2 times), keeps every Table 2 duration of Pająk 2024 to the
-    millisecond and the reference within 2e-6 rad of RK3 at accuracy 1e-8; semi-explicit Euler
-    (one evaluation) moved sim 3's T by 5 ms and the reference by 2.3e-4 rad.
-    """
-    return SimulatorConfig(integration_scheme="runge_kutta2", max_step_size=1e-3, use_error_control=False)
-
-
-@dataclass
-class ControllerGains:
-    """PD gains of the simulated joint controller and the feed-forward choice.
-
-    Empty ``kp`` / ``kd`` take the robot's defaults (:attr:`Robot.default_gains`).
-    """
-
-    kp: list[float] = field(default_factory=list)
-    kd: list[float] = field(default_factory=list)
-    feedforward_acceleration: bool = True
-
-    _UNITS = {"kp": "N m/rad or N/m", "kd": "N m s/rad or N s/m"}
-
-    def for_robot(self, robot: Robot) -> "ControllerGains":
-        """These gains with empty lists filled from ``robot``'s defaults, validated for its joint count."""
-        given = {name: real_array(getattr(self, name), f"controller.{name}", unit).tolist()
-                 for name, unit in self._UNITS.items()}
-        kp, kd = (given[name] if np.size(given[name]) else list(default)
-                  for name, default in zip(("kp", "kd"), robot.default_gains))
-        gains = ControllerGains(kp, kd, self.feedforward_acceleration)
-        gains.validate(robot.num_joints)
-        return gains
-
-    def validate(self, num_joints: int) -> None:
-        """Raise ValueError naming the gain that is not numbers, of the wrong length, non-finite or
-        negative, or a feed-forward choice that is not True or False."""
-        flag(self.feedforward_acceleration, "controller.feedforward_acceleration")
-        for name, unit in self._UNITS.items():
-            gains = real_array(getattr(self, name), f"controller.{name}", unit)
-            if gains.shape != (num_joints,):
-                raise ValueError(f"controller.{name} must have {num_joints} entries, got shape {gains.shape}")
-            if not np.all(np.isfinite(gains)) or np.any(gains < 0):
-                raise ValueError(f"controller.{name} must be finite and non-negative, got {gains.tolist()}")
-        if not np.all(np.asarray(self.kp) > 0):
-            raise ValueError(f"controller.kp must be positive, got {self.kp}")
-
-
-@dataclass
-class SpeedOverride:
-    """A speed-override profile, like a UR pendant's speed slider: ``values[k]`` in [0, 1] from
-    ``times[k]`` [s] on (held until the next time), 1 before the first time. Empty: no override.
-    """
-
-    times: list[float] = field(default_factory=list)
-    values: list[float] = field(default_factory=list)
-
-    def validate(self) -> None:
-        """Raise ValueError naming the field that is malformed."""
-        times, values = real_array(self.times, "speed_override.times", "s"), real_array(self.values, "speed_override.values", "-")
-        if times.shape != values.shape or times.ndim != 1:
-            raise ValueError(f"speed_override.times and speed_override.values must be two lists of equal length, "
-                             f"got {len(self.times)} and {len(self.values)} entries")
-        if not np.all(np.isfinite(times)) or np.any(times < 0) or np.any(np.diff(times) <= 0):
-            raise ValueError(f"speed_override.times must be finite, >= 0 and increasing [s], got {self.times}")
-        if not np.all(np.isfinite(values)) or np.any((values < 0) | (values > 1)):
-            raise ValueError(f"speed_override.values must be in [0, 1], got {self.values}")
-
-    def trajectory(self) -> PiecewisePolynomial:
-        """The profile as a zero-order hold (1 before the first time)."""
-        self.validate()
-        breaks = [0.0] + [t for t in self.times if t > 0.0]
-        values = ([1.0] if self.times[0] > 0.0 else []) + list(self.values)
-        breaks.append(breaks[-1] + 1.0)  # a zero-order hold ignores its last sample: repeat the last value
-        values.append(values[-1])
-        return PiecewisePolynomial.ZeroOrderHold(breaks, np.array([values]))
 
 
 def speed_override_source(speed_override) -> LeafSystem | None:
@@ -181,7 +99,7 @@ def speed_override_source(speed_override) -> LeafSystem | None:
         return TrajectorySource(speed_override.trajectory())
     value = real_scalar(speed_override, "speed_override", "a constant in [0, 1] or a SpeedOverride")
     if not 0.0 <= value <= 1.0:
-        raise ValueError(f"speed_override must be in [0, 1], got {speed_override}")
+        raise invalid("speed_override", f"speed_override must be in [0, 1], got {speed_override}")
     return ConstantVectorSource([value])
 
 
@@ -249,7 +167,7 @@ def add_station(
     """
     instance_of(planner, PlannerSystem, "planner")
     if planner.GetSystemPathname().count("::") > 1:  # "::parent::planner" once built into a diagram
-        raise ValueError(f"planner is already part of a diagram ({planner.GetSystemPathname()}): a planner system "
+        raise invalid("planner", f"planner is already part of a diagram ({planner.GetSystemPathname()}): a planner system "
                          "can be used in one diagram (one run) only; make a new one for this run (make_planner again)")
     instance_of(robot, Robot, "robot")
     if meshcat is not None:
@@ -259,7 +177,7 @@ def add_station(
     plant_config = instance_of(plant_config or default_plant_config(), MultibodyPlantConfig, "plant_config")
     n = robot.num_joints
     if planner.num_joints != n:
-        raise ValueError(f"the planner has {planner.num_joints} joints, robot {robot.name} has {n}")
+        raise invalid("robot", f"the planner has {planner.num_joints} joints, robot {robot.name} has {n}")
     time_step = positive_scalar(plant_config.time_step, "plant.time_step", "s")
     log_period = positive_scalar(log_period, "log_period", "s")
     log_period_check(log_period, time_step)
@@ -339,16 +257,19 @@ def build_station(planner: PlannerSystem, **kwargs) -> Diagram:
     return station
 
 
-def make_station(scenario, meshcat: Meshcat | None = None) -> Diagram:
+def make_station(scenario: Scenario, meshcat: Meshcat | None = None) -> Diagram:
     """The station of a :class:`~drake_traj.scenario.Scenario`: its planner, robot, gains, plant
-    configuration and log period. Simulate it with ``ApplySimulatorConfig(scenario.simulator,
-    simulator)`` (the scenario's integration scheme, step and accuracy).
+    configuration and log period (the preflight is :func:`simulate`'s, or
+    :func:`drake_traj.scenario.preflight`).
 
-    ``scenario`` is a Scenario object, not a file or a name: load one with
-    :func:`~drake_traj.scenario.load_scenario` (TypeError otherwise)."""
-    if not callable(getattr(scenario, "station_arguments", None)):  # a Scenario (the scenario module imports this one)
-        hint = " (load one with drake_traj.load_scenario(path, variant))" if isinstance(scenario, (str, os.PathLike)) else ""
-        raise TypeError(f"scenario must be a Scenario, got {type(scenario).__name__}: {scenario!r:.80}{hint}")
+    Simulate it with ``ApplySimulatorConfig(scenario.simulator, simulator)``: a Diagram cannot
+    carry its integrator, and a plain ``Simulator`` uses Drake's default (error-controlled RK3),
+    not the scenario's (the reference then differs by about 1e-7 rad).
+
+    TypeError unless ``scenario`` is a Scenario (load one from a file or a shipped name with
+    :func:`~drake_traj.scenario.load_scenario`)."""
+    hint = " (load one with drake_traj.load_scenario(name_or_path, variant))"
+    instance_of(scenario, Scenario, "scenario", hint=hint if isinstance(scenario, (str, os.PathLike)) else "")
     from_scenario = scenario.station_arguments()
     return build_station(from_scenario.pop("planner"), meshcat=meshcat, **from_scenario)
 
@@ -379,33 +300,44 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
             if np.isfinite(finish):
                 simulator.AdvanceTo(min(max(finish + settle_time, root.get_time()), max_duration))
                 return None
-        return Failure("timeout", f"planner did not finish within max_duration = {max_duration} s", root.get_time(),
+        return Failure(Cause.TIMEOUT, f"planner did not finish within max_duration = {max_duration} s", root.get_time(),
                        tuple(planner.reference_state(planner_context)[: planner.num_joints].tolist()))
     except KeyboardInterrupt:
-        return Failure("interrupted", f"interrupted at t = {root.get_time():.4f} s", root.get_time())
+        return Failure(Cause.INTERRUPTED, f"interrupted at t = {root.get_time():.4f} s", root.get_time())
     except Exception as error:  # keep the log up to the failure; the reason goes in the result
         return Failure.from_exception(error, root.get_time())
 
 
+_SCENARIO_S = object()  # an argument left to the scenario (or, for a planner, to its default)
+
+
 def simulate(
-    planner: PlannerSystem,
+    planner: PlannerSystem | Scenario,
     *,
-    name: str = "run",
-    robot: Robot = UR10E,
+    name: str = _SCENARIO_S,
+    robot: Robot = _SCENARIO_S,
     gains: ControllerGains | None = None,
     plant_config: MultibodyPlantConfig | None = None,
     simulator_config: SimulatorConfig | None = None,
-    log_period: float = 1e-3,
-    settle_time: float = 0.5,
-    max_duration: float = 120.0,
-    speed_override=None,
+    log_period: float = _SCENARIO_S,
+    settle_time: float = _SCENARIO_S,
+    max_duration: float = _SCENARIO_S,
+    speed_override=_SCENARIO_S,
     meshcat: Meshcat | None = None,
     progress=None,
     add_systems=None,
     before_run=None,
-    tracking_tolerance: float | None = DEFAULT_TRACKING_TOLERANCE,
+    tracking_tolerance: float | None = _SCENARIO_S,
+    preflight: bool = True,
 ) -> SimulationResult:
-    """Run ``planner`` in a station until it finishes, plus ``settle_time`` [s].
+    """Run a planner, or a scenario's, in a station until it finishes, plus ``settle_time`` [s].
+
+    Given a :class:`~drake_traj.scenario.Scenario` (``simulate(load_scenario("quintic_ptp"))``),
+    this is ``drake-traj run`` without the files: the scenario's planner, robot, gains, plant,
+    log period, integrator, speed override, tolerance and times, each replaced by an argument
+    given here (except ``robot``: the scenario names its own). Given a planner system, the
+    defaults are the UR10e, the robot's gains, 1 ms logs, 0.5 s settle time, 120 s at most, no
+    speed override and a 5 mm tracking tolerance.
 
     The run stops at ``max_duration`` [s] if the planner has not finished. Whatever stops the run
     early (an exception from a planner, a timeout, Ctrl-C) is caught: the result holds everything
@@ -414,7 +346,7 @@ def simulate(
 
     Args (the rest as :func:`add_station`):
         simulator_config: integration scheme, step, accuracy and real-time rate (default
-            :func:`default_simulator_config`).
+            :func:`~drake_traj.scenario.default_simulator_config`).
         speed_override: a constant in [0, 1] or a :class:`SpeedOverride` profile on the
             station's ``speed_override`` input (None: unconnected, 1).
         progress: called with the simulated time [s] as the run goes (see :func:`run_station`).
@@ -425,11 +357,33 @@ def simulate(
         tracking_tolerance: the run fails if the TCP strays further from the reference [m], or
             if a joint's torque saturates (None: no such check; see
             :meth:`SimulationResult.execution_failure`).
+        preflight: check the whole task before the motion, as ``drake-traj run`` does
+            (:meth:`PlannerSystem.preflight`: a :class:`~drake_traj.errors.PlanningError` is
+            raised before the run, not recorded as a failed run; False: the run finds it).
 
     Every argument is checked before the run (TypeError or ValueError naming it).
     """
+    given = dict(name=name, robot=robot, log_period=log_period, settle_time=settle_time, max_duration=max_duration,
+                 speed_override=speed_override, tracking_tolerance=tracking_tolerance)
+    if isinstance(planner, Scenario):
+        scenario = planner
+        if robot is not _SCENARIO_S:
+            raise TypeError(f"robot must not be given with a scenario: scenario {scenario.name!r} names its robot "
+                            f"({scenario.robot!r})")
+        defaults = dict(name=scenario.name, robot=get_robot(scenario.robot), log_period=scenario.logging_period(),
+                        settle_time=scenario.settle_time, max_duration=scenario.max_duration,
+                        speed_override=scenario.speed_override, tracking_tolerance=scenario.tracking_tolerance)
+        gains, plant_config = gains or scenario.controller, plant_config or scenario.plant
+        simulator_config = simulator_config or scenario.simulator
+        planner = make_planner(scenario)
+    else:
+        scenario = None
+        defaults = dict(name="run", robot=UR10E, log_period=1e-3, settle_time=0.5, max_duration=120.0,
+                        speed_override=None, tracking_tolerance=DEFAULT_TRACKING_TOLERANCE)
+        instance_of(planner, PlannerSystem, "planner", hint=" or a Scenario")
+    name, robot, log_period, settle_time, max_duration, speed_override, tracking_tolerance = (
+        defaults[key] if value is _SCENARIO_S else value for key, value in given.items())
     # checked before the planner goes into a diagram (a planner is used in one diagram only)
-    instance_of(planner, PlannerSystem, "planner")
     instance_of(name, str, "name")
     if simulator_config is not None:
         instance_of(simulator_config, SimulatorConfig, "simulator_config")
@@ -441,6 +395,10 @@ def simulate(
     callable_or_none(progress, "progress", "progress(t)")
     callable_or_none(add_systems, "add_systems", "add_systems(builder, station)")
     callable_or_none(before_run, "before_run", "before_run(simulator)")
+    if flag(preflight, "preflight") and scenario is not None:
+        scenario_preflight(scenario, planner)  # its errors located in the scenario file
+    elif preflight:
+        planner.preflight()
     builder = DiagramBuilder()
     station = builder.AddSystem(build_station(planner, robot=robot, gains=gains, plant_config=plant_config,
                                               log_period=log_period, meshcat=meshcat))

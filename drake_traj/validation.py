@@ -1,13 +1,29 @@
 """Input checks shared by the package. Every error names the argument, the expected form (with
-the unit) and what was given: a ValueError for a malformed value (text, a boolean or None where a
-number is expected, a wrong shape, a number out of range), a TypeError for an object of the wrong
-type (:func:`instance_of`, :func:`path_argument`, :func:`callable_or_none`)."""
+the unit) and what was given: a :class:`~drake_traj.errors.DrakeTrajError` (a ValueError, cause
+INVALID, ``field`` the argument's path and index) for a malformed value (text, a boolean or None
+where a number is expected, a wrong shape, a number out of range), a TypeError for an object of
+the wrong type (:func:`instance_of`, :func:`path_argument`, :func:`callable_or_none`)."""
 
 import numbers
 import os
 from pathlib import Path
 
 import numpy as np
+
+from drake_traj.errors import DrakeTrajError, joint_label
+
+
+def field_of(name: str, *index: int) -> tuple:
+    """The field path of an argument named ``name`` (``"speed_override.times"`` ->
+    ``("speed_override", "times")``) followed by ``index``; empty where ``name`` is a phrase, not
+    a field (``"path parameter s"``)."""
+    parts = name.split(".")
+    return tuple(parts) + index if all(part.isidentifier() for part in parts) else ()
+
+
+def invalid(name: str, message: str, *index: int) -> DrakeTrajError:
+    """The error for the argument or field ``name`` (at ``index``): its text is ``message``."""
+    return DrakeTrajError(message, field=field_of(name, *index))
 
 
 def _first_non_number(value):
@@ -37,7 +53,7 @@ def real_array(value, name: str, unit: str, what: str = "a real number or an arr
     entries are kept."""
     found = _first_non_number(value)
     if found is not None:
-        raise ValueError(f"{name} must be {what} [{unit}], found {type(found[0]).__name__} {found[0]!r:.40}"
+        raise invalid(name, f"{name} must be {what} [{unit}], found {type(found[0]).__name__} {found[0]!r:.40}"
                          + ("" if found[0] is value else f" in {value!r:.80}"))
     try:
         return np.array(value, dtype=float)
@@ -46,19 +62,19 @@ def real_array(value, name: str, unit: str, what: str = "a real number or an arr
         if "inhomogeneous" in reason:  # a ragged list: say which row is off
             lengths = [len(row) if hasattr(row, "__len__") else 1 for row in value]
             reason = f"its rows must have the same length, got lengths {lengths}"
-        raise ValueError(f"{name} must be an array of real numbers [{unit}]: {reason}") from exc
+        raise invalid(name, f"{name} must be an array of real numbers [{unit}]: {reason}") from exc
 
 
 def real_scalar(value, name: str, unit: str, *, minimum: float = -np.inf, strict: bool = False) -> float:
     """``value`` as a finite float >= ``minimum`` (> with ``strict``), else ValueError naming ``name``."""
     array = real_array(value, name, unit, "a real number")
     if array.size != 1:
-        raise ValueError(f"{name} must be a real number [{unit}], got shape {array.shape}")
+        raise invalid(name, f"{name} must be a real number [{unit}], got shape {array.shape}")
     number = float(array.reshape(-1)[0])
     if not np.isfinite(number):
-        raise ValueError(f"{name} must be finite [{unit}], got {number}")
+        raise invalid(name, f"{name} must be finite [{unit}], got {number}")
     if number < minimum or (strict and number == minimum):
-        raise ValueError(f"{name} must be {'>' if strict else '>='} {minimum:g} [{unit}], got {number}")
+        raise invalid(name, f"{name} must be {'>' if strict else '>='} {minimum:g} [{unit}], got {number}")
     return number
 
 
@@ -76,11 +92,12 @@ def finite_array(value, name: str, unit: str, *, shape: tuple | None = None) -> 
     """``value`` as a float array (copy) of ``shape`` (any if None) with finite entries."""
     array = real_array(value, name, unit)
     if shape is not None and array.shape != shape:
-        raise ValueError(f"{name} must have shape {shape} [{unit}], got shape {array.shape}")
+        raise invalid(name, f"{name} must have shape {shape} [{unit}], got shape {array.shape}")
     if not np.all(np.isfinite(array)):
         bad = np.argwhere(~np.isfinite(np.atleast_1d(array)))[0]
         where = "" if array.ndim == 0 else "[" + ", ".join(str(int(i)) for i in bad) + "]"
-        raise ValueError(f"{name}{where} must be finite [{unit}], got {np.atleast_1d(array)[tuple(bad)]}")
+        index = [int(i) for i in bad] if array.ndim else []
+        raise invalid(name, f"{name}{where} must be finite [{unit}], got {np.atleast_1d(array)[tuple(bad)]}", *index)
     return array
 
 
@@ -90,11 +107,11 @@ def positive_vector(value, name: str, n: int) -> np.ndarray:
     if array.ndim == 0:
         array = np.full(n, float(array))
     if array.shape != (n,):
-        raise ValueError(f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
+        raise invalid(name, f"{name} must be a scalar or have shape ({n},), got shape {array.shape}")
     bad = ~np.isfinite(array) | (array <= 0.0)
     if np.any(bad):
         j = int(np.argmax(bad))
-        raise ValueError(f"{name}[{j}] (joint {j}) must be finite and > 0, got {array[j]}")
+        raise invalid(name, f"{name}[{j}] ({joint_label(j)}) must be finite and > 0, got {array[j]}", j)
     return array
 
 
@@ -102,7 +119,7 @@ def limit_or_default(value, default, name: str, n: int) -> np.ndarray:
     """A per-joint limit from a config (:func:`positive_vector`), ``default`` when it is empty."""
     if value is None or np.size(value) == 0:
         if default is None or not np.all(np.isfinite(default)):
-            raise ValueError(f"{name} must be given: the robot has no default {name.replace('_', ' ')}")
+            raise invalid(name, f"{name} must be given: the robot has no default {name.replace('_', ' ')}")
         value = default
     return positive_vector(value, name, n)
 
@@ -112,9 +129,9 @@ def whole_number(value, name: str, *, minimum: int) -> int:
     naming ``name``."""
     if (isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) or not np.isfinite(value)
             or value != int(value)):
-        raise ValueError(f"{name} must be a whole number >= {minimum}, got {value!r:.80}")
+        raise invalid(name, f"{name} must be a whole number >= {minimum}, got {value!r:.80}")
     if int(value) < minimum:
-        raise ValueError(f"{name} must be a whole number >= {minimum}, got {int(value)}")
+        raise invalid(name, f"{name} must be a whole number >= {minimum}, got {int(value)}")
     return int(value)
 
 
@@ -122,7 +139,7 @@ def flag(value, name: str) -> bool:
     """``value`` if it is True or False (a Python or NumPy bool), else ValueError naming ``name``
     (a truthy text such as 'no' is not a yes)."""
     if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name} must be True or False, got {type(value).__name__} {value!r:.80}")
+        raise invalid(name, f"{name} must be True or False, got {type(value).__name__} {value!r:.80}")
     return bool(value)
 
 
@@ -154,5 +171,5 @@ def log_period_check(log_period: float, time_step: float) -> None:
     [s] (the loggers sample the plant's steps). Both already checked positive."""
     steps = log_period / time_step
     if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
-        raise ValueError(f"log_period must be a whole multiple of plant.time_step = {time_step} s "
+        raise invalid("log_period", f"log_period must be a whole multiple of plant.time_step = {time_step} s "
                          f"(the loggers sample the plant's steps), got {log_period} s")

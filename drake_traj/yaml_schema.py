@@ -16,7 +16,7 @@ from pathlib import Path
 
 import yaml
 
-from drake_traj.errors import DrakeTrajError
+from drake_traj.errors import DrakeTrajError, Field, field_text
 
 __all__ = ["ScenarioError", "checked_document"]
 
@@ -62,13 +62,13 @@ class _Checker:
     def __init__(self, path: Path, loader: _Loader):
         self.path = path
         self.loader = loader
-        self.marks: dict[str, object] = {}  # field path -> node, for value errors found later
+        self.marks: dict[Field, object] = {}  # field path -> node, for value errors found later
 
-    def fail(self, node, field: str, message: str) -> typing.NoReturn:
+    def fail(self, node, field: Field, message: str) -> typing.NoReturn:
         where = f"{_where(self.path, node)}: " if node is not None else f"{self.path}: "
-        raise ScenarioError(f"{where}{field + ': ' if field else ''}{message}")
+        raise ScenarioError(f"{where}{field_text(field) + ': ' if field else ''}{message}", field=field)
 
-    def mapping_items(self, node, field: str):
+    def mapping_items(self, node, field: Field):
         """The (key, value) nodes of a mapping, merge keys applied, duplicate keys refused."""
         seen = {}
         for key, _ in node.value:
@@ -77,17 +77,18 @@ class _Checker:
             if key.tag == "tag:yaml.org,2002:merge":
                 continue
             if key.value in seen:
-                self.fail(key, f"{field}.{key.value}" if field else key.value,
+                self.fail(key, field + (key.value,),
                           f"duplicate key (first at line {seen[key.value].start_mark.line + 1}); "
                           "each key may appear once")
             seen[key.value] = key
         try:
             self.loader.flatten_mapping(node)
         except yaml.MarkedYAMLError as error:  # e.g. << merging a list or a scalar
-            raise ScenarioError(f"{self.path}: {field + ': ' if field else ''}{_mark_message(error)}") from None
+            raise ScenarioError(f"{self.path}: {field_text(field) + ': ' if field else ''}{_mark_message(error)}",
+                                field=field) from None
         return node.value
 
-    def check(self, node, schema, field: str) -> None:
+    def check(self, node, schema, field: Field) -> None:
         self.marks[field] = node
         if node.tag.startswith("tag:yaml.org,2002:python/"):
             self.fail(node, field, f"the tag {node.tag.split(':', 2)[-1]!r} is not allowed: scenario files hold data, "
@@ -100,7 +101,7 @@ class _Checker:
                 self.fail(node, field, f"expected a list, found {_describe(node)}")
             (item,) = typing.get_args(schema)
             for index, child in enumerate(node.value):
-                self.check(child, item, f"{field}[{index}]")
+                self.check(child, item, field + (index,))
             return None
         if _is_record(schema):
             return self.check_record(node, schema, field)
@@ -115,9 +116,9 @@ class _Checker:
             if not yaml12_number and (not isinstance(node, yaml.ScalarNode) or node.tag not in tags):
                 self.fail(node, field, f"expected {description}, found {_describe(node)}")
             return None
-        raise TypeError(f"no YAML check for the type {schema!r} of {field}")  # a schema we did not foresee
+        raise TypeError(f"no YAML check for the type {schema!r} of {field_text(field)}")  # a schema we did not foresee
 
-    def check_union(self, node, options, field: str) -> None:
+    def check_union(self, node, options, field: Field) -> None:
         names = {option.__name__: option for option in options}
         if not isinstance(node, yaml.MappingNode):
             self.fail(node, field, f"expected a mapping tagged with one of !{', !'.join(names)}, found {_describe(node)}")
@@ -126,14 +127,14 @@ class _Checker:
             keys = {key.value for key, _ in node.value}
             if not keys <= set(_fields(options[0])) | {"<<"}:
                 self.fail(node, field, f"needs a tag naming its type, one of !{', !'.join(names)} "
-                                       f"(e.g. {field}: !{options[1].__name__}); without one it is read as "
+                                       f"(e.g. {field_text(field)}: !{options[1].__name__}); without one it is read as "
                                        f"{options[0].__name__}, which has no {sorted(keys - set(_fields(options[0])))}")
             return self.check_record(node, options[0], field)
         if tag not in names:
             self.fail(node, field, f"unknown type !{tag}; expected one of !{', !'.join(names)}")
         return self.check_record(node, names[tag], field)
 
-    def check_record(self, node, schema, field: str) -> None:
+    def check_record(self, node, schema, field: Field) -> None:
         if not isinstance(node, yaml.MappingNode):
             self.fail(node, field, f"expected a mapping of {schema.__name__}'s fields, found {_describe(node)}")
         if node.tag.startswith("!") and not node.tag.startswith("!!") and node.tag[1:] != schema.__name__:
@@ -141,7 +142,7 @@ class _Checker:
                                    "(tags choose a planner's type under planner:); remove the tag")
         fields = _fields(schema)
         for key, value in self.mapping_items(node, field):
-            name = f"{field}.{key.value}" if field else key.value
+            name = field + (key.value,)
             if key.value not in fields:
                 close = [known for known in fields if known.startswith(key.value[:3])]
                 hint = f" (did you mean {close[0]!r}?)" if close else ""
@@ -187,21 +188,21 @@ def checked_document(path: Path, schema, variant_keys=None) -> tuple[object, dic
         raise ScenarioError(f"{path}: the document is nested too deeply to be a scenario") from None
     checker = _Checker(path, loader)
     if root is None:
-        checker.fail(None, "", "the file is empty; a scenario needs at least a planner (see diagrams/)")
+        checker.fail(None, (), "the file is empty; a scenario needs at least a planner (see diagrams/)")
     if not isinstance(root, yaml.MappingNode):
-        checker.fail(root, "", f"a scenario file must be a mapping of fields (or of named variants), found {_describe(root)}")
+        checker.fail(root, (), f"a scenario file must be a mapping of fields (or of named variants), found {_describe(root)}")
     fields = _fields(schema)
     for key, _ in root.value:
         if not isinstance(key, yaml.ScalarNode):
-            checker.fail(key, "", f"a key must be a plain name, found {_describe(key)}")
+            checker.fail(key, (), f"a key must be a plain name, found {_describe(key)}")
     keys = [key.value for key, _ in root.value]
     variants = {}
     if not set(keys) & set(fields):  # a file of variants: top-level keys name them
-        for key, value in checker.mapping_items(root, ""):
+        for key, value in checker.mapping_items(root, ()):
             if not key.value.startswith("_"):
                 variants[key.value] = value
 
-    def check(node, prefix: str = "") -> dict:
+    def check(node, prefix: Field = ()) -> dict:
         checker.marks = {}
         try:
             checker.check_record(node, schema, prefix)
@@ -212,11 +213,11 @@ def checked_document(path: Path, schema, variant_keys=None) -> tuple[object, dic
     return root, variants, check
 
 
-def locate(marks: dict, path: Path, message: str) -> str:
-    """``message`` prefixed with the file and the line of the field it starts with, if known."""
-    match = re.match(r"([A-Za-z_][\w.]*(?:\[\d+\])*)", message)
-    node = marks.get(match.group(1)) if match else None
-    if node is None and match:  # a field path with an index the marks hold without it
-        node = marks.get(re.sub(r"\[\d+\]$", "", match.group(1)))
+def locate(marks: dict, path: Path, field: Field, message: str) -> str:
+    """``message`` prefixed with the file and the line of ``field`` (a path such as
+    ``("planner", "waypoints", 1)``) where the marks hold it, or the list it indexes."""
+    node = marks.get(tuple(field))
+    if node is None and field and isinstance(field[-1], int):  # an entry of a list given in one line
+        node = marks.get(tuple(field[:-1]))
     where = _where(path, node) if node is not None else str(path)
     return f"{where}: {message}"

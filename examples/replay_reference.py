@@ -19,7 +19,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
 
 from drake_traj import SimulationResult, get_robot
-from drake_traj.station import default_plant_config
+from drake_traj.scenario import default_plant_config
 
 
 def replay(run_dir) -> float:

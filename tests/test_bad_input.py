@@ -42,7 +42,8 @@ from drake_traj.planners.pajak import PajakPlanner, paper_parameters
 from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
 from drake_traj.result import ResultFileError
 from drake_traj.rundir import OutputError
-from drake_traj.station import SpeedOverride, build_station
+from drake_traj.scenario import SpeedOverride
+from drake_traj.station import build_station
 
 DIAGRAMS = Path(__file__).resolve().parents[1] / "diagrams"
 QUINTIC = (DIAGRAMS / "quintic_ptp.yaml").read_text()

@@ -7,7 +7,7 @@ import pytest
 from drake_traj import BorygaConfig, LiConfig, MovejConfig, QuinticConfig, RuckigConfig, ToppraConfig, get_robot, simulate
 from drake_traj.bench import joint_waypoints, paper_task
 from drake_traj.planners import make_planner
-from drake_traj.station import SpeedOverride
+from drake_traj.scenario import SpeedOverride
 
 UR10E = get_robot("ur10e")
 JOINTS = joint_waypoints(*paper_task())

@@ -11,7 +11,8 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from drake_traj.robots import ur10e as robot
-from drake_traj.station import build_station, default_plant_config, default_simulator_config, run_station, simulate
+from drake_traj.scenario import default_plant_config, default_simulator_config
+from drake_traj.station import build_station, run_station, simulate
 from drake_traj.planners import pajak as P
 from drake_traj.planners.pajak import parameters as pajak_parameters
 from drake_traj.result import SimulationResult
