@@ -24,8 +24,8 @@ import numpy as np
 
 from drake_traj import compiled as compiled_module
 from drake_traj.compiled import compiled
-from drake_traj.planners import scaling
-from drake_traj.planners.scaling import relaxed_scaling
+from drake_traj.planners.laws import scaling
+from drake_traj.planners.laws.scaling import relaxed_scaling
 from drake_traj.robots import ur10e
 from drake_traj.robots.ur10e import kinematics_into, orientation_error, wrapped
 
