@@ -174,24 +174,16 @@ class _Rates(NamedTuple):
     scaling: float  # c
 
 
-class _Kept:
-    """A time-law planner's last rates and their key (time, clock state), per context."""
-
-    __slots__ = ("key", "rates")
-
-    def __init__(self):
-        self.key, self.rates = None, None
-
-
 class TimeLawPlanner(PlannerSystem):
     """A planner that follows a closed-form joint time law on a scaled planner clock.
 
     ``law`` is a :class:`~drake_traj.planners.laws.TimeLaw` (checked when the planner is made: a
     TypeError names what is missing): ``q_start``, ``duration``, ``acceleration_jumps``,
-    ``rates_at(tau)`` (the hot path) and ``sample(tau)``. The clock tau advances at the rate c: with c = 1 the reference is the law itself,
-    qd = q_law'(tau) c and qdd = q_law''(tau) c² + q_law'(tau) ċ. c starts at ``speed_cap`` (a
-    law that breaks the limits by a factor is slowed into them with ``speed_cap`` < 1: velocity
-    scales by c, acceleration by c²) and relaxes towards ``speed_cap`` times the
+    ``rates_at(tau)`` (the hot path) and ``sample(tau)``. The clock tau advances at the rate c:
+    with c = 1 the reference is the law itself, qd = q_law'(tau) c and
+    qdd = q_law''(tau) c² + q_law'(tau) ċ. c starts at ``speed_cap`` (a law that breaks the limits
+    by a factor is slowed into them with ``speed_cap`` < 1: velocity scales by c, acceleration by
+    c²) and relaxes towards ``speed_cap`` times the
     ``speed_override`` input in the form of eq. 18 of Pająk 2024 (at ``scaling_rate``; a speed
     slider's response, faster than the paper's 1/s), with ċ held over each ``update_period`` and
     changed by at most ``clock_jerk`` × period, so q̈ stays continuous (see
@@ -200,12 +192,13 @@ class TimeLawPlanner(PlannerSystem):
 
     The Simulator integrates the reference [q; qd] from the law's rates, q' = q_law'(tau) c and
     qd' = qdd (so q follows the law's own velocity, not the integrated one). Where the law's
-    acceleration jumps (its ``acceleration_jumps``, law times; None: anywhere), a fixed step integrates the jump with an error that would stay: the
-    update after it sets the reference back on the law, (q_law(tau), q_law'(tau) c), as does every
-    update that changes the clock, and the one that records the exact finish time (so the motion
+    acceleration jumps (its ``acceleration_jumps``, law times; None: anywhere), a fixed step
+    integrates the jump with an error that would stay: the update after it sets the reference
+    back on the law, (q_law(tau), q_law'(tau) c), as does every update that changes the clock, and the one that records the exact finish time (so the motion
     ends exactly at the law's end). While c is at its goal and nothing jumps, the update changes
     nothing. The rates depend on the time and the clock only, and the last ones are kept by that
-    key: the derivatives, both outputs and the update of one step share one law evaluation.
+    key (:meth:`_rates`): the derivatives, both outputs and the update of one step share one law
+    evaluation.
 
     Discrete state: ``clock`` = [tau, ċ, c, t0]: the law time, the clock's rate and c at the last
     update t0 (the clock's truth); ``scaling`` = [c, t0, c] (the contract's view of the same
@@ -248,11 +241,7 @@ class TimeLawPlanner(PlannerSystem):
         self.acceleration_limit = np.asarray(acceleration_limit, dtype=float)
         self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, 0.0, self.speed_cap, 0.0]))
         self.DeclarePeriodicUnrestrictedUpdateEvent(update_period, 0.0, self._update)
-        self._kept = self.DeclareCacheEntry(  # per-context scratch: the last rates and their key
-            "the law's rates on the clock, kept by (time, clock state)",
-            ValueProducer(allocate=lambda: AbstractValue.Make(_Kept()), calc=lambda context, value: None),
-            {self.nothing_ticket()},
-        )
+        self._kept = (None, None)  # (key, _Rates) of _rates: see there why not a cache entry
         jumps = law.acceleration_jumps  # law times where q_law'' jumps (None: anywhere)
         self._acceleration_jumps = None if jumps is None else sorted(np.asarray(jumps, dtype=float).tolist())
 
@@ -272,18 +261,26 @@ class TimeLawPlanner(PlannerSystem):
         They depend on the time and the clock state only, so the last ones are kept by that key.
         Per step Drake asks at t (first RK2 stage), at t + h (second stage) and for the output at
         t + h at the step's end: one law evaluation per step (counted on Li 4-DOF). The arrays are
-        read-only views of one (shared by every caller with that key)."""
-        kept = self._kept.Eval(context)
+        read-only views of one (shared by every caller with that key).
+
+        Kept on the instance, not in a Drake cache entry: the value is a function of the key alone
+        (the law does not change), so contexts with the same key may share it, and both cache
+        entries we measured cost more (planner alone under RK2 at 1 ms, medians of 5, µs per
+        step, quintic_ptp / Li 4-DOF): this memo 64 / 68; a cache entry on time and the clock
+        state 111 / 99 (Drake invalidates it at every SetTime, 3.2 law evaluations per step
+        instead of 1.1); a per-context scratch entry holding this memo 88 / 93 (its Eval from
+        Python). In the station, station / floor fell from 0.45 / 0.44 to 0.33 / 0.26 with the
+        first (examples/bench_planner_cost.py, 3-5 repeats)."""
         key = (context.get_time(), *self._clock_state(context))
-        if key != kept.key:
+        if key != self._kept[0]:
             t, tau0, c_rate, c0, t0 = key
             tau, c = clock_at(t - t0, tau0, c0, c_rate)
             qd_law, qdd_law = self.law.rates_at(tau)
             values = np.concatenate((qd_law * c, qdd_law * c**2 + qd_law * c_rate, (c,)))
             values.flags.writeable = False
             n = self.num_joints
-            kept.key, kept.rates = key, _Rates(values[: 2 * n], values[n : 2 * n], values[n:], c)
-        return kept.rates
+            self._kept = (key, _Rates(values[: 2 * n], values[n : 2 * n], values[n:], c))
+        return self._kept[1]
 
     def evaluate(self, context) -> tuple[np.ndarray, float]:
         rates = self._rates(context)
