@@ -22,7 +22,7 @@ def tool_speed_figure(planner):
     path_ax.plot(1e3 * length, 1e3 * cartesian.velocities, label="after look-ahead (Fig. 2)")
     path_ax.set_xlabel("path length [mm]")
     path_ax.set_ylabel("speed [mm/s]")
-    t, speed, acceleration = tool_speed_and_acceleration(planner.law, planner.tool_motion)
+    t, speed, acceleration = tool_speed_and_acceleration(planner.law, planner._tool_motion)
     v_max, a_max = planner.tool_limits
     speed_ax.plot(t, 1e3 * speed)
     speed_ax.axhline(1e3 * v_max, color="grey", linestyle="--")

@@ -26,13 +26,13 @@ class LiPathPlanner(TimeLawPlanner):
         instance_of(plan, LiPlan, "plan")
         super().__init__(plan.law, velocity_limit, acceleration_limit)
         self.li_plan = plan
-        self.tool_motion = tool_motion
+        self._tool_motion = tool_motion
         self.tool_limits = tool_limits
 
     def tool_statistics(self) -> dict:
         """Tool speed and acceleration peaks and the share of time above 0.5 and 0.8 a_max
         (the paper's efficiency figure), on dense samples."""
-        t, speed, acceleration = tool_speed_and_acceleration(self.law, self.tool_motion)
+        t, speed, acceleration = tool_speed_and_acceleration(self.law, self._tool_motion)
         v_max, a_max = self.tool_limits
         weights = np.gradient(t)
         return {
