@@ -173,3 +173,65 @@ def log_period_check(log_period: float, time_step: float) -> None:
     if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
         raise invalid("log_period", f"log_period must be a whole multiple of plant.time_step = {time_step} s "
                          f"(the loggers sample the plant's steps), got {log_period} s")
+
+
+def float_array(value, name: str, unit: str) -> np.ndarray:
+    """``value`` as a float array (copy) as numpy reads it (the text '1.5' is 1.5), else
+    ValueError naming ``name``; :func:`real_array` is the stricter check."""
+    try:
+        return np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be an array of real numbers [{unit}]: {exc}") from exc
+
+
+def require_finite(array: np.ndarray, name: str, unit: str = "") -> None:
+    """ValueError naming the first non-finite entry of ``array`` (its index, and ``unit`` where
+    given)."""
+    if not np.all(np.isfinite(array)):
+        bad = np.argwhere(~np.isfinite(np.atleast_1d(array)))[0]
+        where = "" if array.ndim == 0 else "[" + ", ".join(str(int(i)) for i in bad) + "]"
+        value = np.atleast_1d(array)[tuple(bad)]
+        raise ValueError(f"{name}{where} must be finite{f' [{unit}]' if unit else ''}, got {value}")
+
+
+def require_positive(array: np.ndarray, name: str) -> None:
+    """ValueError naming the first entry of ``array`` that is not > 0 (its index and joint,
+    counted from 0)."""
+    if np.any(array <= 0.0):
+        if array.ndim == 0:
+            raise ValueError(f"{name} must be > 0, got {float(array)}")
+        bad = np.argwhere(array <= 0.0)[0]
+        where = ", ".join(str(int(i)) for i in bad)
+        raise ValueError(f"{name}[{where}] (joint {where}) must be > 0, got {float(array[tuple(bad)])}")
+
+
+def joint_bound(value, name: str, num_joints: int, unit: str) -> np.ndarray:
+    """A per-joint value: a scalar (every joint) or shape (num_joints,), finite (:func:`real_array`)."""
+    array = real_array(value, name, unit)
+    if array.ndim == 0:
+        array = np.full(num_joints, float(array))
+    elif array.shape != (num_joints,):
+        raise ValueError(f"{name} must be a scalar or have shape ({num_joints},), got shape {array.shape}")
+    require_finite(array, name)
+    return array
+
+
+def joint_limit(value, name: str, num_joints: int, unit: str) -> np.ndarray:
+    """A per-joint limit: as :func:`joint_bound`, and > 0 (joints counted from 0)."""
+    array = joint_bound(value, name, num_joints, unit)
+    require_positive(array, name)
+    return array
+
+
+def joint_limit_with_unit(value, name: str, unit: str, num_joints: int) -> np.ndarray:
+    """A per-joint limit: a scalar (every joint) or shape (num_joints,), finite and > 0, read as
+    numpy reads it (:func:`float_array`); the messages give ``unit`` and count joints from 1."""
+    array = float_array(value, name, unit)
+    if array.ndim != 0 and array.shape != (num_joints,):
+        raise ValueError(f"{name} must be a scalar or have shape ({num_joints},) [{unit}], got shape {array.shape}")
+    require_finite(array, name, unit)
+    array = np.broadcast_to(array, (num_joints,)).copy()
+    if np.any(array <= 0.0):
+        j = int(np.argmax(array <= 0.0))
+        raise ValueError(f"{name}[{j}] (joint {j + 1}) must be > 0 [{unit}], got {array[j]}")
+    return array

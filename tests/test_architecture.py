@@ -92,3 +92,24 @@ def test_public_api():
         assert len(exported) == len(set(exported)), name
     assert issubclass(drake_traj.PlanningError, drake_traj.DrakeTrajError)
     assert issubclass(drake_traj.DrakeTrajError, ValueError)
+
+
+def test_pure_laws_stand_apart_from_drake_systems():
+    # planners.laws holds math only: no pydrake, and of the package only compiled, validation and itself
+    for name, path in MODULES.items():
+        if not name.startswith("drake_traj.planners.laws"):
+            continue
+        tree = ast.parse(path.read_text())
+        modules = {alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names}
+        modules |= {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and node.module}
+        assert not {m for m in modules if m.startswith("pydrake")}, name
+        assert all(t.startswith(("drake_traj.planners.laws", "drake_traj.compiled", "drake_traj.validation"))
+                   for t in GRAPH[name]), (name, GRAPH[name])
+
+
+def test_the_pajak_law_reaches_the_robot_through_the_robot_interface():
+    # its config describes the paper's task on the UR10e; the law, kernel, integration and system
+    # use Robot.task_kinematics
+    for name in MODULES:
+        if name.startswith("drake_traj.planners.pajak") and name != "drake_traj.planners.pajak.parameters":
+            assert "drake_traj.robots.ur10e" not in GRAPH[name], name

@@ -287,7 +287,7 @@ UR10E_HOME = get_robot("ur10e").home_configuration
 GOAL = [[-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]]
 
 API_CASES = [
-    ("quintic plan list", lambda: QuinticPtpPlanner(plan=[1, 2], velocity_limit=1, acceleration_limit=1), TypeError, r"plan must be a QuinticPlan"),
+    ("quintic plan list", lambda: QuinticPtpPlanner(plan=[1, 2], velocity_limit=1, acceleration_limit=1), TypeError, r"plan must be a QuinticLaw"),
     ("pajak q_initial text", lambda: PajakPlanner(paper_parameters(3), ["a"] * 6), ValueError, r"q_initial"),
     ("pajak q_initial short", lambda: PajakPlanner(paper_parameters(3), [0.0] * 5), ValueError, r"q_initial must have shape \(6,\)"),
     ("simulate not a planner", lambda: simulate("planner"), TypeError, r"planner must be a PlannerSystem"),

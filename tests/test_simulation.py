@@ -11,7 +11,7 @@ from pydrake.systems.primitives import ConstantVectorSource
 from drake_traj.robots import ur10e as robot
 from drake_traj.scenario import ControllerGains
 from drake_traj.station import simulate
-from drake_traj.planners.quintic import QuinticPlan, QuinticPtpPlanner, plan_synchronized_quintic
+from drake_traj.planners.quintic import QuinticLaw, QuinticPtpPlanner, plan_synchronized_quintic
 from drake_traj.result import ARRAY_NAMES, SimulationResult
 from drake_traj.scenario import load_scenario, make_planner
 
@@ -98,7 +98,7 @@ def test_gravity_compensation_alone_tracks_worse_than_inverse_dynamics_feedforwa
     assert gravity_only.tracking_error_joint_max_rad < 5e-3  # measured 1.05e-3: still a usable PD loop
 
 
-class PlanFailingAt(QuinticPlan):
+class PlanFailingAt(QuinticLaw):
     """A quintic plan whose rates raise after law time ``fail_time`` [s] (a stand-in for any
     fault in a planner's law)."""
 

@@ -8,15 +8,14 @@ from __future__ import annotations
 
 from typing import Union
 
-from drake_traj.planners import boryga, pajak, quintic
+from drake_traj.planners import boryga, li, pajak, quintic
 from drake_traj.planners.baselines import movej, ruckig, toppra
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.planners.boryga import BorygaConfig
 from drake_traj.planners.baselines.movej import MovejConfig
 from drake_traj.planners.baselines.ruckig import RuckigConfig
 from drake_traj.planners.baselines.toppra import ToppraConfig
-from drake_traj.planners.li import system as li
-from drake_traj.planners.li.system import LiConfig
+from drake_traj.planners.li import LiConfig
 from drake_traj.planners.pajak import PajakConfig
 from drake_traj.planners.quintic import QuinticConfig
 from drake_traj.robots.base import Robot

@@ -23,15 +23,14 @@ subclasses provide the law, not ``evaluate``.
 from __future__ import annotations
 
 from bisect import bisect_right
-from math import comb
 from typing import NamedTuple
 
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, ContinuousStateIndex, EventStatus, LeafSystem, ValueProducer
 
-from drake_traj.planners.polynomials import rate_peaks
-from drake_traj.planners.scaling import admissible_clock_rate, clock_at, next_clock_rate
+from drake_traj.planners.laws.contract import missing_members
+from drake_traj.planners.laws.scaling import admissible_clock_rate, clock_at, next_clock_rate
 from drake_traj.validation import finite_array
 
 _DID_NOTHING = EventStatus.DidNothing()  # returned by the time-law update in the common case
@@ -178,27 +177,28 @@ class _Rates(NamedTuple):
 class TimeLawPlanner(PlannerSystem):
     """A planner that follows a closed-form joint time law on a scaled planner clock.
 
-    ``law`` provides ``q_start`` (n,), ``duration`` [s], ``rates_at(tau) -> (qd, qdd)``, the law's
-    joint velocity and acceleration at law time tau (the hot path), and ``sample(tau) -> (q, qd,
-    qdd)``. The clock tau advances at the rate c: with c = 1 the reference is the law itself,
-    qd = q_law'(tau) c and qdd = q_law''(tau) c² + q_law'(tau) ċ. c starts at ``speed_cap`` (a
-    law that breaks the limits by a factor is slowed into them with ``speed_cap`` < 1: velocity
-    scales by c, acceleration by c²) and relaxes towards ``speed_cap`` times the
+    ``law`` is a :class:`~drake_traj.planners.laws.TimeLaw` (checked when the planner is made: a
+    TypeError names what is missing): ``q_start``, ``duration``, ``acceleration_jumps``,
+    ``rates_at(tau)`` (the hot path) and ``sample(tau)``. The clock tau advances at the rate c:
+    with c = 1 the reference is the law itself, qd = q_law'(tau) c and
+    qdd = q_law''(tau) c² + q_law'(tau) ċ. c starts at ``speed_cap`` (a law that breaks the limits
+    by a factor is slowed into them with ``speed_cap`` < 1: velocity scales by c, acceleration by
+    c²) and relaxes towards ``speed_cap`` times the
     ``speed_override`` input in the form of eq. 18 of Pająk 2024 (at ``scaling_rate``; a speed
     slider's response, faster than the paper's 1/s), with ċ held over each ``update_period`` and
     changed by at most ``clock_jerk`` × period, so q̈ stays continuous (see
-    :mod:`drake_traj.planners.scaling`), and never faster than the joint acceleration limits
+    :mod:`drake_traj.planners.laws.scaling`), and never faster than the joint acceleration limits
     allow at that point of the law (checked at both ends of the period).
 
     The Simulator integrates the reference [q; qd] from the law's rates, q' = q_law'(tau) c and
     qd' = qdd (so q follows the law's own velocity, not the integrated one). Where the law's
-    acceleration jumps (its ``acceleration_jumps``, law times; a law without that attribute is
-    taken to jump anywhere), a fixed step integrates the jump with an error that would stay: the
-    update after it sets the reference back on the law, (q_law(tau), q_law'(tau) c), as does every
-    update that changes the clock, and the one that records the exact finish time (so the motion
+    acceleration jumps (its ``acceleration_jumps``, law times; None: anywhere), a fixed step
+    integrates the jump with an error that would stay: the update after it sets the reference
+    back on the law, (q_law(tau), q_law'(tau) c), as does every update that changes the clock, and the one that records the exact finish time (so the motion
     ends exactly at the law's end). While c is at its goal and nothing jumps, the update changes
     nothing. The rates depend on the time and the clock only, and the last ones are kept by that
-    key: the derivatives, both outputs and the update of one step share one law evaluation.
+    key (:meth:`_rates`): the derivatives, both outputs and the update of one step share one law
+    evaluation.
 
     Discrete state: ``clock`` = [tau, ċ, c, t0]: the law time, the clock's rate and c at the last
     update t0 (the clock's truth); ``scaling`` = [c, t0, c] (the contract's view of the same
@@ -222,10 +222,10 @@ class TimeLawPlanner(PlannerSystem):
         if type(self).evaluate is not TimeLawPlanner.evaluate:  # the hot path never calls it
             raise TypeError(f"{type(self).__name__} overrides evaluate, which a TimeLawPlanner does not use (its "
                             "rates come from the law): change the law, or derive from PlannerSystem")
-        missing = [name for name in ("q_start", "duration", "rates_at", "sample") if not hasattr(law, name)]
+        missing = missing_members(law)
         if missing:
-            raise TypeError(f"law must be a time law with q_start, duration, rates_at and sample; "
-                            f"a {type(law).__name__} has no {', '.join(missing)}")
+            raise TypeError(f"law must be a TimeLaw (drake_traj.planners.laws.TimeLaw: q_start, duration, "
+                            f"acceleration_jumps, rates_at, sample); a {type(law).__name__} has no {', '.join(missing)}")
         if not np.isfinite(speed_cap) or not 0.0 < speed_cap <= 1.0:
             raise ValueError(f"speed_cap must be in (0, 1], got {speed_cap}")
         for name, value in (("update_period", update_period), ("scaling_rate", scaling_rate), ("clock_jerk", clock_jerk)):
@@ -241,8 +241,8 @@ class TimeLawPlanner(PlannerSystem):
         self.acceleration_limit = np.asarray(acceleration_limit, dtype=float)
         self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, 0.0, self.speed_cap, 0.0]))
         self.DeclarePeriodicUnrestrictedUpdateEvent(update_period, 0.0, self._update)
-        self._kept = (None, None)  # (key, _Rates) of _rates
-        jumps = getattr(law, "acceleration_jumps", None)  # law times where q_law'' jumps (None: anywhere)
+        self._kept = (None, None)  # (key, _Rates) of _rates: see there why not a cache entry
+        jumps = law.acceleration_jumps  # law times where q_law'' jumps (None: anywhere)
         self._acceleration_jumps = None if jumps is None else sorted(np.asarray(jumps, dtype=float).tolist())
 
     def _clock_state(self, context) -> list[float]:
@@ -261,7 +261,16 @@ class TimeLawPlanner(PlannerSystem):
         They depend on the time and the clock state only, so the last ones are kept by that key.
         Per step Drake asks at t (first RK2 stage), at t + h (second stage) and for the output at
         t + h at the step's end: one law evaluation per step (counted on Li 4-DOF). The arrays are
-        read-only views of one (shared by every caller with that key)."""
+        read-only views of one (shared by every caller with that key).
+
+        Kept on the instance, not in a Drake cache entry: the value is a function of the key alone
+        (the law does not change), so contexts with the same key may share it, and both cache
+        entries we measured cost more (planner alone under RK2 at 1 ms, medians of 5, µs per
+        step, quintic_ptp / Li 4-DOF): this memo 64 / 68; a cache entry on time and the clock
+        state 111 / 99 (Drake invalidates it at every SetTime, 3.2 law evaluations per step
+        instead of 1.1); a per-context scratch entry holding this memo 88 / 93 (its Eval from
+        Python). In the station, station / floor fell from 0.45 / 0.44 to 0.33 / 0.26 with the
+        first (examples/bench_planner_cost.py, 3-5 repeats)."""
         key = (context.get_time(), *self._clock_state(context))
         if key != self._kept[0]:
             t, tau0, c_rate, c0, t0 = key
@@ -345,92 +354,6 @@ class TimeLawPlanner(PlannerSystem):
         q_law, qd_law, _ = self.law.sample(tau)
         state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(np.concatenate([q_law, qd_law * c]))
         return EventStatus.Succeeded()
-
-
-class HermiteLaw:
-    """A joint time law tabulated at knots, between them the quintic Hermite polynomial that meets
-    q, q̇ and q̈ at both ends (so q̈ is continuous except where the samples on both sides of a
-    knot differ, the law's ``acceleration_jumps``). ``rates_at`` costs a bisection and two small
-    polynomial evaluations, whatever the tabulated law cost.
-
-    Args:
-        knots: increasing law times [s], (K,), from 0 to the law's duration.
-        right: (q, q̇, q̈) just after each knot, (K, 3, n); row K-1 is not used.
-        left: (q, q̇, q̈) just before each knot, (K, 3, n); row 0 is not used. Where the law is
-            continuous it equals ``right``.
-        acceleration_jumps: the knots where q̈ jumps (for :class:`TimeLawPlanner`).
-    """
-
-    def __init__(self, knots, right, left, acceleration_jumps=()):
-        knots = np.asarray(knots, dtype=float)
-        right, left = np.asarray(right, dtype=float), np.asarray(left, dtype=float)
-        if knots.ndim != 1 or len(knots) < 2 or np.any(np.diff(knots) <= 0) or knots[0] != 0.0:
-            raise ValueError(f"knots must increase from 0, got {len(knots)} knots")
-        self.knots = knots
-        self.duration = float(knots[-1])
-        self.q_start = right[0, 0].copy()
-        self.acceleration_jumps = np.asarray(acceleration_jumps, dtype=float)
-        h = np.diff(knots)[:, None]
-        (q0, v0, a0), (q1, v1, a1) = np.moveaxis(right[:-1], 1, 0), np.moveaxis(left[1:], 1, 0)
-        delta = q1 - q0
-        # quintic Hermite in s = tau - knot, monomial coefficients c0..c5, (K-1, 6, n)
-        self._coefficients = np.stack([
-            q0, v0, 0.5 * a0,
-            (20 * delta - (8 * v1 + 12 * v0) * h - (3 * a0 - a1) * h**2) / (2 * h**3),
-            (-30 * delta + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h**2) / (2 * h**4),
-            (12 * delta - 6 * (v1 + v0) * h + (a1 - a0) * h**2) / (2 * h**5),
-        ], axis=1)
-        # (q̇, q̈) at s as one product, powers (1, s, s², s³, s⁴) @ [j c_j | j (j - 1) c_j]: (K-1, 5, 2n)
-        first = np.arange(1, 6)[None, :, None] * self._coefficients[:, 1:]
-        second = np.arange(1, 5)[None, :, None] * first[:, 1:]
-        self._rate_coefficients = np.concatenate([first, np.pad(second, ((0, 0), (0, 1), (0, 0)))], axis=2)
-        self._end = left[-1].copy()
-
-    def interval_polynomials(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """q̇ and q̈ on each knot interval as polynomials in sigma in [-1, 1] (tau = mid + sigma
-        half): (mid [s] (K-1,), half [s] (K-1,), q̇ coefficients (5, K-1, n), q̈ coefficients
-        (4, K-1, n)), for :func:`~drake_traj.planners.polynomials.rate_peaks`."""
-        half = 0.5 * np.diff(self.knots)
-        scale = half[:, None]
-        # q(sigma) = sum_k e_k sigma^k with s = half (1 + sigma): e_k = sum_j C(j, k) c_j half^j
-        position = np.stack([sum(comb(j, k) * self._coefficients[:, j] * scale**j for j in range(k, 6))
-                             for k in range(6)])
-        velocity = np.stack([(k + 1) * position[k + 1] / scale for k in range(5)])
-        acceleration = np.stack([(k + 1) * velocity[k + 1] / scale for k in range(4)])
-        return self.knots[:-1] + half, half, velocity, acceleration
-
-    def peak_rates(self) -> tuple[np.ndarray, np.ndarray]:
-        """(max |q̇|, max |q̈|) over the whole law per joint, exact to round-off (interval ends,
-        both sides of every jump, and the extrema inside each interval)."""
-        _, _, velocity, acceleration = self.interval_polynomials()
-        v_peak, _, a_peak, _ = rate_peaks(velocity, acceleration)
-        return v_peak.max(axis=0), a_peak.max(axis=0)
-
-    def _interval(self, tau: float) -> tuple[int, float]:
-        k = min(max(bisect_right(self.knots, tau) - 1, 0), len(self.knots) - 2)
-        return k, tau - self.knots[k]
-
-    def sample(self, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(q, q̇, q̈) at law time ``tau`` [s]; at rest at the ends outside [0, duration]."""
-        if tau >= self.duration:
-            return self._end[0].copy(), np.zeros_like(self._end[0]), np.zeros_like(self._end[0])
-        k, s = self._interval(max(tau, 0.0))
-        c = self._coefficients[k]
-        powers = s ** np.arange(6)
-        q = powers @ c
-        if tau < 0.0:
-            return q, np.zeros_like(q), np.zeros_like(q)
-        return q, (np.arange(1, 6) * powers[:5]) @ c[1:], (np.array([2, 6, 12, 20]) * powers[:4]) @ c[2:]
-
-    def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
-        """(q̇, q̈) at law time ``tau`` [s] (the planner's hot path: one 5 × 2n product)."""
-        n = self._end.shape[1]
-        if tau >= self.duration or tau < 0.0:
-            return np.zeros(n), np.zeros(n)
-        k, s = self._interval(tau)
-        s2 = s * s
-        rates = np.array((1.0, s, s2, s2 * s, s2 * s2)) @ self._rate_coefficients[k]
-        return rates[:n], rates[n:]
 
 
 def start_and_goals(q_initial, goals, num_joints: int) -> np.ndarray:

@@ -15,7 +15,7 @@ inverse kinematics wrapper. Subclasses (frozen dataclasses) give the dimensions,
 from __future__ import annotations
 
 from pathlib import Path
-from typing import ClassVar
+from typing import Callable, ClassVar, NamedTuple
 
 import numpy as np
 from pydrake.multibody.parsing import Parser
@@ -23,7 +23,7 @@ from pydrake.multibody.parsing import Parser
 from drake_traj.data import data_directory
 from drake_traj.validation import real_array
 
-__all__ = ["LIMIT_TOL", "PointRobot", "Robot"]
+__all__ = ["LIMIT_TOL", "PointRobot", "Robot", "TaskKinematics"]
 
 LIMIT_TOL = 1e-12  # slack on joint limits [rad or m]
 
@@ -54,6 +54,33 @@ def format_point(point) -> str:
 
 def stack_columns(columns) -> np.ndarray:
     return np.stack(np.broadcast_arrays(*columns), axis=-1)
+
+
+class TaskKinematics(NamedTuple):
+    """A robot's task-space kinematics for planners that integrate in task space (Pająk 2024):
+    6 joints, the tool pose k(q) = [x, y, z, φ_X, φ_Y, φ_Z] in the base frame [m, rad] with Z-Y-X
+    Euler angles. The first three are compiled (:mod:`drake_traj.compiled`) and called from
+    compiled kernels; the others are their Python faces.
+
+    Attributes:
+        kinematics_into: ``(q, q̇, pose, jac, bias) -> (cos φ_Y, singularity measure)``: k(q) into
+            ``pose`` (6,), the analytic Jacobian into ``jac`` (6, 6) and J̇q̇ into ``bias`` (6,)
+            [m/s², rad/s²]; q [rad], q̇ [rad/s].
+        wrapped: an angle [rad] (float or array) wrapped into (-π, π].
+        orientation_error: ``(φ, φ_goal) -> `` the angle of R_goalᵀ R [rad] for Euler angles (3,).
+        wrap_angle: :attr:`wrapped` for any array-like.
+        pose_error: ``(poses (..., 6), goal (6,)) -> (position error [m], orientation error
+            [rad])``, each (...).
+        inverse_kinematics_all: ``pose (6,) -> q (k, n)``, every joint solution of a pose [rad];
+            ValueError for a pose out of reach, SingularConfigurationError at a singular one.
+    """
+
+    kinematics_into: Callable
+    wrapped: Callable
+    orientation_error: Callable
+    wrap_angle: Callable
+    pose_error: Callable
+    inverse_kinematics_all: Callable
 
 
 class Robot:
@@ -165,6 +192,12 @@ class Robot:
         """(qd, qdd) that move the tool point with velocity ``v`` and acceleration ``a`` at q,
         the tool orientation held where the robot has one; arrays broadcast together."""
         raise NotImplementedError
+
+    def task_kinematics(self) -> TaskKinematics:
+        """The robot's :class:`TaskKinematics` (the Pająk 2024 planner's only way to the robot);
+        ValueError naming the robot where it has none (this default)."""
+        raise ValueError(f"the {self.name} robot provides no task-space kinematics (6 joints, a tool pose with Z-Y-X "
+                         "Euler angles, compiled)")
 
 
 class PointRobot(Robot):

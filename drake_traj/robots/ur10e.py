@@ -19,7 +19,7 @@ import numpy as np
 
 from drake_traj.compiled import compiled
 from drake_traj.errors import SingularConfigurationError
-from drake_traj.robots.base import Robot
+from drake_traj.robots.base import Robot, TaskKinematics
 from drake_traj.validation import real_array
 
 __all__ = ["UR10E", "UR10e"]
@@ -780,5 +780,12 @@ class UR10e(Robot):
         qdd = np.linalg.solve(jacobian, np.concatenate([a, np.zeros(3)]) - bias)
         return qd, qdd
 
+    def task_kinematics(self) -> TaskKinematics:
+        """This module's compiled k(q), analytic Jacobian and J̇q̇ (:func:`kinematics_into`), angle
+        wrapping, orientation error, pose errors and closed-form IK."""
+        return _TASK_KINEMATICS
 
+
+_TASK_KINEMATICS = TaskKinematics(kinematics_into, wrapped, orientation_error, wrap_angle, pose_error,
+                                  inverse_kinematics_all)
 UR10E = UR10e()

@@ -18,9 +18,9 @@ from scipy.integrate import cumulative_trapezoid
 from drake_traj.planners.boryga import (
     PHASES,
     LoopGeometry,
-    LoopPathPlan,
+    LoopPath,
     loop_geometry,
-    loop_time_law,
+    loop_timing,
     plan_loop_path,
     poly7_profile,
     poly7_timing,
@@ -46,7 +46,7 @@ PRINTED_TOL = 5e-4  # the paper prints three decimals
 
 
 @pytest.fixture(scope="module")
-def plan() -> LoopPathPlan:
+def plan() -> LoopPath:
     return plan_loop_path(B, M, E, V_MAX, delta=DELTA)
 
 
@@ -473,9 +473,9 @@ def test_bad_points_are_rejected(points, match):
 
 def test_bad_arguments_to_the_time_law_and_sampler(plan):
     with pytest.raises(ValueError, match="geometry must be a LoopGeometry"):
-        loop_time_law({"R": 1.0}, V_MAX)
-    with pytest.raises(ValueError, match="timing must be a LoopTimeLaw"):
-        LoopPathPlan(plan.geometry, None)
+        loop_timing({"R": 1.0}, V_MAX)
+    with pytest.raises(ValueError, match="timing must be a LoopTiming"):
+        LoopPath(plan.geometry, None)
     with pytest.raises(ValueError, match="side must be 'left' or 'right'"):
         plan.sample(0.1, side="middle")
     with pytest.raises(ValueError, match="t must be finite"):

@@ -409,7 +409,8 @@ def test_acceleration_is_continuous(sim):
 def test_jerk_budget_rates():
     # improvement 1: the rate limits that keep c (and σ, the approach rate) from changing q̈ faster
     # than the budget: budget / max |∂q̈_i/∂x|
-    from drake_traj.planners.pajak.kernel import budgeted_rate, scaling_slew
+    from drake_traj.planners.pajak.kernel import budgeted_rate
+    from drake_traj.planners.pajak.limits import scaling_slew
 
     b = np.array([1.0, -200.0, 0.5, 0.0, 0.0, 0.0])
     assert scaling_slew(b, 3.0, 40.0) == pytest.approx(0.2)  # 200 rad/s² per unit of c

@@ -14,7 +14,7 @@ import pytest
 from scipy.integrate import cumulative_trapezoid
 
 from drake_traj.planners.quintic import (
-    QuinticPlan,
+    QuinticLaw,
     QuinticSegment,
     joint_minimum_times,
     peak_acceleration,
@@ -100,7 +100,7 @@ def test_table6_theoretical_peaks():
 
 def test_table6_peaks_reproduced_by_dense_sampling():
     d, t_f = np.pi / 2, 230.0
-    plan = QuinticPlan((QuinticSegment(np.array([0.0]), np.array([d]), 0.0, t_f),))
+    plan = QuinticLaw((QuinticSegment(np.array([0.0]), np.array([d]), 0.0, t_f),))
     t = np.linspace(0.0, t_f, 20001)
     h = t[1] - t[0]
     q = plan.sample(t)[0][:, 0]
@@ -488,7 +488,7 @@ def test_functions_reject_bad_inputs():
     with pytest.raises(ValueError, match=r"duration must be >= 0"):
         peak_acceleration(1.0, -1.0)
     with pytest.raises(ValueError, match=r"segments must contain at least one"):
-        QuinticPlan(())
+        QuinticLaw(())
     with pytest.raises(ValueError, match=r"duration must be finite and >= 0"):
         QuinticSegment(np.zeros(2), np.ones(2), 0.0, -1.0)
     with pytest.raises(ValueError, match=r"duration must be > 0 .* q_goal differs"):
@@ -496,7 +496,7 @@ def test_functions_reject_bad_inputs():
     with pytest.raises(ValueError, match=r"q_goal must have the shape of q_start"):
         QuinticSegment(np.zeros(2), np.ones(3), 0.0, 1.0)
     with pytest.raises(ValueError, match=r"segments\[1\] starts at t = 0.5 s"):
-        QuinticPlan(
+        QuinticLaw(
             (
                 QuinticSegment(np.zeros(1), np.ones(1), 0.0, 1.0),
                 QuinticSegment(np.ones(1), np.zeros(1), 0.5, 1.0),

@@ -5,7 +5,7 @@ import pytest
 
 from drake_traj import QuinticConfig, get_robot
 from drake_traj.planners import make_planner
-from drake_traj.planners.scaling import admissible_clock_rate, clock_at, next_clock_rate, relaxed_scaling
+from drake_traj.planners.laws.scaling import admissible_clock_rate, clock_at, next_clock_rate, relaxed_scaling
 
 
 def test_relaxed_scaling_is_eq_18_and_its_derivative():

@@ -16,8 +16,8 @@ import pytest
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
-from drake_traj.planners.li import system as li_system
-from drake_traj.planners.li.system import li_closed_path
+from drake_traj.planners.li import config as li_config
+from drake_traj.planners.li.path import li_closed_path
 from drake_traj.robots import LI_4DOF
 
 PI = math.pi
@@ -65,8 +65,8 @@ def test_dh_table_and_limits_are_the_papers():
     np.testing.assert_array_equal(LI_4DOF.velocity_limits, [2.0, 2.5, 3.0, 3.0])
     np.testing.assert_array_equal(LI_4DOF.acceleration_limits, [1.0, 1.2, 1.5, 1.8])
     # Table 4.
-    assert li_system.CARTESIAN_VELOCITY_LIMIT == 0.2
-    assert li_system.CARTESIAN_ACCELERATION_LIMIT == 0.1
+    assert li_config.CARTESIAN_VELOCITY_LIMIT == 0.2
+    assert li_config.CARTESIAN_ACCELERATION_LIMIT == 0.1
 
 
 def test_initial_pose():

@@ -109,6 +109,10 @@ class MovejBlendLaw:
         segment_durations (m,), blend_overlaps (m - 1,) [s] (delta_k, 0 without blending).
     """
 
+    # q̈ jumps where each trapezoid's ramps begin and end: None lets the planner set the reference
+    # back on the law at every update (the TimeLaw contract)
+    acceleration_jumps = None
+
     def __init__(self, q_waypoints, velocity_limit, acceleration_limit, blend_radius: float = 0.0, *, tcp_position=None):
         try:
             waypoints = np.array(q_waypoints, dtype=float)

@@ -33,7 +33,8 @@ import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
 from drake_traj.planners.li.cartesian import acc_dec_profile
-from drake_traj.planners.polynomials import rate_peaks
+from drake_traj.planners.laws.polynomials import rate_peaks
+from drake_traj.validation import float_array, joint_limit_with_unit, require_finite
 
 __all__ = [
     "JointSplineLaw",
@@ -57,29 +58,14 @@ DEFAULT_SAMPLES_PER_INTERVAL = 16
 # --------------------------------------------------------------------------------------------
 
 
-def _float_array(value, name: str, unit: str) -> np.ndarray:
-    try:
-        return np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be an array of real numbers [{unit}]: {exc}") from exc
-
-
-def _require_finite(array: np.ndarray, name: str, unit: str) -> None:
-    if not np.all(np.isfinite(array)):
-        bad = np.argwhere(~np.isfinite(np.atleast_1d(array)))[0]
-        where = "" if array.ndim == 0 else "[" + ", ".join(str(int(i)) for i in bad) + "]"
-        value = np.atleast_1d(array)[tuple(bad)]
-        raise ValueError(f"{name}{where} must be finite [{unit}], got {value}")
-
-
 def _samples(times, q) -> tuple[np.ndarray, np.ndarray]:
     """``times`` (N,) strictly increasing and ``q`` (N, n), N >= 2, all finite (copies)."""
-    t = _float_array(times, "times", "s")
+    t = float_array(times, "times", "s")
     if t.ndim != 1:
         raise ValueError(f"times must have shape (N,) [s], got shape {t.shape}")
     if t.size < 2:
         raise ValueError(f"times must have at least two samples, got {t.size}")
-    _require_finite(t, "times", "s")
+    require_finite(t, "times", "s")
     steps = np.diff(t)
     if np.any(steps <= 0.0):
         i = int(np.argmax(steps <= 0.0)) + 1
@@ -87,30 +73,14 @@ def _samples(times, q) -> tuple[np.ndarray, np.ndarray]:
             f"times must be strictly increasing [s]: times[{i}] = {t[i]} <= "
             f"times[{i - 1}] = {t[i - 1]}"
         )
-    joints = _float_array(q, "q", "rad")
+    joints = float_array(q, "q", "rad")
     if joints.ndim != 2 or joints.shape[0] != t.size or joints.shape[1] == 0:
         raise ValueError(
             f"q must have shape (N, n) = ({t.size}, n) with n >= 1 (one row per time) [rad], "
             f"got shape {joints.shape}"
         )
-    _require_finite(joints, "q", "rad")
+    require_finite(joints, "q", "rad")
     return t, joints
-
-
-def _limit(value, name: str, unit: str, num_joints: int) -> np.ndarray:
-    """A per-joint limit: scalar (every joint) or shape (n,); finite and > 0."""
-    array = _float_array(value, name, unit)
-    if array.ndim != 0 and array.shape != (num_joints,):
-        raise ValueError(
-            f"{name} must be a scalar or have shape ({num_joints},) [{unit}], "
-            f"got shape {array.shape}"
-        )
-    _require_finite(array, name, unit)
-    array = np.broadcast_to(array, (num_joints,)).copy()
-    if np.any(array <= 0.0):
-        j = int(np.argmax(array <= 0.0))
-        raise ValueError(f"{name}[{j}] (joint {j + 1}) must be > 0 [{unit}], got {array[j]}")
-    return array
 
 
 # --------------------------------------------------------------------------------------------
@@ -168,8 +138,8 @@ def joint_interval_times(times, q, velocity_limit, acceleration_limit) -> np.nda
     """
     t, joints = _samples(times, q)
     n = joints.shape[1]
-    omega = _limit(velocity_limit, "velocity_limit", "rad/s", n)
-    alpha = _limit(acceleration_limit, "acceleration_limit", "rad/s^2", n)
+    omega = joint_limit_with_unit(velocity_limit, "velocity_limit", "rad/s", n)
+    alpha = joint_limit_with_unit(acceleration_limit, "acceleration_limit", "rad/s^2", n)
     lengths = np.abs(np.diff(joints, axis=0))
     speeds = _joint_point_speeds(t, joints, omega)
     reach = 2.0 * (2.0 / 3.0) * alpha * lengths  # 2 A l, A = (2/3) alpha_m (eq. 12)
@@ -353,8 +323,8 @@ class JointSplineLaw:
         Returns:
             (q [rad], qd [rad/s], qdd [rad/s^2]), each of shape t.shape + (n,).
         """
-        times = _float_array(t, "t", "s")
-        _require_finite(times, "t", "s")
+        times = float_array(t, "t", "s")
+        require_finite(times, "t", "s")
         clipped = np.clip(times, 0.0, self._duration)
         inside = ((times >= 0.0) & (times <= self._duration))[..., None]
         q = self.spline(clipped)
@@ -364,8 +334,8 @@ class JointSplineLaw:
 
     def jerk(self, t):
         """Third derivative [rad/s^3] at law times ``t`` (zero outside [0, duration])."""
-        times = _float_array(t, "t", "s")
-        _require_finite(times, "t", "s")
+        times = float_array(t, "t", "s")
+        require_finite(times, "t", "s")
         inside = ((times >= 0.0) & (times <= self._duration))[..., None]
         return np.where(inside, self._jerk(np.clip(times, 0.0, self._duration)), 0.0)
 
@@ -496,8 +466,8 @@ def check_limits(
     if not isinstance(law, JointSplineLaw):
         raise ValueError(f"law must be a JointSplineLaw, got {type(law).__name__}")
     n = law.num_joints
-    omega = _limit(velocity_limit, "velocity_limit", "rad/s", n)
-    alpha = _limit(acceleration_limit, "acceleration_limit", "rad/s^2", n)
+    omega = joint_limit_with_unit(velocity_limit, "velocity_limit", "rad/s", n)
+    alpha = joint_limit_with_unit(acceleration_limit, "acceleration_limit", "rad/s^2", n)
     if isinstance(samples_per_interval, bool) or int(samples_per_interval) != samples_per_interval:
         raise ValueError(
             f"samples_per_interval must be an integer >= 2, got {samples_per_interval!r}"

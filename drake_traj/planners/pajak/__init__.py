@@ -1,8 +1,10 @@
 """Pająk 2024: the acceleration-level task-space planner (see :mod:`.law` for the method).
 
 Modules: :mod:`.parameters` (the config and the paper's task), :mod:`.kernel` (the law and its
-integrator, compiled), :mod:`.law` (the law for Python callers), :mod:`.integration` (RK4
-integration outside Drake) and :mod:`.system` (the Drake system and ``make``).
+integrator, compiled), :mod:`.limits` (its limit keeping: the choice of c and the braking,
+compiled), :mod:`.law` (the law for Python callers), :mod:`.integration` (RK4 integration outside
+Drake) and :mod:`.system` (the Drake system and ``make``). The robot is reached through
+:meth:`~drake_traj.robots.Robot.task_kinematics` only.
 """
 
 from drake_traj.errors import PlanningError
@@ -16,12 +18,11 @@ from drake_traj.planners.pajak.kernel import (
     approach_rate,
     blend_progress,
     blended_target,
-    choose_scaling,
     damping_factor,
-    scaling_interval,
     velocity_penalty,
 )
 from drake_traj.planners.pajak.law import DISCRETE_NAMES, PajakLaw
+from drake_traj.planners.pajak.limits import choose_scaling, scaling_interval
 from drake_traj.planners.pajak.parameters import PAPER_METHOD, PajakConfig, paper_initial_configuration, paper_parameters
 from drake_traj.planners.pajak.system import PajakPlanner, make
 

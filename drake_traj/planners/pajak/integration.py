@@ -11,7 +11,7 @@ import numpy as np
 from drake_traj.errors import PlanningError
 from drake_traj.planners.pajak.kernel import Discrete, Evaluation, Log, Status, integrate_kernel
 from drake_traj.planners.pajak.law import PajakLaw
-from drake_traj.robots import ur10e as robot
+from drake_traj.validation import finite_array
 
 __all__ = ["integrate"]
 
@@ -53,7 +53,7 @@ def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settl
             raise ValueError(f"{name} must be a positive number of seconds, got {value}")
     if not np.isfinite(settle_time) or settle_time < 0:
         raise ValueError(f"settle_time must be a non-negative number of seconds, got {settle_time}")
-    q0 = np.array(robot._as_joint_vector(q0, "q0"))
+    q0 = finite_array(q0, "q0", "rad", shape=(law.robot.num_joints,))
     unreachable = law.reach_failure(q0)
     if unreachable is not None:
         raise unreachable
@@ -84,6 +84,6 @@ def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settl
         error.partial = result
         raise error
     goal = law.waypoints[-1]
-    position, orientation = robot.pose_error(result["tcp"][finish], goal)
+    position, orientation = law.kinematics.pose_error(result["tcp"][finish], goal)
     return result | {"T": float(result["t"][finish]), "finish_index": int(finish), "error": position,
                      "orientation_error": orientation}

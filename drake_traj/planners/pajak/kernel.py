@@ -16,6 +16,7 @@ improvements (each a flag of the parameters).
 """
 
 import hashlib
+import inspect
 import math
 from enum import IntEnum
 from pathlib import Path
@@ -24,16 +25,25 @@ import numpy as np
 
 from drake_traj import compiled as compiled_module
 from drake_traj.compiled import compiled
-from drake_traj.planners import scaling
-from drake_traj.planners.scaling import relaxed_scaling
-from drake_traj.robots import ur10e
-from drake_traj.robots.ur10e import kinematics_into, orientation_error, wrapped
+from drake_traj.planners.laws import scaling
+from drake_traj.planners.laws.scaling import relaxed_scaling
+from drake_traj.planners.pajak import limits
+from drake_traj.planners.pajak.limits import (
+    BRAKE_LAG,
+    BRAKE_SLEW,
+    brake,
+    brake_weight,
+    choose_scaling,
+    keep_limits,
+    scaling_interval,
+    scaling_slew,
+)
+from drake_traj.robots import UR10E
 
 __all__ = [
     "Discrete", "Evaluation", "Log", "Parameter", "Status", "acceleration_box", "acceleration_terms",
-    "approach_damping", "approach_rate", "blend_progress", "blended_target", "brake_weight", "budgeted_rate",
-    "choose_scaling", "damping_factor", "evaluate_kernel", "finished_kernel", "integrate_kernel", "keep_limits",
-    "scaling_interval", "scaling_slew", "update_kernel", "velocity_penalty",
+    "approach_damping", "approach_rate", "blend_progress", "blended_target", "budgeted_rate", "damping_factor",
+    "KINEMATICS", "evaluate_kernel", "finished_kernel", "integrate_kernel", "update_kernel", "velocity_penalty",
 ]
 
 
@@ -121,12 +131,17 @@ class Status(IntEnum):
 
 
 ORIENTATION_LENGTH = 0.1  # [m/rad], weight of orientation in the progress measure and the approach rate
-MIN_COS_PITCH = 1e-6  # Euler gimbal lock (as ur10e.analytic_jacobian_and_bias)
-BRAKE_TIME = 0.05  # [s], time constant of the fallback braking at low speed (improvement 2)
-BRAKE_ONSET = 0.5  # violation (relative to q̈_max) at which the fallback is pure braking
-BRAKE_LAG = 0.02  # [s], time constant with which the braking weight follows its target
-BRAKE_SLEW = 10.0  # [1/s], largest rate of change of the braking weight
+MIN_COS_PITCH = 1e-6  # Euler gimbal lock (as the UR10e's analytic_jacobian_and_bias)
 SCALE_FLOOR = 0.1  # smallest c_r the approach damping is sized for (improvement 4)
+
+# The robot's compiled task kinematics (Robot.task_kinematics), bound once as module globals: numba
+# compiles the calls to them into the law and caches the law on disk. Passed in (a closure over
+# compiled functions, or an argument), they would miss numba's cache in every process (measured:
+# a closure over a compiled function recompiled in each new process), and the law takes 12-40 s
+# to compile. The law is therefore bound to one robot's kinematics, the UR10e's (the paper's
+# robot); PajakLaw refuses a robot whose task kinematics are other ones.
+KINEMATICS = UR10E.task_kinematics()
+kinematics_into, orientation_error, wrapped = KINEMATICS.kinematics_into, KINEMATICS.orientation_error, KINEMATICS.wrapped
 
 
 # --------------------------------------------------------------------------------------------
@@ -295,81 +310,6 @@ def budgeted_rate(jac, lam2, use_damped, direction, scale: float, budget: float)
 
 
 @compiled
-def scaling_slew(b, slew: float, budget: float) -> float:
-    """Largest |dc/dt| [1/s] (improvement 1): ``slew``, lowered where a change of c at that rate
-    would change some q̈_i = a_i + c b_i faster than ``budget`` [rad/s³]: at most
-    budget / max |b_i|. Where c is small the law's b is large (b_i of 100-400 rad/s² with the
-    penalty of eq. 15 active and c of a few 10⁻³), and eq. 18's relaxation at (1 - c) per second
-    alone changed q̈ by 0.1-0.2 rad/s² per ms."""
-    largest = 0.0
-    for k in range(b.shape[0]):
-        largest = max(largest, abs(b[k]))
-    if largest * slew <= budget:
-        return slew
-    return budget / largest
-
-
-@compiled
-def _fmin(x: float, y: float) -> float:
-    """min ignoring NaN (numpy's fmin)."""
-    if x != x:
-        return y
-    if y != y:
-        return x
-    return min(x, y)
-
-
-@compiled
-def _fmax(x: float, y: float) -> float:
-    """max ignoring NaN (numpy's fmax)."""
-    if x != x:
-        return y
-    if y != y:
-        return x
-    return max(x, y)
-
-
-@compiled
-def scaling_interval(a, b, lower, upper):
-    """(c_lo, c_hi): the interval of c with lower <= a + c b <= upper on every joint.
-
-    Each joint gives the bound of cases (1)-(4) (Corrected (docs/papers.md): (2) and (4) use q̈_min):
-    b_i > 0: (q̈_min - a_i)/b_i <= c <= (q̈_max - a_i)/b_i; b_i < 0: the same with the roles
-    of q̈_min and q̈_max swapped; b_i = 0: no bound if a_i is inside the box, else empty.
-    Upper bounds (cases 1, 2) combine by min (case a), lower bounds (3, 4) by max (case b).
-    The interval is empty where c_lo > c_hi.
-    """
-    c_lo = -np.inf
-    c_hi = np.inf
-    for i in range(a.shape[0]):
-        to_max = (upper[i] - a[i]) / b[i]
-        to_min = (lower[i] - a[i]) / b[i]
-        c_lo = max(c_lo, _fmin(to_max, to_min))
-        c_hi = min(c_hi, _fmax(to_max, to_min))
-    return c_lo, c_hi
-
-
-@compiled
-def choose_scaling(c_relaxed: float, c_lo: float, c_hi: float, bounded: bool = True):
-    """(c, feasible) from the relaxed value c_r (eq. 18) and the admissible interval (case a-c).
-
-    c = c_r when it is admissible; otherwise the admissible value closest to c_r (case a: the
-    smallest upper bound, case b: the largest lower bound, case c: the point of
-    [ĉ_min, ĉ_max] closest to c_r, which is the previous c when the anchor was just recorded).
-    ``bounded`` (improvement 2) restricts the interval to [0, 1]. feasible is False where the
-    interval is empty (then c is the clip of c_r to it, and the caller must keep the limits
-    some other way).
-    """
-    if bounded:
-        c_lo = max(c_lo, 0.0)
-        c_hi = min(c_hi, 1.0)
-    c = min(max(c_relaxed, c_lo), c_hi)
-    if bounded:
-        c = min(max(c, 0.0), 1.0)
-    return c, c_lo <= c_hi
-
-
-@compiled
 def acceleration_box(qd, p, lower, upper):
     """The box [lower, upper] (6 each) that q̈ must stay in: ±q̈_max (eq. 5), narrowed near the
     velocity limits (improvement 2) so that q̇ stays viable: q̈_i <= K (q̇_max - q̇_i) and the
@@ -385,61 +325,6 @@ def acceleration_box(qd, p, lower, upper):
             speed = p[Parameter.QD_MAX + k]
             upper[k] = min(max(gain * (speed - qd[k]), -limit), limit)
             lower[k] = min(max(gain * (-speed - qd[k]), -limit), limit)
-
-
-@compiled
-def keep_limits(a, b, c_relaxed: float, lower, upper, qdd_max, c_low: float, c_high: float, qdd):
-    """Improvement 2: q̈ = a + c b (eq. 17) inside the box [lower, upper] at every evaluation,
-    with c continuous in the state; returns (c, violation), q̈ into ``qdd``.
-
-    - c is chosen by cases 1-4 and a-c (:func:`scaling_interval`, :func:`choose_scaling`) in
-      [0, 1], then kept in [c_low, c_high] (the rate limit of c, improvement 1).
-    - When a = -J⁻¹J̇q̇ alone is outside the box (``violation`` = the largest excess relative to
-      q̈_max > 0: the joints move too fast for the curvature of the path), no c in [0, 1] keeps
-      the limits. c is then chosen in the box widened by twice the violation, which a is
-      strictly inside, so c stays continuous as some b_i changes sign (in the box itself the
-      interval's bounds would jump between ±∞).
-    - q̈ is clipped to the box: the limits win where the law (or the rate-limited c) would
-      break them; the caller counts those evaluations.
-    """
-    violation = 0.0
-    for k in range(6):
-        violation = max(violation, (a[k] - upper[k]) / qdd_max[k], (lower[k] - a[k]) / qdd_max[k])
-    low = np.empty(6)
-    high = np.empty(6)
-    for k in range(6):
-        widen = 2.0 * violation * qdd_max[k]
-        low[k] = lower[k] - widen
-        high[k] = upper[k] + widen
-    c_lo, c_hi = scaling_interval(a, b, low, high)  # cases 1-4
-    c, _ = choose_scaling(c_relaxed, c_lo, c_hi, True)  # cases a-c
-    c = min(max(c, c_low), c_high)
-    for k in range(6):
-        qdd[k] = min(max(a[k] + c * b[k], lower[k]), upper[k])  # eq. 17, clipped to the box
-    return c, violation
-
-
-@compiled
-def brake_weight(violation: float, weight: float, slope: float, elapsed: float):
-    """(weight now, its target): the share of braking in q̈ (improvement 2). The target is
-    smoothstep(violation / BRAKE_ONSET); the weight follows it from its value ``weight`` at the
-    last update with that update's ``slope`` [1/s] for ``elapsed`` seconds (so q̈ changes at a
-    bounded rate while the braking sets in or ends)."""
-    x = min(violation / BRAKE_ONSET, 1.0)
-    return min(max(weight + slope * elapsed, 0.0), 1.0), x * x * (3.0 - 2.0 * x)
-
-
-@compiled
-def brake(qd, lower, upper, qdd_max, weight: float, qdd):
-    """q̈ blended by ``weight`` from its value in ``qdd`` (in the box) into braking every joint in
-    proportion to its speed at the largest rate the box allows (at most 1/BRAKE_TIME); both ends
-    are in the box, so the blend is (improvement 2)."""
-    rate = 1.0 / BRAKE_TIME
-    for k in range(6):
-        rate = min(rate, qdd_max[k] / abs(qd[k]))
-    for k in range(6):
-        braking = min(max(-qd[k] * rate, lower[k]), upper[k])
-        qdd[k] += weight * (braking - qdd[k])
 
 
 @compiled
@@ -463,21 +348,23 @@ def blend_progress(position, reference, travel: float, length: float):
 # --------------------------------------------------------------------------------------------
 #
 # numba caches a compiled function under its own source file only (numba issue #1833): after an
-# edit of the UR10e kinematics or of eq. 18 in their modules, the cached law would go on using the
-# old code. Numba does hash a function's closure into its cache key, so each function below that
+# edit of the robot's kinematics, of eq. 18 or of the limit keeping in their modules, the cached
+# law would go on using the old code. Numba does hash a function's closure into its cache key, so each function below that
 # reaches compiled code of another module is made in a closure over the digest of those modules'
 # sources (``dependencies``, unused otherwise); they call each other through the module's globals.
 
 
-def _sources_digest(*modules) -> str:
-    """sha256 of the source files of ``modules``."""
+def _sources_digest(*files) -> str:
+    """sha256 of the source ``files`` (in sorted order)."""
     digest = hashlib.sha256()
-    for module in modules:
-        digest.update(Path(module.__file__).read_bytes())
+    for file in sorted(set(files)):
+        digest.update(Path(file).read_bytes())
     return digest.hexdigest()
 
 
-_DEPENDENCIES = _sources_digest(ur10e, scaling, compiled_module)
+_DEPENDENCIES = _sources_digest(
+    *(inspect.getsourcefile(function.py_func) for function in (kinematics_into, orientation_error, wrapped)),
+    scaling.__file__, limits.__file__, compiled_module.__file__)
 
 
 @compiled

@@ -25,6 +25,7 @@ import numpy as np
 
 from drake_traj.errors import PlanningError, SingularConfigurationError
 from drake_traj.planners.pajak.kernel import (
+    KINEMATICS,
     MIN_COS_PITCH,
     ORIENTATION_LENGTH,
     Discrete,
@@ -36,7 +37,7 @@ from drake_traj.planners.pajak.kernel import (
     update_kernel,
 )
 from drake_traj.planners.pajak.parameters import PajakConfig
-from drake_traj.robots import ur10e as robot
+from drake_traj.robots import UR10E, Robot
 
 __all__ = ["DISCRETE_NAMES", "PajakLaw"]
 
@@ -63,18 +64,29 @@ class PajakLaw:
 
     Args:
         parameters: the task and the law's settings (validated here; ValueError names the field).
+        robot: the robot, reached through its :meth:`~drake_traj.robots.Robot.task_kinematics`
+            only; the compiled law is bound to the UR10e's (:data:`~.kernel.KINEMATICS`), so
+            another robot is refused with a ValueError naming it.
     """
 
-    def __init__(self, parameters: PajakConfig):
+    def __init__(self, parameters: PajakConfig, robot: Robot = UR10E):
         if not isinstance(parameters, PajakConfig):
             raise ValueError(f"parameters must be a PajakConfig, got {type(parameters).__name__}")
+        try:
+            kinematics = robot.task_kinematics()
+            if kinematics != KINEMATICS:
+                raise ValueError("its task kinematics are not the ones the compiled law is bound to")
+        except ValueError as error:
+            raise ValueError(f"the Pająk planner runs on the UR10e (closed-form task kinematics), not on "
+                             f"{robot.name!r}: {error}") from None
+        self.robot, self.kinematics = robot, kinematics
         p = parameters.validate()
         self.parameters = p
         self.waypoints = np.ascontiguousarray(p.waypoints)
         count = len(self.waypoints)
         # remaining path after p_i (position + weighted orientation), for the progress monitor
         steps = np.linalg.norm(np.diff(self.waypoints[:, :3], axis=0), axis=1) + ORIENTATION_LENGTH * np.linalg.norm(
-            robot.wrap_angle(np.diff(self.waypoints[:, 3:], axis=0)), axis=1)
+            kinematics.wrap_angle(np.diff(self.waypoints[:, 3:], axis=0)), axis=1)
         self.remaining = np.append(np.cumsum(steps[::-1])[::-1], 0.0)
         v = np.zeros(Parameter.SIZE)
 
@@ -202,7 +214,7 @@ class PajakLaw:
         waypoint is reachable (a wrist-singular pose counts as reachable)."""
         for k, pose in enumerate(self.waypoints):
             try:
-                robot.inverse_kinematics_all(pose)
+                self.kinematics.inverse_kinematics_all(pose)
             except SingularConfigurationError:
                 continue
             except ValueError as exc:

@@ -9,8 +9,8 @@ from drake_traj.planners.pajak.integration import integrate
 from drake_traj.planners.pajak.kernel import Discrete
 from drake_traj.planners.pajak.law import PajakLaw
 from drake_traj.planners.pajak.parameters import PajakConfig
-from drake_traj.robots import ur10e
-from drake_traj.robots.base import Robot
+from drake_traj.robots import UR10E, Robot
+from drake_traj.validation import finite_array
 
 __all__ = ["PajakPlanner", "make"]
 
@@ -29,15 +29,17 @@ class PajakPlanner(PlannerSystem):
     Args:
         parameters: the task and the law's settings.
         q_initial: joint positions at t = 0 [rad].
+        robot: the robot (:class:`PajakLaw`: the UR10e).
     """
 
     plans_online = True
 
-    def __init__(self, parameters: PajakConfig, q_initial):
-        self.law = PajakLaw(parameters)
+    def __init__(self, parameters: PajakConfig, q_initial, *, robot: Robot = UR10E):
+        self.law = PajakLaw(parameters, robot)
         update_period = self.law.parameters.update_period
         initial = self.law.initial_discrete()
-        super().__init__(ur10e._as_joint_vector(q_initial, "q_initial"), initial_scaling=float(initial[Discrete.C]))
+        super().__init__(finite_array(q_initial, "q_initial", "rad", shape=(robot.num_joints,)),
+                         initial_scaling=float(initial[Discrete.C]))
         self.task_state_index = self.DeclareDiscreteState(initial[Discrete.C0 + 1:])
         self.velocity_limit = self.law.qd_max
         self.acceleration_limit = self.law.qdd_max
@@ -94,8 +96,6 @@ class PajakPlanner(PlannerSystem):
 
 
 def make(config: PajakConfig, robot: Robot, q_initial) -> PajakPlanner:
-    """The planner of ``config`` on ``robot`` (the UR10e: the law uses its closed-form task
-    kinematics), starting at rest at ``q_initial`` [rad]."""
-    if robot.name != ur10e.UR10E.name:
-        raise ValueError(f"the Pająk planner runs on the UR10e (closed-form task kinematics), not on {robot.name!r}")
-    return PajakPlanner(config, q_initial)
+    """The planner of ``config`` on ``robot`` (one with the task kinematics the compiled law is
+    bound to: the UR10e), starting at rest at ``q_initial`` [rad]."""
+    return PajakPlanner(config, q_initial, robot=robot)

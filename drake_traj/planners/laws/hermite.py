@@ -1,0 +1,100 @@
+"""A joint time law tabulated at knots and interpolated by quintic Hermite polynomials
+(:class:`HermiteLaw`), for laws that are costly to evaluate (Boryga's inverse kinematics at every
+instant). Joint positions in rad (m for prismatic joints), law time tau in s."""
+
+from __future__ import annotations
+
+from bisect import bisect_right
+from math import comb
+
+import numpy as np
+
+from drake_traj.planners.laws.polynomials import rate_peaks
+
+__all__ = ["HermiteLaw"]
+
+
+class HermiteLaw:
+    """A joint time law tabulated at knots, between them the quintic Hermite polynomial that meets
+    q, q̇ and q̈ at both ends (so q̈ is continuous except where the samples on both sides of a
+    knot differ, the law's ``acceleration_jumps``). ``rates_at`` costs a bisection and two small
+    polynomial evaluations, whatever the tabulated law cost.
+
+    Args:
+        knots: increasing law times [s], (K,), from 0 to the law's duration.
+        right: (q, q̇, q̈) just after each knot, (K, 3, n); row K-1 is not used.
+        left: (q, q̇, q̈) just before each knot, (K, 3, n); row 0 is not used. Where the law is
+            continuous it equals ``right``.
+        acceleration_jumps: the knots where q̈ jumps (for :class:`TimeLawPlanner`).
+    """
+
+    def __init__(self, knots, right, left, acceleration_jumps=()):
+        knots = np.asarray(knots, dtype=float)
+        right, left = np.asarray(right, dtype=float), np.asarray(left, dtype=float)
+        if knots.ndim != 1 or len(knots) < 2 or np.any(np.diff(knots) <= 0) or knots[0] != 0.0:
+            raise ValueError(f"knots must increase from 0, got {len(knots)} knots")
+        self.knots = knots
+        self.duration = float(knots[-1])
+        self.q_start = right[0, 0].copy()
+        self.acceleration_jumps = np.asarray(acceleration_jumps, dtype=float)
+        h = np.diff(knots)[:, None]
+        (q0, v0, a0), (q1, v1, a1) = np.moveaxis(right[:-1], 1, 0), np.moveaxis(left[1:], 1, 0)
+        delta = q1 - q0
+        # quintic Hermite in s = tau - knot, monomial coefficients c0..c5, (K-1, 6, n)
+        self._coefficients = np.stack([
+            q0, v0, 0.5 * a0,
+            (20 * delta - (8 * v1 + 12 * v0) * h - (3 * a0 - a1) * h**2) / (2 * h**3),
+            (-30 * delta + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h**2) / (2 * h**4),
+            (12 * delta - 6 * (v1 + v0) * h + (a1 - a0) * h**2) / (2 * h**5),
+        ], axis=1)
+        # (q̇, q̈) at s as one product, powers (1, s, s², s³, s⁴) @ [j c_j | j (j - 1) c_j]: (K-1, 5, 2n)
+        first = np.arange(1, 6)[None, :, None] * self._coefficients[:, 1:]
+        second = np.arange(1, 5)[None, :, None] * first[:, 1:]
+        self._rate_coefficients = np.concatenate([first, np.pad(second, ((0, 0), (0, 1), (0, 0)))], axis=2)
+        self._end = left[-1].copy()
+
+    def interval_polynomials(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """q̇ and q̈ on each knot interval as polynomials in sigma in [-1, 1] (tau = mid + sigma
+        half): (mid [s] (K-1,), half [s] (K-1,), q̇ coefficients (5, K-1, n), q̈ coefficients
+        (4, K-1, n)), for :func:`~drake_traj.planners.laws.polynomials.rate_peaks`."""
+        half = 0.5 * np.diff(self.knots)
+        scale = half[:, None]
+        # q(sigma) = sum_k e_k sigma^k with s = half (1 + sigma): e_k = sum_j C(j, k) c_j half^j
+        position = np.stack([sum(comb(j, k) * self._coefficients[:, j] * scale**j for j in range(k, 6))
+                             for k in range(6)])
+        velocity = np.stack([(k + 1) * position[k + 1] / scale for k in range(5)])
+        acceleration = np.stack([(k + 1) * velocity[k + 1] / scale for k in range(4)])
+        return self.knots[:-1] + half, half, velocity, acceleration
+
+    def peak_rates(self) -> tuple[np.ndarray, np.ndarray]:
+        """(max |q̇|, max |q̈|) over the whole law per joint, exact to round-off (interval ends,
+        both sides of every jump, and the extrema inside each interval)."""
+        _, _, velocity, acceleration = self.interval_polynomials()
+        v_peak, _, a_peak, _ = rate_peaks(velocity, acceleration)
+        return v_peak.max(axis=0), a_peak.max(axis=0)
+
+    def _interval(self, tau: float) -> tuple[int, float]:
+        k = min(max(bisect_right(self.knots, tau) - 1, 0), len(self.knots) - 2)
+        return k, tau - self.knots[k]
+
+    def sample(self, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q, q̇, q̈) at law time ``tau`` [s]; at rest at the ends outside [0, duration]."""
+        if tau >= self.duration:
+            return self._end[0].copy(), np.zeros_like(self._end[0]), np.zeros_like(self._end[0])
+        k, s = self._interval(max(tau, 0.0))
+        c = self._coefficients[k]
+        powers = s ** np.arange(6)
+        q = powers @ c
+        if tau < 0.0:
+            return q, np.zeros_like(q), np.zeros_like(q)
+        return q, (np.arange(1, 6) * powers[:5]) @ c[1:], (np.array([2, 6, 12, 20]) * powers[:4]) @ c[2:]
+
+    def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
+        """(q̇, q̈) at law time ``tau`` [s] (the planner's hot path: one 5 × 2n product)."""
+        n = self._end.shape[1]
+        if tau >= self.duration or tau < 0.0:
+            return np.zeros(n), np.zeros(n)
+        k, s = self._interval(tau)
+        s2 = s * s
+        rates = np.array((1.0, s, s2, s2 * s, s2 * s2)) @ self._rate_coefficients[k]
+        return rates[:n], rates[n:]

@@ -1,0 +1,39 @@
+"""The synchronised quintic planner system: :class:`QuinticPtpPlanner`, a thin
+:class:`~drake_traj.planners.base.TimeLawPlanner` around a :class:`~.law.QuinticLaw`."""
+
+import numpy as np
+
+from drake_traj.planners.base import TimeLawPlanner
+from drake_traj.planners.quintic.law import QuinticLaw
+from drake_traj.planners.quintic.profile import UNITS
+from drake_traj.robots import UR10E, Robot
+from drake_traj.validation import instance_of, joint_limit
+
+__all__ = ["QuinticPtpPlanner"]
+
+
+class QuinticPtpPlanner(TimeLawPlanner):
+    """Planner system for a :class:`QuinticLaw`: a :class:`TimeLawPlanner` whose waypoints are
+    the flange positions at the joint goals.
+
+    Args:
+        plan: the joint-space plan (from :func:`plan_synchronized_quintic`).
+        velocity_limit, acceleration_limit: the limits the plan was made for [rad/s, rad/s^2].
+        update_period: how often the speed override is read [s].
+        robot: the robot (for the tool positions at the goals).
+    """
+
+    def __init__(self, plan: QuinticLaw, velocity_limit, acceleration_limit, *, update_period: float = 0.001,
+                 robot: Robot = UR10E):
+        instance_of(plan, QuinticLaw, "plan")
+        super().__init__(
+            plan,
+            joint_limit(velocity_limit, "velocity_limit", plan.num_joints, UNITS),
+            joint_limit(acceleration_limit, "acceleration_limit", plan.num_joints, UNITS),
+            update_period=update_period,
+        )
+        self.robot = robot
+
+    def task_waypoints(self) -> np.ndarray:
+        """Tool positions at the joint goals [m]."""
+        return self.robot.tool_position(np.array([segment.q_goal for segment in self.law.segments]))
