@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drake_traj.errors import DrakeTrajError, joint_label
+from drake_traj.errors import DrakeTrajError, field_text, joint_label
 
 
 def field_of(name: str, *index: int) -> tuple:
@@ -24,6 +24,16 @@ def field_of(name: str, *index: int) -> tuple:
 def invalid(name: str, message: str, *index: int) -> DrakeTrajError:
     """The error for the argument or field ``name`` (at ``index``): its text is ``message``."""
     return DrakeTrajError(message, field=field_of(name, *index))
+
+
+def at_field(error: ValueError, name: str, *index: int) -> DrakeTrajError:
+    """``error`` (about a value) passed on at the field ``name`` (and ``index``), its text
+    prefixed with the field (``points[2]: ...``), its cause kept."""
+    field = field_of(name, *index)
+    message = f"{field_text(field) or name}: {error}"
+    if isinstance(error, DrakeTrajError):
+        return error.relocated(field, message)
+    return DrakeTrajError(message, field=field)
 
 
 def _first_non_number(value):
@@ -93,11 +103,7 @@ def finite_array(value, name: str, unit: str, *, shape: tuple | None = None) -> 
     array = real_array(value, name, unit)
     if shape is not None and array.shape != shape:
         raise invalid(name, f"{name} must have shape {shape} [{unit}], got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
-        bad = np.argwhere(~np.isfinite(np.atleast_1d(array)))[0]
-        where = "" if array.ndim == 0 else "[" + ", ".join(str(int(i)) for i in bad) + "]"
-        index = [int(i) for i in bad] if array.ndim else []
-        raise invalid(name, f"{name}{where} must be finite [{unit}], got {np.atleast_1d(array)[tuple(bad)]}", *index)
+    require_finite(array, name, unit)
     return array
 
 
@@ -181,28 +187,28 @@ def float_array(value, name: str, unit: str) -> np.ndarray:
     try:
         return np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be an array of real numbers [{unit}]: {exc}") from exc
+        raise invalid(name, f"{name} must be an array of real numbers [{unit}]: {exc}") from exc
 
 
 def require_finite(array: np.ndarray, name: str, unit: str = "") -> None:
-    """ValueError naming the first non-finite entry of ``array`` (its index, and ``unit`` where
-    given)."""
+    """A :class:`DrakeTrajError` at the first non-finite entry of ``array`` (its index, and
+    ``unit`` where given)."""
     if not np.all(np.isfinite(array)):
         bad = np.argwhere(~np.isfinite(np.atleast_1d(array)))[0]
-        where = "" if array.ndim == 0 else "[" + ", ".join(str(int(i)) for i in bad) + "]"
+        index = [int(i) for i in bad] if array.ndim else []
+        where = "".join(f"[{i}]" for i in index) if len(index) < 2 else f"[{', '.join(map(str, index))}]"
         value = np.atleast_1d(array)[tuple(bad)]
-        raise ValueError(f"{name}{where} must be finite{f' [{unit}]' if unit else ''}, got {value}")
+        raise invalid(name, f"{name}{where} must be finite{f' [{unit}]' if unit else ''}, got {value}", *index)
 
 
 def require_positive(array: np.ndarray, name: str) -> None:
-    """ValueError naming the first entry of ``array`` that is not > 0 (its index and joint,
-    counted from 0)."""
+    """A :class:`DrakeTrajError` at the first entry of the per-joint ``array`` that is not > 0
+    (its index and joint)."""
     if np.any(array <= 0.0):
         if array.ndim == 0:
-            raise ValueError(f"{name} must be > 0, got {float(array)}")
-        bad = np.argwhere(array <= 0.0)[0]
-        where = ", ".join(str(int(i)) for i in bad)
-        raise ValueError(f"{name}[{where}] (joint {where}) must be > 0, got {float(array[tuple(bad)])}")
+            raise invalid(name, f"{name} must be > 0, got {float(array)}")
+        j = int(np.argmax(array <= 0.0))
+        raise invalid(name, f"{name}[{j}] ({joint_label(j)}) must be > 0, got {float(array[j])}", j)
 
 
 def joint_bound(value, name: str, num_joints: int, unit: str) -> np.ndarray:
@@ -211,13 +217,13 @@ def joint_bound(value, name: str, num_joints: int, unit: str) -> np.ndarray:
     if array.ndim == 0:
         array = np.full(num_joints, float(array))
     elif array.shape != (num_joints,):
-        raise ValueError(f"{name} must be a scalar or have shape ({num_joints},), got shape {array.shape}")
+        raise invalid(name, f"{name} must be a scalar or have shape ({num_joints},), got shape {array.shape}")
     require_finite(array, name)
     return array
 
 
 def joint_limit(value, name: str, num_joints: int, unit: str) -> np.ndarray:
-    """A per-joint limit: as :func:`joint_bound`, and > 0 (joints counted from 0)."""
+    """A per-joint limit: as :func:`joint_bound`, and > 0."""
     array = joint_bound(value, name, num_joints, unit)
     require_positive(array, name)
     return array
@@ -225,13 +231,13 @@ def joint_limit(value, name: str, num_joints: int, unit: str) -> np.ndarray:
 
 def joint_limit_with_unit(value, name: str, unit: str, num_joints: int) -> np.ndarray:
     """A per-joint limit: a scalar (every joint) or shape (num_joints,), finite and > 0, read as
-    numpy reads it (:func:`float_array`); the messages give ``unit`` and count joints from 1."""
+    numpy reads it (:func:`float_array`); the messages give ``unit``."""
     array = float_array(value, name, unit)
     if array.ndim != 0 and array.shape != (num_joints,):
-        raise ValueError(f"{name} must be a scalar or have shape ({num_joints},) [{unit}], got shape {array.shape}")
+        raise invalid(name, f"{name} must be a scalar or have shape ({num_joints},) [{unit}], got shape {array.shape}")
     require_finite(array, name, unit)
     array = np.broadcast_to(array, (num_joints,)).copy()
     if np.any(array <= 0.0):
         j = int(np.argmax(array <= 0.0))
-        raise ValueError(f"{name}[{j}] (joint {j + 1}) must be > 0 [{unit}], got {array[j]}")
+        raise invalid(name, f"{name}[{j}] ({joint_label(j)}) must be > 0 [{unit}], got {array[j]}", j)
     return array

@@ -95,7 +95,7 @@ YAML_CASES = [
      r"planner.velocity_limit must be a scalar or have shape \(6,\)"),
     ("limit infinite", quintic("  acceleration_limit: [1.40, ", "  acceleration_limit: [.inf, "), r"planner.acceleration_limit\[0\].*finite"),
     ("goal row too short", quintic("    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]", "    - [-0.9, -1.9, -1.9, -0.9, 1.2]"), r"planner.goals"),
-    ("goal out of range", quintic("    - [-0.9, -1.9", "    - [-6.9, -1.9"), r"goals\[0\] joint 0 = -6.9 rad"),
+    ("goal out of range", quintic("    - [-0.9, -1.9", "    - [-6.9, -1.9"), r"goals\[0\]\[0\] \(joint 1\) = -6.9 rad"),
     ("goals empty", quintic("  goals:\n", "  goals: []\n  goals_removed:\n"), r"planner.goals_removed: unknown field"),
     ("goals scalar", quintic("  goals:\n    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]\n", "  goals: 3\n  unused:\n    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]\n"),
      r"planner.goals: expected a list, found an integer"),

@@ -47,7 +47,7 @@ def test_default_scenario_is_shipped_with_the_package():
         (("q_initial: [-1.5707963267948966", "q_initial: [7.0"), r"q_initial\[0\] = 7.0 rad is outside"),
         (("velocity_limit: [1.05, ", "velocity_limit: [0.0, "), r"velocity_limit\[0\].*> 0"),
         (("acceleration_limit: [1.40, ", "acceleration_limit: [-1.0, "), r"acceleration_limit\[0\].*> 0"),
-        (("    - [-0.9, -1.9", "    - [-6.9, -1.9"), r"goals\[0\] joint 0 = -6.9 rad"),
+        (("    - [-0.9, -1.9", "    - [-6.9, -1.9"), r"planner.goals\[0\]\[0\] \(joint 1\) = -6.9 rad"),
         (("    - [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]", "    - [-0.9, -1.9, -1.9, -0.9, 1.2]"), r"goals"),
         (("    - [-0.9, -1.9", "    - [.inf, -1.9"), r"goals.*finite"),
         (("  kp: [4000, ", "  kp: [-4000, "), r"controller.kp"),

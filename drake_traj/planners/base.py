@@ -31,7 +31,7 @@ from pydrake.systems.framework import BasicVector, ContinuousStateIndex, EventSt
 
 from drake_traj.planners.laws.contract import missing_members
 from drake_traj.planners.laws.scaling import admissible_clock_rate, clock_at, next_clock_rate
-from drake_traj.validation import finite_array
+from drake_traj.validation import finite_array, invalid
 
 _DID_NOTHING = EventStatus.DidNothing()  # returned by the time-law update in the common case
 
@@ -230,7 +230,7 @@ class TimeLawPlanner(PlannerSystem):
             raise ValueError(f"speed_cap must be in (0, 1], got {speed_cap}")
         for name, value in (("update_period", update_period), ("scaling_rate", scaling_rate), ("clock_jerk", clock_jerk)):
             if not np.isfinite(value) or value <= 0:
-                raise ValueError(f"{name} must be a positive number, got {value}")
+                raise invalid(name, f"{name} must be a positive number, got {value}")
         super().__init__(law.q_start, initial_scaling=speed_cap)
         self.law = law
         self.speed_cap = float(speed_cap)
@@ -361,7 +361,7 @@ def start_and_goals(q_initial, goals, num_joints: int) -> np.ndarray:
     start = finite_array(q_initial, "q_initial", "rad", shape=(num_joints,))
     rows = finite_array(goals, "goals", "rad")
     if rows.size == 0:
-        raise ValueError("goals must have at least one row of joint positions, got none")
+        raise invalid("goals", "goals must have at least one row of joint positions, got none")
     if rows.ndim != 2 or rows.shape[1] != num_joints:
-        raise ValueError(f"goals must have shape (m, {num_joints}), got shape {rows.shape}")
+        raise invalid("goals", f"goals must have shape (m, {num_joints}), got shape {rows.shape}")
     return np.vstack([start, rows])

@@ -21,7 +21,8 @@ import numpy as np
 from pydrake.multibody.parsing import Parser
 
 from drake_traj.data import data_directory
-from drake_traj.validation import real_array
+from drake_traj.errors import Cause, DrakeTrajError
+from drake_traj.validation import invalid, real_array
 
 __all__ = ["LIMIT_TOL", "PointRobot", "Robot", "TaskKinematics"]
 
@@ -42,9 +43,9 @@ def joint_vectors(q, size: int, name: str = "q", *, finite: bool = True) -> np.n
     False), or ValueError naming ``name``."""
     array = real_array(q, name, "rad or m")
     if array.ndim == 0 or array.shape[-1] != size:
-        raise ValueError(f"{name} must have shape (..., {size}) [rad or m], got {array.shape}")
+        raise invalid(name, f"{name} must have shape (..., {size}) [rad or m], got {array.shape}")
     if finite and not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be finite")
+        raise invalid(name, f"{name} must be finite")
     return array
 
 
@@ -309,7 +310,7 @@ class PointRobot(Robot):
         p = point_array(positions).reshape(-1, 3)
         problems = self._solve(p)[1]
         if problems:
-            raise ValueError(self._message(p, problems, label, times))
+            raise DrakeTrajError(self._message(p, problems, label, times), cause=Cause.UNREACHABLE)
 
     def _message(self, p, problems, label, times) -> str:
         index, reason = problems[0]
@@ -356,5 +357,5 @@ class PointRobot(Robot):
         flat = p.reshape(-1, 3)
         q, problems = self._solve(flat)
         if problems:
-            raise ValueError(self._message(flat, problems, label, times))
+            raise DrakeTrajError(self._message(flat, problems, label, times), cause=Cause.UNREACHABLE)
         return q.reshape(p.shape[:-1] + (self.num_joints,))

@@ -46,6 +46,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from drake_traj.errors import SingularConfigurationError
 from drake_traj.robots.base import LIMIT_TOL, PointRobot, format_point, joint_vectors, stack_columns
 
 __all__ = [
@@ -86,7 +87,7 @@ class _PaperRobot(PointRobot):
         singular = np.flatnonzero(measure < _SINGULAR_TOL)
         if singular.size:
             index = int(singular[0])
-            raise ValueError(
+            raise SingularConfigurationError(
                 f"point {index} at q = {format_point(q[index])}: the {self.name} robot's Jacobian is singular "
                 f"(singularity measure {measure[index]:.3g}), joint rates are undefined"
             )

@@ -18,9 +18,9 @@ from typing import ClassVar
 import numpy as np
 
 from drake_traj.compiled import compiled
-from drake_traj.errors import SingularConfigurationError
+from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError, joint_label
 from drake_traj.robots.base import Robot, TaskKinematics
-from drake_traj.validation import real_array
+from drake_traj.validation import invalid, real_array
 
 __all__ = ["UR10E", "UR10e"]
 
@@ -68,9 +68,9 @@ def model_path() -> Path:
 def _as_joint_vector(q, name: str = "q") -> np.ndarray:
     q = real_array(q, name, "rad")
     if q.shape != (NUM_JOINTS,):
-        raise ValueError(f"{name} must have shape ({NUM_JOINTS},), got {q.shape}")
+        raise invalid(name, f"{name} must have shape ({NUM_JOINTS},), got {q.shape}")
     if not np.all(np.isfinite(q)):
-        raise ValueError(f"{name} must be finite, got {q}")
+        raise invalid(name, f"{name} must be finite, got {q}")
     return q
 
 
@@ -460,7 +460,7 @@ def _as_flange_pose(pose, name: str = "pose") -> np.ndarray:
     pose = np.asarray(pose, dtype=float)
     if pose.shape == (6,):
         if not np.all(np.isfinite(pose)):
-            raise ValueError(f"{name} must be finite, got {pose}")
+            raise invalid(name, f"{name} must be finite, got {pose}")
         out = np.eye(4)
         out[:3, :3] = rotation_from_zyx_euler(pose[3:])
         out[:3, 3] = pose[:3]
@@ -470,9 +470,9 @@ def _as_flange_pose(pose, name: str = "pose") -> np.ndarray:
             f"{name} must be a 4x4 transform or a task pose of shape (6,), got shape {pose.shape}"
         )
     if not np.all(np.isfinite(pose)):
-        raise ValueError(f"{name} must be finite, got {pose.tolist()}")
+        raise invalid(name, f"{name} must be finite, got {pose.tolist()}")
     if not np.allclose(pose[3], [0.0, 0.0, 0.0, 1.0], atol=1e-12, rtol=0.0):
-        raise ValueError(f"{name} must have last row [0, 0, 0, 1], got {pose[3].tolist()}")
+        raise invalid(name, f"{name} must have last row [0, 0, 0, 1], got {pose[3].tolist()}")
     rotation = pose[:3, :3]
     orthogonality = np.max(np.abs(rotation.T @ rotation - np.eye(3)))
     if orthogonality > 1e-6 or np.linalg.det(rotation) <= 0.0:
@@ -498,9 +498,9 @@ def _ik_solve(pose: np.ndarray, tol: float):
     h_sq = r * r - _D4 * _D4
     reach = abs(_A2) + abs(_A3)
     if h_sq < -(tol * reach) ** 2:
-        raise ValueError(
+        raise DrakeTrajError(
             f"{_describe_pose(pose)} is out of reach: the wrist centre (flange - d6 z) is "
-            f"{r:.6g} m from the joint-1 axis, closer than the shoulder offset d4 = {_D4} m"
+            f"{r:.6g} m from the joint-1 axis, closer than the shoulder offset d4 = {_D4} m", cause=Cause.UNREACHABLE
         )
     h_abs = math.sqrt(max(h_sq, 0.0))
     shoulder_singular = h_abs < tol * reach
@@ -553,10 +553,10 @@ def _ik_solve(pose: np.ndarray, tol: float):
         centre = math.hypot(r, o5[2] - _D1)
         max_centre = math.hypot(reach + _D5, _D4)
         reasons = "; ".join(dict.fromkeys(failures.values()))
-        raise ValueError(
+        raise DrakeTrajError(
             f"{_describe_pose(pose)} is out of reach: the wrist centre (flange - d6 z) is {centre:.6g} m "
-            f"from the shoulder point (0, 0, d1) (the arm reaches at most {max_centre:.6g} m); {reasons}"
-        )
+            f"from the shoulder point (0, 0, d1) (the arm reaches at most {max_centre:.6g} m); {reasons}",
+            cause=Cause.UNREACHABLE)
     return solutions, failures, flags
 
 
@@ -645,9 +645,9 @@ def inverse_kinematics(
                 f"folded): the elbow branch is undefined"
             )
         if branch not in solutions:
-            raise ValueError(
+            raise DrakeTrajError(
                 f"{_describe_pose(pose)} is out of reach of branch (shoulder, elbow, wrist) = {branch}: "
-                f"{failures.get(branch, 'no real solution')}"
+                f"{failures.get(branch, 'no real solution')}", cause=Cause.UNREACHABLE
             )
         candidates = [solutions[branch]]
     else:
@@ -686,13 +686,13 @@ def inverse_kinematics_path(
         except SingularConfigurationError as err:
             raise SingularConfigurationError(f"path sample {i}: {err}") from err
         except ValueError as err:
-            raise ValueError(f"path sample {i}: {err}") from err
+            raise DrakeTrajError(f"path sample {i}: {err}", cause=getattr(err, "cause", None)) from err
         step = np.abs(q - q_prev)
         if np.max(step) > max_step:
             joint = int(np.argmax(step))
             where = "q_start" if i == 0 else f"sample {i - 1}"
-            raise ValueError(
-                f"path sample {i}: joint {joint + 1} moves {step[joint]:.4g} rad from {where} "
+            raise DrakeTrajError(
+                f"path sample {i}: {joint_label(joint, JOINT_NAMES)} moves {step[joint]:.4g} rad from {where} "
                 f"(limit {max_step} rad): the path leaves the branch {ik_branch(q_prev)} "
                 f"(now {ik_branch(q)}) or is sampled too coarsely"
             )

@@ -451,15 +451,15 @@ GOALS = np.array([[0.5, 0.2, -0.3, 0.0, 0.1, 0.4], [1.0, -0.5, 0.3, 0.2, 0.0, -0
         ({"goals": "abc"}, r"goals"),
         ({"q_start": np.zeros((1, 6))}, r"q_start must have shape \(n,\)"),
         ({"q_start": [0, 0, np.inf, 0, 0, 0]}, r"q_start\[2\] must be finite"),
-        ({"velocity_limit": [1, 1, 1, 0.0, 1, 1]}, r"velocity_limit\[3\] \(joint 3\) must be > 0"),
-        ({"velocity_limit": -1.0}, r"velocity_limit\[0\] \(joint 0\) must be > 0"),
+        ({"velocity_limit": [1, 1, 1, 0.0, 1, 1]}, r"velocity_limit\[3\] \(joint 4\) must be > 0"),
+        ({"velocity_limit": -1.0}, r"velocity_limit\[0\] \(joint 1\) must be > 0"),
         ({"velocity_limit": np.ones(5)}, r"velocity_limit must be a scalar or have shape \(6,\)"),
         ({"velocity_limit": np.nan}, r"velocity_limit\[0\] must be finite"),
-        ({"acceleration_limit": [1, 1, 1, 1, 1, -2.0]}, r"acceleration_limit\[5\] \(joint 5\)"),
+        ({"acceleration_limit": [1, 1, 1, 1, 1, -2.0]}, r"acceleration_limit\[5\] \(joint 6\)"),
         ({"acceleration_limit": np.inf}, r"acceleration_limit\[0\] must be finite"),
-        ({"position_upper": 0.9}, r"goals\[1\] joint 0 = 1.0 rad is above position_upper\[0\]"),
-        ({"position_lower": -0.4}, r"goals\[1\] joint 1 = -0.5 rad is below position_lower\[1\]"),
-        ({"position_lower": 0.05}, r"q_start joint 0 = 0.0 rad is below position_lower\[0\]"),
+        ({"position_upper": 0.9}, r"goals\[1\]\[0\] \(joint 1\) = 1.0 rad is above position_upper\[0\]"),
+        ({"position_lower": -0.4}, r"goals\[1\]\[1\] \(joint 2\) = -0.5 rad is below position_lower\[1\]"),
+        ({"position_lower": 0.05}, r"q_start\[0\] \(joint 1\) = 0.0 rad is below position_lower\[0\]"),
         (
             {"position_lower": [-1, -1, 2, -1, -1, -1], "position_upper": 1.0},
             r"position_lower\[2\] = 2.0 is above position_upper\[2\]",
@@ -475,7 +475,7 @@ def test_plan_rejects_bad_inputs(kwargs, pattern):
 
 
 def test_functions_reject_bad_inputs():
-    with pytest.raises(ValueError, match=r"velocity_limit\[1\] \(joint 1\) must be > 0"):
+    with pytest.raises(ValueError, match=r"velocity_limit\[1\] \(joint 2\) must be > 0"):
         joint_minimum_times([1.0, 1.0], [1.0, 0.0], 1.0)
     with pytest.raises(ValueError, match=r"acceleration_limit must be > 0"):
         joint_minimum_times(1.0, 1.0, 0.0)

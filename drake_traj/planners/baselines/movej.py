@@ -48,7 +48,7 @@ import numpy as np
 
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.robots import UR10E, Robot
-from drake_traj.validation import instance_of, limit_or_default, positive_vector
+from drake_traj.validation import instance_of, invalid, limit_or_default, positive_vector
 
 __all__ = [
     "MovejBlendLaw",
@@ -129,9 +129,9 @@ class MovejBlendLaw:
         try:
             radius = float(blend_radius)
         except (TypeError, ValueError) as exc:
-            raise ValueError(f"blend_radius must be a number of metres: {exc}") from exc
+            raise invalid("blend_radius", f"blend_radius must be a number of metres: {exc}") from exc
         if not np.isfinite(radius) or radius < 0.0:
-            raise ValueError(f"blend_radius must be finite and >= 0 [m], got {blend_radius}")
+            raise invalid("blend_radius", f"blend_radius must be finite and >= 0 [m], got {blend_radius}")
         self.blend_radius = radius
         if tcp_position is None:
             if radius > 0.0 and n != UR10E.num_joints:

@@ -35,7 +35,7 @@ from pydrake.trajectories import PathParameterizedTrajectory, PiecewisePolynomia
 
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.robots import Robot
-from drake_traj.validation import limit_or_default, positive_vector, real_array, whole_number
+from drake_traj.validation import invalid, limit_or_default, positive_vector, real_array, whole_number
 
 __all__ = [
     "ToppraLaw",
@@ -164,7 +164,7 @@ def time_optimal_along_path(
     ka = positive_vector(acceleration_limit, "acceleration_limit", n)
     s0, s1 = path.start_time(), path.end_time()
     if not s1 > s0:
-        raise ValueError(f"path must have a positive length in s, got [{s0}, {s1}]")
+        raise invalid("path", f"path must have a positive length in s, got [{s0}, {s1}]")
     if plant is None:
         plant = _joint_chain_plant(n)
     elif plant.num_positions() != n or plant.num_velocities() != n:

@@ -9,7 +9,7 @@ from drake_traj.planners.boryga.path import plan_loop_path
 from drake_traj.planners.boryga.placements import PAPER_LOOP, PLACED_ROBOTS, paper_loop_placement
 from drake_traj.planners.boryga.system import BorygaLoopPlanner
 from drake_traj.robots import Robot
-from drake_traj.validation import limit_or_default, real_array
+from drake_traj.validation import at_field, invalid, limit_or_default, real_array
 
 __all__ = ["BorygaConfig", "make"]
 
@@ -46,12 +46,12 @@ def make(config: BorygaConfig, robot: Robot, q_initial) -> BorygaLoopPlanner:
     points = [real_array(getattr(config, name), name, "m") for name in ("B", "M", "E")]
     if any(point.size for point in points):
         if not all(point.shape == (3,) for point in points):
-            raise ValueError(f"B, M and E must all be 3-vectors [m] or all empty, got {[p.tolist() for p in points]}")
+            raise invalid("B", f"B, M and E must all be 3-vectors [m] or all empty, got {[p.tolist() for p in points]}")
         for name, point in zip(("B", "M", "E"), points):  # named before the path between them is solved
             try:
                 robot.point_ik(point[None], q_initial)
             except ValueError as error:
-                raise ValueError(f"{name}: {error}") from error
+                raise at_field(error, name) from error
     elif robot.name in PLACED_ROBOTS:
         placement = paper_loop_placement(robot.name)
         points = [placement.B, placement.M, placement.E]

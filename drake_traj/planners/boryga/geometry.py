@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from drake_traj.validation import finite_array, positive_scalar
+from drake_traj.validation import finite_array, invalid, positive_scalar
 
 __all__ = ["LoopGeometry", "loop_geometry"]
 
@@ -150,9 +150,9 @@ def loop_geometry(B, M, E, delta=None, radius=None) -> LoopGeometry:
     norm_a = float(np.linalg.norm(a))
     norm_d = float(np.linalg.norm(d))
     if norm_a == 0.0:
-        raise ValueError(f"B and M coincide (both {M}): segment BM has no length, no corner")
+        raise invalid("B", f"B and M coincide (both {M}): segment BM has no length, no corner")
     if norm_d == 0.0:
-        raise ValueError(f"E and M coincide (both {M}): segment ME has no length, no corner")
+        raise invalid("E", f"E and M coincide (both {M}): segment ME has no length, no corner")
     a_hat = a / norm_a
     d_hat = d / norm_d
     cross = np.cross(a_hat, d_hat)

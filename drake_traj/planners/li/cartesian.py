@@ -33,7 +33,7 @@ from enum import IntEnum
 
 import numpy as np
 
-from drake_traj.validation import finite_array, nonnegative_scalar, positive_scalar
+from drake_traj.validation import finite_array, invalid, nonnegative_scalar, positive_scalar
 
 __all__ = [
     "AccDecCase",
@@ -66,7 +66,7 @@ _RTOL = 1e-9
 def _vector(value, name: str, unit: str) -> np.ndarray:
     array = finite_array(value, name, unit)
     if array.ndim != 1:
-        raise ValueError(f"{name} must have shape (n,), got shape {array.shape}")
+        raise invalid(name, f"{name} must have shape (n,), got shape {array.shape}")
     return array
 
 
@@ -75,12 +75,12 @@ def _polyline(points) -> np.ndarray:
     try:
         array = np.array(points, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"points must be an (N, 3) array of real numbers [m]: {exc}") from exc
+        raise invalid("points", f"points must be an (N, 3) array of real numbers [m]: {exc}") from exc
     if array.ndim != 2 or array.shape[1] != 3:
-        raise ValueError(f"points must have shape (N, 3) [m], got shape {array.shape}")
+        raise invalid("points", f"points must have shape (N, 3) [m], got shape {array.shape}")
     if not np.all(np.isfinite(array)):
         i, j = (int(k) for k in np.argwhere(~np.isfinite(array))[0])
-        raise ValueError(f"points[{i}, {j}] must be finite [m], got {array[i, j]}")
+        raise invalid("points", f"points[{i}, {j}] must be finite [m], got {array[i, j]}", i, j)
     if len(np.unique(array, axis=0)) < 2:
         raise ValueError(
             f"points must contain at least two distinct points, got {len(array)} point(s) and "
@@ -333,7 +333,7 @@ def _segment_inputs(length, v_start, v_end, v_max, a_max):
     v_e = nonnegative_scalar(v_end, "v_end", "m/s")
     for name, value in (("v_start", v_s), ("v_end", v_e)):
         if value > v_m * (1.0 + _RTOL):
-            raise ValueError(f"{name} = {value} m/s must be <= v_max = {v_m} m/s")
+            raise invalid(name, f"{name} = {value} m/s must be <= v_max = {v_m} m/s")
     v_s, v_e = min(v_s, v_m), min(v_e, v_m)
     l_min = abs(v_e**2 - v_s**2) / (2.0 * acc)  # eq. 8 with A
     if length < l_min * (1.0 - _RTOL):

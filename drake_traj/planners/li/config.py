@@ -8,7 +8,7 @@ from drake_traj.planners.li.path import li_closed_path
 from drake_traj.planners.li.plan import plan_li_path
 from drake_traj.planners.li.system import LiPathPlanner
 from drake_traj.robots import LI_4DOF, Robot
-from drake_traj.validation import limit_or_default, real_array
+from drake_traj.validation import at_field, invalid, limit_or_default, real_array
 
 __all__ = ["CARTESIAN_ACCELERATION_LIMIT", "CARTESIAN_VELOCITY_LIMIT", "LiConfig", "make"]
 
@@ -45,12 +45,12 @@ def make(config: LiConfig, robot: Robot, q_initial) -> LiPathPlanner:
     if np.size(config.points):
         points = real_array(config.points, "points", "m")
         if points.ndim != 2 or points.shape[1] != 3 or len(points) < 2:
-            raise ValueError(f"points must be a list of at least two [x, y, z] rows [m], got shape {points.shape}")
+            raise invalid("points", f"points must be a list of at least two [x, y, z] rows [m], got shape {points.shape}")
         for index, point in enumerate(points):  # named by its index before the path between them is solved
             try:
                 robot.point_ik(point[None], q_initial)
             except ValueError as error:
-                raise ValueError(f"points[{index}]: {error}") from error
+                raise at_field(error, "points", index) from error
     else:
         points = li_closed_path()
         if robot.name != LI_4DOF.name:

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
+from drake_traj.errors import joint_label
 from drake_traj.planners.li.cartesian import acc_dec_profile
 from drake_traj.planners.laws.polynomials import rate_peaks
 from drake_traj.validation import float_array, joint_limit_with_unit, require_finite
@@ -425,13 +426,13 @@ class LimitReport:
         for j in range(self.peak_velocity.size):
             if self.velocity_ratio[j] > 1.0 - self.margin:
                 lines.append(
-                    f"joint {j + 1}: |qd| = {self.peak_velocity[j]:.6g} rad/s at t = "
+                    f"{joint_label(j)}: |qd| = {self.peak_velocity[j]:.6g} rad/s at t = "
                     f"{self.peak_velocity_time[j]:.6g} s > limit {self.velocity_limit[j]:.6g} "
                     f"(x{self.velocity_ratio[j]:.4g})"
                 )
             if self.acceleration_ratio[j] > 1.0 - self.margin:
                 lines.append(
-                    f"joint {j + 1}: |qdd| = {self.peak_acceleration[j]:.6g} rad/s^2 at t = "
+                    f"{joint_label(j)}: |qdd| = {self.peak_acceleration[j]:.6g} rad/s^2 at t = "
                     f"{self.peak_acceleration_time[j]:.6g} s > limit "
                     f"{self.acceleration_limit[j]:.6g} (x{self.acceleration_ratio[j]:.4g})"
                 )

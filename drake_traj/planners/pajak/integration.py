@@ -8,10 +8,10 @@ import math
 
 import numpy as np
 
-from drake_traj.errors import PlanningError
+from drake_traj.errors import Cause, PlanningError
 from drake_traj.planners.pajak.kernel import Discrete, Evaluation, Log, Status, integrate_kernel
 from drake_traj.planners.pajak.law import PajakLaw
-from drake_traj.validation import finite_array
+from drake_traj.validation import finite_array, invalid
 
 __all__ = ["integrate"]
 
@@ -50,7 +50,7 @@ def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settl
         raise ValueError(f"law must be a PajakLaw, got {type(law).__name__}")
     for name, value, low in (("dt", dt, 0.0), ("t_max", t_max, 0.0)):
         if not np.isfinite(value) or value <= low:
-            raise ValueError(f"{name} must be a positive number of seconds, got {value}")
+            raise invalid(name, f"{name} must be a positive number of seconds, got {value}")
     if not np.isfinite(settle_time) or settle_time < 0:
         raise ValueError(f"settle_time must be a non-negative number of seconds, got {settle_time}")
     q0 = finite_array(q0, "q0", "rad", shape=(law.robot.num_joints,))
@@ -78,7 +78,7 @@ def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settl
             if not raise_on_timeout:
                 return result | {"T": np.nan, "finish_index": None, "error": np.nan, "orientation_error": np.nan}
             error = PlanningError(f"the task did not finish within t_max = {t_max} s", time=float(log[-1, Log.T]),
-                                  configuration=final[:6].copy(), cause="timeout")
+                                  configuration=final[:6].copy(), cause=Cause.TIMEOUT)
         else:  # failed at step ``count``, before its sample
             error = law.failure(status, count * dt, final[:6], final[12:], out)
         error.partial = result

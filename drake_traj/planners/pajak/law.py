@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from drake_traj.errors import PlanningError, SingularConfigurationError
+from drake_traj.errors import Cause, PlanningError, SingularConfigurationError
 from drake_traj.planners.pajak.kernel import (
     KINEMATICS,
     MIN_COS_PITCH,
@@ -209,7 +209,7 @@ class PajakLaw:
         return updated
 
     def reach_failure(self, q0) -> PlanningError | None:
-        """The :class:`PlanningError` (cause "unreachable", time 0) for the first waypoint whose
+        """The :class:`PlanningError` (cause UNREACHABLE, time 0, field ``("waypoints", k)``) for the first waypoint whose
         pose no IK branch of the UR10e reaches, naming it and the reason; None when every
         waypoint is reachable (a wrist-singular pose counts as reachable)."""
         for k, pose in enumerate(self.waypoints):
@@ -219,7 +219,8 @@ class PajakLaw:
                 continue
             except ValueError as exc:
                 return PlanningError(f"waypoint {k} cannot be reached: {exc}", time=0.0,
-                                     configuration=np.array(q0, dtype=float), cause="unreachable")
+                                     configuration=np.array(q0, dtype=float), cause=Cause.UNREACHABLE,
+                                     field=("waypoints", k))
         return None
 
     def finished(self, q, qd, discrete) -> bool:
@@ -235,11 +236,11 @@ class PajakLaw:
         if status == Status.SINGULAR:
             message = (f"Z-Y-X Euler angles are singular: phi_Y = {out[Evaluation.POSE + 4]:.6f} rad is at +-pi/2 "
                        "(gimbal lock), the analytic Jacobian has no inverse")
-            cause = "singular"
+            cause, field = Cause.SINGULAR, ()
         elif status == Status.NON_FINITE:
             message = (f"non-finite state or acceleration {out[Evaluation.QDD:Evaluation.QDD + 6].tolist()} "
                        f"(singularity measure {out[Evaluation.MEASURE]:.2e})")
-            cause = "non-finite"
+            cause, field = Cause.NON_FINITE, ()
         elif status == Status.STALL:
             near = " near a singular configuration" if out[Evaluation.MEASURE] < self.parameters.singularity_threshold \
                 else ""
@@ -249,10 +250,10 @@ class PajakLaw:
                 f"{np.round(out[Evaluation.POSE:Evaluation.POSE + 3], 4).tolist()}, c = {out[Evaluation.C]:.3g}, "
                 f"singularity measure {out[Evaluation.MEASURE]:.3g}"
             )
-            cause = "stall"
+            cause, field = Cause.STALL, ("waypoints", int(discrete[Discrete.WAYPOINT]))
         else:
             raise ValueError(f"status {status!r} is not a failure")
-        return PlanningError(message, time=float(t), configuration=q, cause=cause)
+        return PlanningError(message, time=float(t), configuration=q, cause=cause, field=field)
 
     def tcp_positions(self) -> np.ndarray:
         """Waypoint positions [m], (w, 3), for plots."""

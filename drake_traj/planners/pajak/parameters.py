@@ -6,7 +6,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from drake_traj.robots import ur10e as robot
-from drake_traj.validation import flag, positive_vector, real_array
+from drake_traj.validation import flag, invalid, positive_vector, real_array
+from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
 
 __all__ = ["PAPER_METHOD", "PajakConfig", "paper_initial_configuration", "paper_parameters"]
 
@@ -111,23 +112,22 @@ class PajakConfig:
         if waypoints.ndim == 1 and waypoints.shape == (6,):
             waypoints = waypoints[None, :]
         if waypoints.ndim != 2 or waypoints.shape[1] != 6 or waypoints.shape[0] == 0:
-            raise ValueError(f"waypoints must have shape (w, 6) with w >= 1, got shape {waypoints.shape}")
+            raise invalid("waypoints", f"waypoints must have shape (w, 6) with w >= 1, got shape {waypoints.shape}")
         if not np.all(np.isfinite(waypoints)):
             k = int(np.argwhere(~np.isfinite(waypoints))[0, 0])
-            raise ValueError(f"waypoints[{k}] must be finite, got {waypoints[k].tolist()}")
+            raise invalid("waypoints", f"waypoints[{k}] must be finite, got {waypoints[k].tolist()}", k)
         reach = np.linalg.norm(waypoints[:, :3] - SHOULDER, axis=1)
         if np.any(reach > REACH):
             k = int(np.argmax(reach > REACH))
-            raise ValueError(
+            raise DrakeTrajError(
                 f"waypoints[{k}] position {waypoints[k, :3].tolist()} is {reach[k]:.3f} m from the "
-                f"shoulder (0, 0, {_D1}), beyond the UR10e reach of {REACH} m"
-            )
+                f"shoulder (0, 0, {_D1}), beyond the UR10e reach of {REACH} m", field=("waypoints", k),
+                cause=Cause.UNREACHABLE)
         if np.any(np.abs(np.cos(waypoints[:, 4])) < 1e-3):
             k = int(np.argmax(np.abs(np.cos(waypoints[:, 4])) < 1e-3))
-            raise ValueError(
+            raise SingularConfigurationError(
                 f"waypoints[{k}] phi_Y = {waypoints[k, 4]:.4f} rad is at +-pi/2: Z-Y-X Euler angles are "
-                "singular (gimbal lock) there"
-            )
+                "singular (gimbal lock) there", field=("waypoints", k))
         values = {}
         for name in ("position_gain", "velocity_gain", "velocity_limit", "acceleration_limit"):
             values[name] = positive_vector(getattr(self, name), name, n)
@@ -138,27 +138,24 @@ class PajakConfig:
         ):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-                raise ValueError(f"{name} must be a real number, got {value!r}")
+                raise invalid(name, f"{name} must be a real number, got {value!r}")
             if not np.isfinite(value) or value <= 0:
-                raise ValueError(f"{name} must be finite and > 0, got {value}")
+                raise invalid(name, f"{name} must be finite and > 0, got {value}")
             values[name] = float(value)
         vartheta = self.vartheta
         if isinstance(vartheta, bool) or not isinstance(vartheta, (int, float, np.floating)) or not (
             0.0 < vartheta < 0.5
         ):
-            raise ValueError(f"vartheta must be a number in (0, 0.5), got {vartheta!r}")
+            raise invalid("vartheta", f"vartheta must be a number in (0, 0.5), got {vartheta!r}")
         if values["accuracy"] > values["neighbourhood"]:
-            raise ValueError(
-                f"accuracy ({values['accuracy']} m) must not be larger than neighbourhood "
-                f"({values['neighbourhood']} m)"
-            )
+            raise invalid("accuracy", f"accuracy ({values['accuracy']} m) must not be larger than neighbourhood "
+                                      f"({values['neighbourhood']} m)")
         steps = np.linalg.norm(np.diff(waypoints[:, :3], axis=0), axis=1)
         if np.any(steps < values["neighbourhood"]):
             k = int(np.argmax(steps < values["neighbourhood"]))
-            raise ValueError(
+            raise DrakeTrajError(
                 f"waypoints[{k}] and waypoints[{k + 1}] are {steps[k]:.4f} m apart, closer than the "
-                f"neighbourhood {values['neighbourhood']} m"
-            )
+                f"neighbourhood {values['neighbourhood']} m", field=("waypoints", k + 1), cause=Cause.INFEASIBLE)
         for name in (
             "limit_velocity", "limit_acceleration", "blend_waypoints", "smooth_penalty",
             "continuous_switching", "bounded_scaling", "damped_inverse", "preserve_damping",

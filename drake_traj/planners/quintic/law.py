@@ -8,8 +8,9 @@ from typing import ClassVar
 
 import numpy as np
 
+from drake_traj.errors import field_text, joint_label
 from drake_traj.planners.quintic.profile import UNITS, quintic_profile, quintic_third_derivative, synchronized_duration
-from drake_traj.validation import joint_bound, joint_limit, real_array, require_finite
+from drake_traj.validation import invalid, joint_bound, joint_limit, real_array, require_finite
 
 __all__ = ["QuinticLaw", "QuinticSegment", "plan_synchronized_quintic"]
 
@@ -273,12 +274,10 @@ def plan_synchronized_quintic(
     if goal_array.ndim == 1 and goal_array.shape == (n,):
         goal_array = goal_array[None, :]
     if goal_array.ndim != 2 or goal_array.shape[1] != n:
-        raise ValueError(
-            f"goals must have shape (m, {n}) or ({n},) to match q_start, "
-            f"got shape {goal_array.shape}"
-        )
+        raise invalid("goals", f"goals must have shape (m, {n}) or ({n},) to match q_start, "
+                               f"got shape {goal_array.shape}")
     if goal_array.shape[0] == 0:
-        raise ValueError(f"goals must contain at least one goal, got shape {goal_array.shape}")
+        raise invalid("goals", f"goals must contain at least one goal, got shape {goal_array.shape}")
     require_finite(goal_array, "goals")
 
     kv = joint_limit(velocity_limit, "velocity_limit", n, UNITS)
@@ -288,26 +287,18 @@ def plan_synchronized_quintic(
     upper = None if position_upper is None else joint_bound(position_upper, "position_upper", n, UNITS)
     if lower is not None and upper is not None and np.any(lower > upper):
         j = int(np.argmax(lower > upper))
-        raise ValueError(
-            f"position_lower[{j}] = {lower[j]} is above position_upper[{j}] = {upper[j]} "
-            f"(joint {j})"
-        )
+        raise invalid("position_lower", f"position_lower[{j}] = {lower[j]} is above position_upper[{j}] = "
+                                        f"{upper[j]} ({joint_label(j)})", j)
     points = (("q_start", q0[None, :]), ("goals", goal_array))
     for name, array in points:
         for k, row in enumerate(array):
-            label = name if name == "q_start" else f"goals[{k}]"
-            if lower is not None and np.any(row < lower):
-                j = int(np.argmax(row < lower))
-                raise ValueError(
-                    f"{label} joint {j} = {row[j]} rad is below "
-                    f"position_lower[{j}] = {lower[j]} rad"
-                )
-            if upper is not None and np.any(row > upper):
-                j = int(np.argmax(row > upper))
-                raise ValueError(
-                    f"{label} joint {j} = {row[j]} rad is above "
-                    f"position_upper[{j}] = {upper[j]} rad"
-                )
+            index = () if name == "q_start" else (k,)
+            for outside, bound, side in ((row < lower if lower is not None else None, lower, "below position_lower"),
+                                         (row > upper if upper is not None else None, upper, "above position_upper")):
+                if outside is not None and np.any(outside):
+                    j = int(np.argmax(outside))
+                    raise invalid(name, f"{field_text((name, *index, j))} ({joint_label(j)}) = {row[j]} rad is "
+                                        f"{side}[{j}] = {bound[j]} rad", *index, j)
 
     segments: list[QuinticSegment] = []
     t = 0.0
