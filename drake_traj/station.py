@@ -23,23 +23,8 @@ Subsystems by name: ``planner``, ``plant``, ``scene_graph``, ``acceleration_and_
 ``Demultiplexer`` of the planner's [q̈; c] port: one Python call per step serves the plant, the
 loggers and the exported ports), ``lookahead_mux`` and ``lookahead`` (the one-step lookahead),
 ``feedforward`` (inverse dynamics), ``tcp_pose``, the loggers of
-:data:`drake_traj.result.LOGGERS` and, with Meshcat, ``visualizer``.
-
-Exported ports of the station:
-
-=====================  ======  ===============================================================
-port                   size    meaning
-=====================  ======  ===============================================================
-speed_override (in)    1       the planner's speed override in [0, 1]; unconnected means 1
-applied_generalized_   n       generalized forces added on the joints [N m], e.g. a disturbance;
-force (in)                     unconnected means none
-desired_state          2n      the planner's reference [q; q̇] [rad, rad/s]
-desired_acceleration   n       the planner's q̈ [rad/s²]
-scaling                1       the planner's scaling coefficient c
-measured_state         2n      the plant's [q; q̇]
-torque                 n       the net actuation of the drives (PD + feed-forward, saturated) [N m]
-tcp_pose               6       the measured tool pose [x, y, z, φ_X, φ_Y, φ_Z] [m, rad], base frame
-=====================  ======  ===============================================================
+:data:`drake_traj.result.LOGGERS` and, with Meshcat, ``visualizer``. The station's exported ports
+are declared in :func:`build_station`'s docstring.
 """
 
 import os
@@ -239,8 +224,37 @@ def add_station(
 
 
 def build_station(planner: PlannerSystem, **kwargs) -> Diagram:
-    """The Diagram ``station`` of :func:`add_station` (same keyword arguments) with the exported
-    ports of the module docstring."""
+    """The Diagram ``station`` of :func:`add_station` (same keyword arguments) with these exported
+    ports (``tests/test_station.py`` checks this list against the built diagram):
+
+    .. pydrake_system::
+
+        name: station
+        input_ports:
+        - speed_override (optional)
+        - applied_generalized_force (optional)
+        output_ports:
+        - desired_state
+        - desired_acceleration
+        - scaling
+        - measured_state
+        - torque
+        - tcp_pose
+
+    With n the robot's joint count:
+
+    - ``speed_override`` (1): the planner's speed override in [0, 1]; unconnected means 1.
+    - ``applied_generalized_force`` (n): generalized forces added on the joints [N m or N], e.g. a
+      disturbance; unconnected means none.
+    - ``desired_state`` (2n): the planner's reference [q; q̇] [rad, rad/s].
+    - ``desired_acceleration`` (n): the planner's q̈ [rad/s²].
+    - ``scaling`` (1): the planner's scaling coefficient c.
+    - ``measured_state`` (2n): the plant's [q; q̇].
+    - ``torque`` (n): the net actuation of the drives (PD + feed-forward, saturated at the effort
+      limits) [N m or N].
+    - ``tcp_pose`` (6): the measured tool pose [x, y, z, φ_X, φ_Y, φ_Z] [m, rad], base frame,
+      computed only when asked for.
+    """
     builder = DiagramBuilder()
     parts = add_station(builder, planner, **kwargs)
     builder.ExportInput(planner.GetInputPort("speed_override"), "speed_override")

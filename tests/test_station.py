@@ -1,11 +1,14 @@
 """The station as a Drake user composes it: public API only, one's own builder and Simulator."""
 
+import inspect
 import runpy
 import sys
+import textwrap
 from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
@@ -14,6 +17,7 @@ import drake_traj
 from drake_traj import SimulationResult, load_scenario, make_planner, make_station, run_station, simulate
 from drake_traj.result import ARRAY_NAMES, LOGGERS
 from drake_traj.scenario import find_scenario
+from drake_traj.station import build_station
 
 DIAGRAMS = Path(__file__).resolve().parents[1] / "diagrams"
 PORTS_IN = {"speed_override": 1, "applied_generalized_force": 6}
@@ -36,6 +40,31 @@ def test_station_is_named_with_named_parts_and_ports(scenario):
     for name, size in PORTS_OUT.items():
         assert station.GetOutputPort(name).size() == size
     assert station.num_input_ports() == len(PORTS_IN) and station.num_output_ports() == len(PORTS_OUT)
+
+
+def declared_ports(docstring: str) -> dict:
+    """The ``.. pydrake_system::`` block of a docstring (Drake's way to document a system's ports)
+    as {"name": ..., "input_ports": [...], "output_ports": [...]}, without "(optional)" marks."""
+    lines = inspect.cleandoc(docstring).splitlines()
+    start = lines.index(".. pydrake_system::") + 1
+    end = next(k for k in range(start + 1, len(lines)) if lines[k] and not lines[k].startswith(" "))
+    block = yaml.safe_load(textwrap.dedent("\n".join(lines[start:end])))
+    for key in ("input_ports", "output_ports"):
+        block[key] = [port.removesuffix(" (optional)") for port in block[key]]
+    return block
+
+
+def test_the_docstring_declares_the_built_stations_ports(scenario):
+    # the ports are documented once, in build_station's docstring: it cannot drift from the diagram
+    declared = declared_ports(build_station.__doc__)
+    station = make_station(scenario)
+    assert declared["name"] == station.get_name()
+    assert declared["input_ports"] == [station.get_input_port(k).get_name() for k in range(station.num_input_ports())]
+    assert declared["output_ports"] == [station.get_output_port(k).get_name()
+                                        for k in range(station.num_output_ports())]
+    described = build_station.__doc__.split(".. pydrake_system::")[1]
+    for port in declared["input_ports"] + declared["output_ports"]:
+        assert f"- ``{port}`` (" in described, f"{port} is declared but not described"
 
 
 @pytest.mark.parametrize("name, variant", [("quintic_ptp", None), ("pajak", "sim3")])
