@@ -17,7 +17,7 @@ from drake_traj.meshcat import export_html
 
 CHROMIUM = browser.find_chromium()
 pytestmark = pytest.mark.skipif(
-    CHROMIUM is None and not os.environ.get("CI"), reason="chromium not installed (CI installs it)"
+    CHROMIUM is None and not os.environ.get("CI"), reason="chromium is not installed: install it first (Debian: sudo apt-get install chromium; .ci/run does)"
 )
 
 
