@@ -1,13 +1,15 @@
 """``drake-traj``: run scenarios, list them, benchmark the planners.
 
     drake-traj run [SCENARIO] [--variant NAME] [--out DIR] [--overwrite] [--no-preflight]
-                   [--meshcat [--port P] [--rate R] [--no-wait] [--wait-timeout S]]
+                   [--meshcat [--port P] [--rate R] [--no-wait] [--wait-timeout S] [--serve-after S]]
     drake-traj list
+    drake-traj show [SCENARIO] [--variant NAME]
     drake-traj export RUN_DIR --format csv|urscript|ros2 [--period 0.002] [--out FILE]
     drake-traj bench [--out DIR] [--count N] [--seed S] [--repeats R]
 
 ``run`` writes DIR/result.npz, metrics.json, *.png, meshcat.html and run.json (the manifest);
-SCENARIO is a YAML file or the name of a shipped scenario (``drake-traj list``). ``export``
+SCENARIO is a YAML file or the name of a shipped scenario (``drake-traj list``: the shipped
+scenarios under their files' paths); ``show`` prints the file of one, to copy. ``export``
 writes a run's reference for a robot or another tool (drake_traj.export). ``bench`` runs
 every planner and baseline on Pająk 2024's task and N seeded tasks and writes DIR/bench.csv,
 bench.md and bench.png.
@@ -26,6 +28,7 @@ import sys
 import threading
 import traceback
 from pathlib import Path
+from time import sleep
 
 import numpy as np
 from tqdm import tqdm
@@ -38,10 +41,13 @@ from drake_traj.meshcat import add_live_view, draw_task, draw_tcp_path, export_h
 from drake_traj.result import SimulationResult
 from drake_traj.rundir import MANIFEST, add_to_manifest, begin_output, check_output, run_files, write_manifest
 from drake_traj.scenario import (DEFAULT_SCENARIO, ScenarioError, default_scenario_path, find_scenario, load_scenario,
-                                 locate_in_scenario, preflight, shipped_scenarios)
+                                 locate_in_scenario, preflight, scenario_variants, shipped_scenarios)
 from drake_traj.station import simulate
 
 EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_TERMINATED = 0, 1, 2, 130, 143
+# [s] how long the live view's recording stays served after the run when no terminal is attached
+# (on a terminal: until Ctrl-C); --serve-after sets it
+DEFAULT_SERVE_AFTER = 60.0
 SUMMARY = ("name", "succeeded", "failure", "failure_cause", "duration_s", "max_velocity_over_limit", "max_acceleration_over_limit",
            "tracking_error_joint_max_rad", "tracking_error_tcp_max_m", "real_time_factor")
 
@@ -159,13 +165,8 @@ def run(args) -> int:
     metrics = result.metrics().to_dict()
     print(json.dumps({key: metrics[key] for key in SUMMARY}, indent=2))
     print(f"wrote {out_dir}: {', '.join(sorted(files))}")
-    if args.meshcat and sys.stdin.isatty():
-        print(f"Meshcat is serving the recording at {meshcat.web_url()}; press Ctrl-C to quit.", file=sys.stderr)
-        try:
-            while True:
-                input()
-        except (KeyboardInterrupt, EOFError):
-            pass
+    if args.meshcat:
+        serve_recording(meshcat.web_url(), args.serve_after)
     if interrupts:
         print("drake-traj: interrupted while writing; the run's files were completed first", file=sys.stderr)
         return EXIT_TERMINATED if signal.SIGTERM in interrupts else EXIT_INTERRUPTED
@@ -174,12 +175,47 @@ def run(args) -> int:
     return EXIT_INTERRUPTED if result.failure.cause is Cause.INTERRUPTED else EXIT_RUN_FAILED
 
 
+def serve_recording(url: str, seconds: float | None) -> None:
+    """After a live run, keep Meshcat serving the recording at ``url``: for ``seconds`` [s]; when
+    None, until Ctrl-C on a terminal and for :data:`DEFAULT_SERVE_AFTER` without one (a script,
+    CI, an IDE's run button). Ctrl-C ends it sooner."""
+    if seconds is None and not sys.stdin.isatty():
+        seconds = DEFAULT_SERVE_AFTER
+    try:
+        if seconds is None:
+            print(f"Meshcat is serving the recording at {url}; press Ctrl-C to quit.", file=sys.stderr)
+            while True:
+                input()
+        elif seconds > 0:
+            print(f"Meshcat is serving the recording at {url} for {seconds:g} s (--serve-after S sets how long; "
+                  "Ctrl-C quits sooner)", file=sys.stderr, flush=True)
+            sleep(seconds)
+    except (KeyboardInterrupt, EOFError):
+        pass
+
+
 def list_scenarios(args) -> int:
-    """``drake-traj list``: the shipped scenarios, a line each."""
+    """``drake-traj list``: the shipped scenarios, a line each, under the path of their file."""
     entries = shipped_scenarios()
     width = max(len(entry.name) for entry in entries)
-    for entry in entries:
-        print(f"{entry.name:{width}}  {entry.description}")
+    for path in dict.fromkeys(entry.path for entry in entries):
+        print(path)
+        for entry in entries:
+            if entry.path == path:
+                print(f"  {entry.name:{width}}  {entry.description}")
+    return EXIT_OK
+
+
+def show_scenario(args) -> int:
+    """``drake-traj show``: the text of a scenario's file (a shipped one by its name), to copy
+    and edit; on stderr, its path and how to run the copy."""
+    path, variant = _scenario_reference(args)
+    if variant is not None:
+        load_scenario(path, variant)  # an unknown variant is named as ``run`` names it
+    variants = scenario_variants(path)
+    print(path.read_text(), end="")
+    option = f" --variant {variant or '|'.join(variants)}" if variants else ""
+    print(f"drake-traj: that is {path}; run a copy with: drake-traj run my_copy.yaml{option}", file=sys.stderr)
     return EXIT_OK
 
 
@@ -220,9 +256,12 @@ def check_options(args) -> None:
         checks = [("--port", args.port is None or 1 <= args.port <= 65535, args.port, "a port number 1-65535"),
                   ("--rate", np.isfinite(args.rate) and args.rate > 0, args.rate, "a positive real-time rate"),
                   ("--wait-timeout", np.isfinite(args.wait_timeout) and args.wait_timeout >= 0, args.wait_timeout,
-                   "a number of seconds >= 0")]
+                   "a number of seconds >= 0"),
+                  ("--serve-after", args.serve_after is None or (np.isfinite(args.serve_after) and args.serve_after >= 0),
+                   args.serve_after, "a number of seconds >= 0")]
         live_only = [option for option, given in (("--rate", args.rate != 1.0), ("--port", args.port is not None),
-                                                  ("--no-wait", not args.wait)) if given]
+                                                  ("--no-wait", not args.wait),
+                                                  ("--serve-after", args.serve_after is not None)) if given]
         if live_only and not args.meshcat:
             raise DrakeTrajError(f"{live_only[0]} sets up the live view; add --meshcat (or leave {live_only[0]} out)")
     for option, ok, value, expected in checks:
@@ -253,8 +292,16 @@ def build_parser() -> argparse.ArgumentParser:
     live.add_argument("--rate", type=float, default=1.0, help="real-time rate of the live run (default 1)")
     live.add_argument("--no-wait", dest="wait", action="store_false", help="start the motion without waiting for a browser")
     live.add_argument("--wait-timeout", type=float, default=60.0, help="how long to wait for a browser [s] (default 60)")
-    list_parser = commands.add_parser("list", help="list the shipped scenarios")
+    live.add_argument("--serve-after", type=float, default=None, metavar="S",
+                      help="keep serving the recording S seconds after the run (default: until Ctrl-C on a terminal, "
+                           f"{DEFAULT_SERVE_AFTER:g} s without one)")
+    list_parser = commands.add_parser("list", help="list the shipped scenarios under their files' paths")
     list_parser.set_defaults(handler=list_scenarios)
+    show_parser = commands.add_parser("show", help="print a shipped scenario's file, to copy and edit")
+    show_parser.set_defaults(handler=show_scenario)
+    show_parser.add_argument("scenario", nargs="?", default=None,
+                             help=f"a shipped scenario's name (default: {DEFAULT_SCENARIO[0]}; see drake-traj list)")
+    show_parser.add_argument("--variant", default=None, help="the variant, in a file of several")
     export_parser = commands.add_parser("export", help="write a run's reference as CSV, URScript or ROS 2")
     export_parser.set_defaults(handler=export_run)
     export_parser.add_argument("run_dir", help="a run's output folder (drake-traj run --out)")

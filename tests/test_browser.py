@@ -66,10 +66,11 @@ def test_live_view_shows_the_arm_the_task_and_a_growing_trail(tmp_path):
     assert CHROMIUM is not None, "CI must install chromium"
     port = browser.free_port()
     out = tmp_path / "live"
-    # A quarter of real time: the 5.3 s motion of Pająk 2024 sim 3 takes 21 s; no terminal: no prompt after it.
+    # A quarter of real time: the 5.3 s motion of Pająk 2024 sim 3 takes 21 s; no terminal, and
+    # --serve-after 0: it exits once the run's files are written.
     process = subprocess.Popen(
         [sys.executable, "-m", "drake_traj.cli", "run", "pajak_sim3", "--out", str(out), "--meshcat",
-         "--port", str(port), "--rate", "0.25", "--wait-timeout", "120"],
+         "--port", str(port), "--rate", "0.25", "--wait-timeout", "120", "--serve-after", "0"],
         stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     try:
         waiting = browser.read_until(process.stderr, "waiting up to", timeout=120)

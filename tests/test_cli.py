@@ -1,0 +1,96 @@
+"""The command line a newcomer meets first: the shipped scenarios with their files, a scenario to
+copy, a rerun into the default folder, and the live view's recording without a terminal."""
+
+import io
+import subprocess
+import sys
+import time
+import urllib.request
+
+import pytest
+
+import browser
+from drake_traj import cli
+from drake_traj.scenario import load_scenario, shipped_scenarios
+
+
+def test_list_gives_each_shipped_files_path_above_its_scenarios(capsys):
+    assert cli.main(["list"]) == cli.EXIT_OK
+    lines = capsys.readouterr().out.splitlines()
+    for entry in shipped_scenarios():
+        header = lines.index(str(entry.path))
+        below = lines[header + 1:]
+        below = below[:next((k for k, line in enumerate(below) if not line.startswith("  ")), len(below))]
+        assert any(line.split()[0] == entry.name for line in below), (entry.name, lines)
+
+
+@pytest.mark.parametrize("argv, variant", [(["show", "quintic_ptp"], None), (["show", "pajak_sim3"], "sim3"),
+                                           (["show", "pajak", "--variant", "sim2"], "sim2")])
+def test_show_prints_the_shipped_file_to_copy_and_run(argv, variant, tmp_path, capsys):
+    assert cli.main(argv) == cli.EXIT_OK
+    captured = capsys.readouterr()
+    shipped = next(entry for entry in shipped_scenarios()
+                   if entry.name == argv[1] or (entry.path.stem, entry.variant) == (argv[1], variant))
+    assert captured.out == shipped.path.read_text()
+    assert str(shipped.path) in captured.err
+    assert ("--variant " + variant in captured.err) if variant else "--variant" not in captured.err
+    copy = tmp_path / "my_copy.yaml"
+    copy.write_text(captured.out)
+    assert load_scenario(copy, variant).planner == load_scenario(shipped.path, variant).planner
+
+
+def test_show_of_a_file_of_variants_names_them(capsys):
+    assert cli.main(["show", "pajak"]) == cli.EXIT_OK
+    assert "run a copy with: drake-traj run my_copy.yaml --variant sim1|sim2|sim3" in capsys.readouterr().err
+
+
+def test_a_rerun_into_the_default_folder_names_the_overwrite_flag(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    earlier = tmp_path / "out" / "quintic_ptp"
+    earlier.mkdir(parents=True)
+    (earlier / "result.npz").write_bytes(b"an earlier run")
+    assert cli.main(["run", "quintic_ptp"]) == cli.EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "output folder out/quintic_ptp holds an earlier run" in err and "pass --overwrite" in err, err
+    assert (earlier / "result.npz").read_bytes() == b"an earlier run"
+
+
+class Stdin(io.StringIO):
+    def __init__(self, terminal: bool):
+        super().__init__()
+        self._terminal = terminal
+
+    def isatty(self) -> bool:
+        return self._terminal
+
+
+@pytest.mark.parametrize("terminal, serve_after, slept", [(False, None, cli.DEFAULT_SERVE_AFTER), (False, 2.5, 2.5),
+                                                          (True, 2.5, 2.5), (False, 0.0, None)])
+def test_the_recording_is_served_for_serve_after_seconds(terminal, serve_after, slept, monkeypatch, capsys):
+    # without a terminal (a script, CI, an IDE) there is no Ctrl-C prompt: the recording stays
+    # served for --serve-after seconds (default 60); on a terminal too when it is given
+    sleeps = []
+    monkeypatch.setattr(sys, "stdin", Stdin(terminal))
+    monkeypatch.setattr(cli, "sleep", sleeps.append)
+    cli.serve_recording("http://localhost:7000", serve_after)
+    assert sleeps == ([] if slept is None else [slept])
+    err = capsys.readouterr().err
+    assert (f"serving the recording at http://localhost:7000 for {slept:g} s" in err) if slept else not err
+
+
+def test_a_live_run_without_a_terminal_serves_its_recording_then_exits(tmp_path):
+    port = browser.free_port()
+    process = subprocess.Popen(
+        [sys.executable, "-m", "drake_traj.cli", "run", "quintic_ptp", "--out", str(tmp_path / "live"), "--meshcat",
+         "--no-wait", "--rate", "100", "--port", str(port), "--serve-after", "1.5"],
+        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        serving = browser.read_until(process.stderr, "serving the recording", timeout=180)
+        start = time.monotonic()
+        assert f"at http://localhost:{port} for 1.5 s" in serving
+        with urllib.request.urlopen(f"http://localhost:{port}", timeout=5) as page:  # still served
+            assert page.status == 200
+        assert process.wait(timeout=60) == cli.EXIT_OK
+        assert time.monotonic() - start > 0.5
+    finally:
+        process.kill()
