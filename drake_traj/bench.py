@@ -67,7 +67,7 @@ from drake_traj.robots import UR10E
 from drake_traj.robots import ur10e as robot
 
 __all__ = [
-    "COLUMNS", "CONFIG_BUILDERS", "PLANNERS", "BenchSetupError", "Task", "bench", "medians", "paper_task",
+    "COLUMNS", "CONFIG_BUILDERS", "PLANNERS", "BenchSetupError", "Task", "bench", "bench_figure", "medians", "paper_task",
     "random_tasks", "run_planner", "run_toppra", "tasks",
 ]
 
@@ -505,7 +505,7 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers:
     if count:
         text += f"\n## Medians over {count} seeded tasks\n\n" + _markdown(table[len(rows):])
     (out_dir / "bench.md").write_text(text)
-    _plot(rows, out_dir / "bench.png")
+    bench_figure(rows).savefig(out_dir / "bench.png", dpi=110)
     print(text)
     return table
 
@@ -550,18 +550,29 @@ def medians(rows) -> list[dict]:
     return summary
 
 
-def _plot(rows, path) -> None:
+def bench_figure(rows):
+    """The plot of ``bench.png``: per planner, boxes of T over the time-optimal T and of the peak
+    q̈ over the limit across the tasks of ``rows``, the task count in the title."""
     from matplotlib.figure import Figure
 
     names = _planner_names(rows)
-    figure = Figure(figsize=(9, 4), layout="constrained")
+    tasks = list(dict.fromkeys(row["task"] for row in rows))
+    seeded = sum(task != "paper" for task in tasks)
+    figure = Figure(figsize=(9, 4.6), layout="constrained")
     duration_ax, acceleration_ax = figure.subplots(1, 2)
-    for ax, column, label in ((duration_ax, "T_over_optimal", "T / time-optimal T on the same path"),
-                              (acceleration_ax, "max_qdd_over_limit", "max |qdd| / limit")):
+    for ax, column, label, bound in ((duration_ax, "T_over_optimal", "T / time-optimal T on the same path",
+                                      "1: time-optimal"),
+                                     (acceleration_ax, "max_qdd_over_limit", "max |qdd| / limit", "1: the limit")):
         data = [[row[column] for row in rows if row["planner"] == name and np.isfinite(row[column])]
                 for name in names]
-        ax.boxplot(data, tick_labels=names)
-        ax.axhline(1.0, color="grey", linestyle="--")
+        # a planner whose runs did not all give a value (failed runs) says over how many the box is
+        ticks = [name if len(values) == len(tasks) else f"{name}\n({len(values)} of {len(tasks)})"
+                 for name, values in zip(names, data)]
+        boxes = ax.boxplot(data, tick_labels=ticks)
+        line = ax.axhline(1.0, color="grey", linestyle="--")
+        ax.legend([boxes["medians"][0], line], ["median over the tasks (box: quartiles)", bound], fontsize="small")
         ax.set_ylabel(label)
         ax.tick_params(axis="x", rotation=45)
-    figure.savefig(path, dpi=110)
+    figure.suptitle(f"{len(names)} planners on {len(tasks)} UR10e tasks: Pająk 2024's"
+                    + (f" and {seeded} seeded random ones" if seeded else ""))
+    return figure

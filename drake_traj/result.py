@@ -5,6 +5,9 @@ All arrays are time-major (one row per logged sample) on a uniform grid ``t`` [s
 (plant state), ``tau`` (net joint torque applied by the drives, N m), ``scaling`` (c), ``tcp``
 (measured flange pose k(q) = [x, y, z, phi_X, phi_Y, phi_Z], m and rad, base frame) and
 ``tcp_ref`` (the same of the reference q_ref).
+
+In the figures each joint has its colour, line style and marker (:func:`joint_style`), so joints
+stay apart where their lines overlap, and every panel has its legend.
 """
 
 from __future__ import annotations
@@ -19,12 +22,14 @@ from matplotlib.figure import Figure
 
 from drake_traj.errors import Cause, DrakeTrajError, Failure, joint_label
 from drake_traj.export import export, reference_trajectory
+from drake_traj.planners.pajak import PajakPlanner
 from drake_traj.robots import get_robot
 from drake_traj.robots.ur10e import pose_error
 from drake_traj.rundir import OutputError, clear_run, create_folder, holds_a_run
 from drake_traj.validation import invalid, path_argument, positive_scalar, real_array
 
-__all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult"]
+__all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult",
+           "joint_style", "waypoint_neighbourhood"]
 
 SATURATION = 1.0 - 1e-6  # |torque| at or above this fraction of the effort limit counts as saturated
 # Far above the shipped scenarios' largest TCP tracking error (0.13 mm, Boryga's SCARA; 0.03 mm on
@@ -34,6 +39,33 @@ DEFAULT_TRACKING_TOLERANCE = 0.005  # [m]
 
 class ResultFileError(DrakeTrajError):
     """A saved result cannot be read: names the file and what is wrong with it."""
+
+
+def waypoint_neighbourhood(planner) -> float:
+    """The radius [m] of the ball around each waypoint but the last inside which ``planner`` turns
+    to the next one: the Pająk planner's ϵ when it blends (eq. 19); NaN for planners that pass
+    through their waypoints or stop at them."""
+    if isinstance(planner, PajakPlanner) and planner.law.parameters.blend_waypoints:
+        return float(planner.law.parameters.neighbourhood)
+    return float("nan")
+
+
+_JOINT_LINE_STYLES = ("-", "--", "-.")
+_JOINT_MARKERS = ("o", "s", "^", "v", "D", "X")
+
+
+def joint_style(j: int) -> dict:
+    """Matplotlib line properties of joint ``j`` (from 0): a colour, a line style and a marker of
+    its own (markers spaced along the line, offset per joint), so joints whose lines overlap stay
+    apart, not by colour alone."""
+    return {"color": f"C{j % 10}", "linestyle": _JOINT_LINE_STYLES[j % len(_JOINT_LINE_STYLES)],
+            "marker": _JOINT_MARKERS[j % len(_JOINT_MARKERS)], "markevery": (0.015 * (j % 6), 0.09),
+            "markersize": 4.5, "markerfacecolor": "none"}
+
+
+def _legend(ax) -> None:
+    """The panel's own legend, beside it on the right."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
 
 
 def _json_ready(value):
@@ -138,6 +170,7 @@ class SimulationResult:
     wall_time: float = float("nan")
     joint_types: tuple[str, ...] = ()  # "revolute" or "prismatic" per joint; empty: all revolute
     robot: str = ""  # the robot's name (drake_traj.robots.get_robot), where known
+    waypoint_neighbourhood: float = float("nan")  # [m] see waypoint_neighbourhood(); NaN: none
 
     def __post_init__(self):
         """Every array as a float array of its shape (:data:`_SHAPES`), or ValueError naming it.
@@ -307,6 +340,7 @@ class SimulationResult:
             wall_time=wall_time,
             joint_types=tuple(robot.joint_types),
             robot=robot.name,
+            waypoint_neighbourhood=waypoint_neighbourhood(planner),
         )
         if result.failure is None and tracking_tolerance is not None:
             result.failure = result.execution_failure(tracking_tolerance)
@@ -326,7 +360,8 @@ class SimulationResult:
         arrays = {name: getattr(self, name) for name in ARRAY_NAMES + _LIMIT_NAMES + ("goal",)}
         failure = None if self.failure is None else self.failure.to_dict()
         meta = {"name": self.name, "duration": self.duration, "failure": failure, "wall_time": self.wall_time,
-                "joint_types": list(self.joint_types), "robot": self.robot}
+                "joint_types": list(self.joint_types), "robot": self.robot,
+                "waypoint_neighbourhood": self.waypoint_neighbourhood}
         np.savez_compressed(directory / "result.npz", meta=json.dumps(_json_ready(meta), allow_nan=False), **arrays)
         (directory / "metrics.json").write_text(json.dumps(self.metrics().to_dict(), indent=2, allow_nan=False))
         return directory
@@ -365,8 +400,9 @@ class SimulationResult:
             if meta["failure"] is not None:
                 meta["failure"] = Failure.from_dict(meta["failure"])
             meta["joint_types"] = tuple(meta.get("joint_types", ()))
-            meta["duration"] = float("nan") if meta["duration"] is None else float(meta["duration"])
-            meta["wall_time"] = float("nan") if meta["wall_time"] is None else float(meta["wall_time"])
+            for key in ("duration", "wall_time", "waypoint_neighbourhood"):  # NaN is saved as null
+                if key in meta:  # (a result saved before the neighbourhood was has none)
+                    meta[key] = float("nan") if meta[key] is None else float(meta[key])
         except (KeyError, TypeError, ValueError) as error:
             raise ResultFileError(f"{path}: its metadata is damaged: {error}") from None
         try:
@@ -390,7 +426,7 @@ class SimulationResult:
         if np.isfinite(self.duration):
             for ax in axes:
                 ax.axvline(self.duration, color="black", linewidth=0.8, alpha=0.5,
-                           label=f"finished, T = {self.duration:.3f} s" if ax is axes[0] else None)
+                           label=f"finished, T = {self.duration:.3f} s")
 
     def joint_figure(self) -> Figure:
         """q, q̇, q̈ per joint against time, with the velocity and acceleration limit lines."""
@@ -404,17 +440,16 @@ class SimulationResult:
             ("q̈", self.qdd_ref, self.acceleration_limit, axes[2], "/s²"),
         ):
             for j in range(data.shape[1]):
-                ax.plot(self.t, data[:, j], label=f"joint {j + 1} [{self.joint_unit(j)}{suffix or ''}]"
-                        if ax is axes[0] else None)
+                ax.plot(self.t, data[:, j], label=f"joint {j + 1} [{self.joint_unit(j)}{suffix}]", **joint_style(j))
             if limit is not None and np.all(np.isfinite(limit)):
                 for bound in (np.max(limit), -np.max(limit)):
-                    ax.axhline(bound, color="grey", linestyle="--", linewidth=1,
-                               label="limit" if bound > 0 and ax is axes[1] else None)
+                    ax.axhline(bound, color="grey", linestyle="--", linewidth=1, label="limit" if bound > 0 else None)
             ax.set_ylabel(f"{name} [{unit}{suffix}]")
             ax.grid(True, alpha=0.3)
         self._finish_line(axes)
         axes[-1].set_xlabel("t [s]")
-        figure.legend(loc="outside right upper", fontsize="small")
+        for ax in axes:
+            _legend(ax)
         figure.suptitle(f"{self.name}: joint reference")
         return figure
 
@@ -424,8 +459,9 @@ class SimulationResult:
         error_ax, torque_ax = figure.subplots(2, 1, sharex=True)
         for j in range(self.q_ref.shape[1]):
             scale, unit = (1e3, "mm") if self.joint_unit(j) == "m" else (1e3, "mrad")
-            error_ax.plot(self.t, scale * (self.q_ref[:, j] - self.q_meas[:, j]), label=f"joint {j + 1} [{unit}]")
-            torque_ax.plot(self.t, self.tau[:, j] / self.effort_limit[j])
+            error_ax.plot(self.t, scale * (self.q_ref[:, j] - self.q_meas[:, j]), label=f"joint {j + 1} [{unit}]",
+                          **joint_style(j))
+            torque_ax.plot(self.t, self.tau[:, j] / self.effort_limit[j], label=f"joint {j + 1}", **joint_style(j))
         error_ax.set_ylabel("q_ref - q_meas [mrad or mm]" if self.joint_types and "prismatic" in self.joint_types
                             else "q_ref - q_meas [mrad]")
         torque_ax.set_ylabel("effort / effort limit")
@@ -433,7 +469,7 @@ class SimulationResult:
         self._finish_line([error_ax, torque_ax])
         for ax in (error_ax, torque_ax):
             ax.grid(True, alpha=0.3)
-        figure.legend(loc="outside right upper", fontsize="small")
+            _legend(ax)
         figure.suptitle(f"{self.name}: tracking")
         return figure
 
@@ -447,18 +483,22 @@ class SimulationResult:
         ax.set_ylabel("c")
         ax.set_ylim(-0.05, 1.05)
         ax.grid(True, alpha=0.3)
-        figure.legend(loc="outside right upper", fontsize="small")
+        _legend(ax)
         figure.suptitle(f"{self.name}: scaling coefficient")
         return figure
 
     def tcp_path_figure(self) -> Figure:
-        """The measured and reference TCP paths in 3-D (base frame) with the waypoints."""
+        """The measured and reference TCP paths in 3-D (base frame) with the waypoints and, for a
+        planner that turns to the next waypoint inside a neighbourhood of each (the Pająk
+        planner's ϵ), those neighbourhoods as spheres."""
         figure = Figure(figsize=(7, 6), layout="constrained")
         ax = figure.add_subplot(projection="3d")
         ax.plot(*self.tcp_ref[:, :3].T, label="reference", linewidth=2)
         ax.plot(*self.tcp[:, :3].T, "--", label="measured", linewidth=1)
         if len(self.waypoints):
             ax.scatter(*self.waypoints.T, color="tab:orange", s=60, label="waypoints")
+        if len(self.waypoints) > 1 and np.isfinite(self.waypoint_neighbourhood):
+            self._draw_neighbourhoods(ax)
         if len(self.tcp_ref):
             ax.scatter(*self.tcp_ref[0, :3], color="tab:green", marker="^", s=90, label="start", depthshade=False)
             ax.scatter(*self.tcp_ref[-1, :3], color="black", marker="x", s=60, label="end")
@@ -470,9 +510,19 @@ class SimulationResult:
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
         ax.set_zlabel("z [m]")
-        figure.legend(loc="outside right upper", fontsize="small")
+        figure.legend(loc="outside right upper", fontsize="small")  # the one panel's, clear of the 3-D box
         ax.set_title(f"{self.name}: TCP path")
         return figure
+
+    def _draw_neighbourhoods(self, ax) -> None:
+        """Translucent spheres of radius :attr:`waypoint_neighbourhood` around every waypoint
+        but the last (where the task ends instead)."""
+        radius = self.waypoint_neighbourhood
+        azimuth, polar = np.meshgrid(np.linspace(0, 2 * np.pi, 25), np.linspace(0, np.pi, 13))
+        unit = np.array([np.cos(azimuth) * np.sin(polar), np.sin(azimuth) * np.sin(polar), np.cos(polar)])
+        for k, centre in enumerate(self.waypoints[:-1]):
+            ax.plot_surface(*(centre[:, None, None] + radius * unit), color="tab:orange", alpha=0.15, linewidth=0,
+                            label=f"neighbourhood, ϵ = {1e3 * radius:g} mm" if k == 0 else None)
 
     def save_figures(self, directory) -> list[Path]:
         """Write joints.png, tracking.png, scaling.png and tcp_path.png into ``directory``

@@ -134,3 +134,12 @@ def test_an_output_that_is_or_lies_below_a_file_is_refused(tmp_path, capsys):
         assert cli.main(["bench", "--out", str(out), "--count", "0"]) == 2
         assert f"--out {out}" in capsys.readouterr().err
     assert afile.read_text() == "keep me"
+
+
+def test_the_plot_has_the_task_count_in_its_title_and_a_legend_on_each_panel(rows, cluster_rows):
+    figure = bench.bench_figure(rows)
+    assert figure.get_suptitle() == "6 planners on 2 UR10e tasks: Pająk 2024's and 1 seeded random ones"
+    assert all(ax.get_legend() is not None for ax in figure.axes)
+    # a box over fewer runs than tasks (a failed run has no value) says how many
+    labels = [label.get_text() for label in bench.bench_figure(cluster_rows).axes[0].get_xticklabels()]
+    assert labels == ["pajak_blend", "quintic_stop", "toppra", "broken\n(0 of 2)"]

@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
@@ -12,7 +13,7 @@ from drake_traj.robots import ur10e as robot
 from drake_traj.scenario import ControllerGains
 from drake_traj.station import simulate
 from drake_traj.planners.quintic import QuinticLaw, QuinticPtpPlanner, plan_synchronized_quintic
-from drake_traj.result import ARRAY_NAMES, SimulationResult
+from drake_traj.result import ARRAY_NAMES, SimulationResult, joint_style
 from drake_traj.scenario import load_scenario, make_planner
 
 from conftest import DIAGRAMS
@@ -187,3 +188,35 @@ def test_the_ur_controllers_500_hz_works_in_a_scenario(name, tmp_path):
     metrics = result.metrics()
     assert metrics.max_velocity_over_limit <= 1 + LIMIT_TOLERANCE and metrics.max_acceleration_over_limit <= 1 + LIMIT_TOLERANCE
     assert metrics.tracking_error_tcp_max_m < 5e-4  # the PD loop at 500 Hz (measured below 0.2 mm)
+
+
+@pytest.fixture(scope="module")
+def sim3_result(default_run_dir):
+    return SimulationResult.load(default_run_dir)
+
+
+def test_every_panel_has_a_legend_and_joints_differ_in_more_than_colour(quintic_result):
+    styles = {(joint_style(j)["linestyle"], joint_style(j)["marker"]) for j in range(6)}
+    assert len(styles) == 6  # overlapping lines of two joints stay apart without their colours
+    for figure in (quintic_result.joint_figure(), quintic_result.tracking_figure(), quintic_result.scaling_figure()):
+        for ax in figure.axes:
+            assert ax.get_legend() is not None, figure.get_suptitle()
+            joints = [line for line in ax.get_lines() if line.get_label().startswith("joint")]
+            assert len({(line.get_linestyle(), line.get_marker()) for line in joints}) == len(joints)
+    assert quintic_result.tcp_path_figure().legends  # its one panel's legend, beside the 3-D box
+
+
+def spheres(figure) -> list:
+    return [item for item in figure.axes[0].collections if isinstance(item, Poly3DCollection)]
+
+
+def test_the_tcp_path_shows_the_neighbourhoods_where_the_planner_turns(sim3_result, quintic_result, tmp_path):
+    # the Pająk planner turns to the next waypoint inside ϵ = 5 cm of each (eq. 19); not at the
+    # last one, where the task ends; the quintic planner passes through its goals: none drawn
+    assert sim3_result.waypoint_neighbourhood == 0.05 and len(sim3_result.waypoints) == 4
+    figure = sim3_result.tcp_path_figure()
+    assert len(spheres(figure)) == 3
+    assert "neighbourhood, ϵ = 50 mm" in [text.get_text() for text in figure.legends[0].get_texts()]
+    assert np.isnan(quintic_result.waypoint_neighbourhood)
+    assert not spheres(quintic_result.tcp_path_figure())
+    assert SimulationResult.load(sim3_result.save(tmp_path / "again")).waypoint_neighbourhood == 0.05
