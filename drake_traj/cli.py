@@ -300,7 +300,8 @@ def build_parser() -> argparse.ArgumentParser:
     show_parser = commands.add_parser("show", help="print a shipped scenario's file, to copy and edit")
     show_parser.set_defaults(handler=show_scenario)
     show_parser.add_argument("scenario", nargs="?", default=None,
-                             help=f"a shipped scenario's name (default: {DEFAULT_SCENARIO[0]}; see drake-traj list)")
+                             help=f"a shipped scenario's name (default: {DEFAULT_SCENARIO[0]}, whose variant "
+                                  f"{DEFAULT_SCENARIO[1]} run runs; see drake-traj list)")
     show_parser.add_argument("--variant", default=None, help="the variant, in a file of several")
     export_parser = commands.add_parser("export", help="write a run's reference as CSV, URScript or ROS 2")
     export_parser.set_defaults(handler=export_run)
