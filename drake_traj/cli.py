@@ -269,6 +269,13 @@ def check_options(args) -> None:
             raise DrakeTrajError(f"{option} must be {expected}, got {value}")
 
 
+def _add_scenario_arguments(parser, what: str, verb: str) -> None:
+    """SCENARIO and --variant, which ``run`` and ``show`` resolve alike (:func:`_scenario_reference`)."""
+    parser.add_argument("scenario", nargs="?", default=None,
+                        help=f"{what} (default: {DEFAULT_SCENARIO[0]}, variant {DEFAULT_SCENARIO[1]}; see drake-traj list)")
+    parser.add_argument("--variant", default=None, help=f"the variant to {verb}, in a file of several")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="drake-traj", description=__doc__.splitlines()[0],
                                      epilog="exit codes: 0 success, 1 run failed (log kept), 2 bad input, 130 interrupted (Ctrl-C), "
@@ -278,10 +285,7 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True)
     run_parser = commands.add_parser("run", help="simulate a scenario and write its results")
     run_parser.set_defaults(handler=run)
-    run_parser.add_argument("scenario", nargs="?", default=None,
-                            help=f"a scenario YAML file or a shipped scenario's name (default: {DEFAULT_SCENARIO[0]}, "
-                                 f"variant {DEFAULT_SCENARIO[1]}; see drake-traj list)")
-    run_parser.add_argument("--variant", default=None, help="the variant to run, in a file of several")
+    _add_scenario_arguments(run_parser, "a scenario YAML file or a shipped scenario's name", "run")
     run_parser.add_argument("--out", default=None, help="output folder (default: out/<scenario name>)")
     run_parser.add_argument("--overwrite", action="store_true", help="replace an earlier run in the output folder")
     run_parser.add_argument("--no-preflight", dest="preflight", action="store_false",
@@ -299,10 +303,7 @@ def build_parser() -> argparse.ArgumentParser:
     list_parser.set_defaults(handler=list_scenarios)
     show_parser = commands.add_parser("show", help="print a shipped scenario's file, to copy and edit")
     show_parser.set_defaults(handler=show_scenario)
-    show_parser.add_argument("scenario", nargs="?", default=None,
-                             help=f"a shipped scenario's name (default: {DEFAULT_SCENARIO[0]}, whose variant "
-                                  f"{DEFAULT_SCENARIO[1]} run runs; see drake-traj list)")
-    show_parser.add_argument("--variant", default=None, help="the variant, in a file of several")
+    _add_scenario_arguments(show_parser, "a shipped scenario's name", "show")
     export_parser = commands.add_parser("export", help="write a run's reference as CSV, URScript or ROS 2")
     export_parser.set_defaults(handler=export_run)
     export_parser.add_argument("run_dir", help="a run's output folder (drake-traj run --out)")
