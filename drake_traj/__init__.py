@@ -12,15 +12,8 @@ Planner configs (``PajakConfig``, ``QuinticConfig``, ...) build planners with
 
 from drake_traj.station import add_station, build_station, make_station, run_station, simulate
 from drake_traj.errors import Cause, DrakeTrajError, Failure, PlanningError, SingularConfigurationError
-from drake_traj.planners import (
-    BorygaConfig,
-    LiConfig,
-    MovejConfig,
-    PajakConfig,
-    QuinticConfig,
-    RuckigConfig,
-    ToppraConfig,
-)
+from drake_traj.planners import (BorygaConfig, LiConfig, MovejConfig, PajakConfig, QuinticConfig,
+                                 RuckigConfig, ToppraConfig)
 from drake_traj.result import Metrics, SimulationResult
 from drake_traj.robots import Robot, get_robot
 from drake_traj.scenario import ControllerGains, Scenario, SpeedOverride, load_scenario, make_planner, preflight

@@ -34,7 +34,7 @@ import numpy as np
 from tqdm import tqdm
 
 from drake_traj.version import __version__
-from drake_traj.bench import BenchSetupError, bench
+from drake_traj.bench import bench
 from drake_traj.errors import Cause, DrakeTrajError, PlanningError
 from drake_traj.export import FORMATS, UR_CYCLE, ExportError
 from drake_traj.meshcat import add_live_view, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser

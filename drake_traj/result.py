@@ -22,14 +22,13 @@ from matplotlib.figure import Figure
 
 from drake_traj.errors import Cause, DrakeTrajError, Failure, joint_label
 from drake_traj.export import export, reference_trajectory
-from drake_traj.planners.pajak import PajakPlanner
 from drake_traj.robots import get_robot
 from drake_traj.robots.ur10e import pose_error
 from drake_traj.rundir import OutputError, clear_run, create_folder, holds_a_run
 from drake_traj.validation import invalid, path_argument, positive_scalar, real_array
 
 __all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult",
-           "joint_style", "waypoint_neighbourhood"]
+           "joint_style"]
 
 SATURATION = 1.0 - 1e-6  # |torque| at or above this fraction of the effort limit counts as saturated
 # Far above the shipped scenarios' largest TCP tracking error (0.13 mm, Boryga's SCARA; 0.03 mm on
@@ -39,15 +38,6 @@ DEFAULT_TRACKING_TOLERANCE = 0.005  # [m]
 
 class ResultFileError(DrakeTrajError):
     """A saved result cannot be read: names the file and what is wrong with it."""
-
-
-def waypoint_neighbourhood(planner) -> float:
-    """The radius [m] of the ball around each waypoint but the last inside which ``planner`` turns
-    to the next one: the Pająk planner's ϵ when it blends (eq. 19); NaN for planners that pass
-    through their waypoints or stop at them."""
-    if isinstance(planner, PajakPlanner) and planner.law.parameters.blend_waypoints:
-        return float(planner.law.parameters.neighbourhood)
-    return float("nan")
 
 
 _JOINT_LINE_STYLES = ("-", "--", "-.")
@@ -170,7 +160,7 @@ class SimulationResult:
     wall_time: float = float("nan")
     joint_types: tuple[str, ...] = ()  # "revolute" or "prismatic" per joint; empty: all revolute
     robot: str = ""  # the robot's name (drake_traj.robots.get_robot), where known
-    waypoint_neighbourhood: float = float("nan")  # [m] see waypoint_neighbourhood(); NaN: none
+    waypoint_neighbourhood: float = float("nan")  # [m] see PlannerSystem.waypoint_neighbourhood(); NaN: none
 
     def __post_init__(self):
         """Every array as a float array of its shape (:data:`_SHAPES`), or ValueError naming it.
@@ -340,7 +330,7 @@ class SimulationResult:
             wall_time=wall_time,
             joint_types=tuple(robot.joint_types),
             robot=robot.name,
-            waypoint_neighbourhood=waypoint_neighbourhood(planner),
+            waypoint_neighbourhood=planner.waypoint_neighbourhood(),
         )
         if result.failure is None and tracking_tolerance is not None:
             result.failure = result.execution_failure(tracking_tolerance)

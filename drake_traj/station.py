@@ -32,25 +32,14 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import (
-    CollisionFilterDeclaration,
-    Meshcat,
-    MeshcatVisualizer,
-    MeshcatVisualizerParams,
-)
+from pydrake.geometry import (CollisionFilterDeclaration, Meshcat, MeshcatVisualizer, MeshcatVisualizerParams)
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant, MultibodyPlantConfig
 from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 from pydrake.systems.controllers import InverseDynamics
 from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, TriggerType
-from pydrake.systems.primitives import (
-    ConstantVectorSource,
-    Demultiplexer,
-    LogVectorOutput,
-    MatrixGain,
-    Multiplexer,
-    TrajectorySource,
-)
+from pydrake.systems.primitives import (ConstantVectorSource, Demultiplexer, LogVectorOutput, MatrixGain,
+                                        Multiplexer, TrajectorySource)
 
 from drake_traj.errors import Cause, Failure
 from drake_traj.planners.base import PlannerSystem
@@ -59,16 +48,8 @@ from drake_traj.robots import UR10E, Robot, get_robot
 from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, default_plant_config,
                                  default_simulator_config, make_planner)
 from drake_traj.scenario import preflight as scenario_preflight
-from drake_traj.validation import (
-    callable_or_none,
-    flag,
-    instance_of,
-    invalid,
-    log_period_check,
-    nonnegative_scalar,
-    positive_scalar,
-    real_scalar,
-)
+from drake_traj.validation import (callable_or_none, flag, instance_of, invalid, log_period_check,
+                                   nonnegative_scalar, positive_scalar, real_scalar)
 
 __all__ = [
     "Station", "add_speed_override", "add_station", "build_station", "make_station", "run_station", "simulate",

@@ -60,7 +60,7 @@ def test_a_run_that_raises_is_a_failed_row_with_its_reason(cluster_rows):
     assert [row["task"] for row in broken] == ["paper", "random_0"]
     for row in broken:
         assert not row["succeeded"] and math.isnan(row["T_s"]), row
-        assert row["failure"].startswith("ValueError: velocity_limit"), row
+        assert row["failure"].startswith("DrakeTrajError: velocity_limit"), row
     assert all(row["failure"] == "" for row in cluster_rows if row["planner"] != "broken")
 
 

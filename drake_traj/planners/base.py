@@ -114,6 +114,12 @@ class PlannerSystem(LeafSystem):
         is given in task space; None where it is given in joint space."""
         return None
 
+    def waypoint_neighbourhood(self) -> float:
+        """The radius [m] of the ball around each waypoint but the last inside which the planner
+        turns to the next one (Pająk 2024's ϵ, eq. 19); NaN for planners that pass through their
+        waypoints or stop at them (this default)."""
+        return float("nan")
+
     # --- shared ------------------------------------------------------------------------------
     def finish_time(self, context) -> float:
         """When the task finished [s], as recorded by the planner's update events; NaN before."""

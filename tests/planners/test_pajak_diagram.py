@@ -10,6 +10,7 @@ import pytest
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
+from drake_traj.errors import Cause, PlanningError
 from drake_traj.robots import ur10e as robot
 from drake_traj.scenario import default_plant_config, default_simulator_config
 from drake_traj.station import build_station, run_station, simulate
@@ -85,8 +86,11 @@ def test_unreachable_goal_stops_with_the_reason_and_keeps_the_log(tmp_path):
     goal = pose.copy()
     direction = (pose[:3] - pajak_parameters.SHOULDER) / np.linalg.norm(pose[:3] - pajak_parameters.SHOULDER)
     goal[:3] = pajak_parameters.SHOULDER + 1.29 * direction  # inside 1.3 m, but not reachable with this orientation
-    planner = P.PajakPlanner(P.PajakConfig(waypoints=goal[None], limit_velocity=True, limit_acceleration=False, stall_time=1.0), Q0)
-    result = simulate(planner, max_duration=20.0)
+    config = P.PajakConfig(waypoints=goal[None], limit_velocity=True, limit_acceleration=False, stall_time=1.0)
+    with pytest.raises(PlanningError, match="no progress") as found:  # simulate's preflight, before the motion
+        simulate(P.PajakPlanner(config, Q0), max_duration=20.0)
+    assert found.value.cause is Cause.STALL and found.value.field == ("waypoints", 0)
+    result = simulate(P.PajakPlanner(config, Q0), max_duration=20.0, preflight=False)  # the run finds it too
     assert not result.succeeded
     message = result.failure.message
     assert "PlanningError" in message and "no progress" in message and "q = " in message

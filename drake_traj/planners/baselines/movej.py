@@ -53,7 +53,6 @@ from drake_traj.validation import instance_of, invalid, limit_or_default, positi
 __all__ = [
     "MovejBlendLaw",
     "MovejPlanner",
-    "paper_task_joint_waypoints",
     "trapezoid_profile",
 ]
 

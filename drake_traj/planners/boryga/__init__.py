@@ -43,15 +43,8 @@ from drake_traj.planners.boryga.config import BorygaConfig, make
 from drake_traj.planners.boryga.figures import loop_path_figure
 from drake_traj.planners.boryga.geometry import LoopGeometry, loop_geometry
 from drake_traj.planners.boryga.law import RobotLoopLaw, joint_speed_cap
-from drake_traj.planners.boryga.path import (
-    PHASES,
-    LoopPath,
-    LoopTiming,
-    loop_timing,
-    plan_loop_path,
-    poly7_profile,
-    poly7_timing,
-)
+from drake_traj.planners.boryga.path import (PHASES, LoopPath, LoopTiming, loop_timing, plan_loop_path,
+                                             poly7_profile, poly7_timing)
 from drake_traj.planners.boryga.placements import PAPER_LOOP, LoopPlacement, paper_loop_placement
 from drake_traj.planners.boryga.system import BorygaLoopPlanner
 

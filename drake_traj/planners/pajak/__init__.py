@@ -9,18 +9,9 @@ Drake) and :mod:`.system` (the Drake system and ``make``). The robot is reached 
 
 from drake_traj.errors import PlanningError
 from drake_traj.planners.pajak.integration import integrate
-from drake_traj.planners.pajak.kernel import (
-    Discrete,
-    Evaluation,
-    Parameter,
-    acceleration_terms,
-    approach_damping,
-    approach_rate,
-    blend_progress,
-    blended_target,
-    damping_factor,
-    velocity_penalty,
-)
+from drake_traj.planners.pajak.kernel import (Discrete, Evaluation, Parameter, acceleration_terms,
+                                              approach_damping, approach_rate, blend_progress, blended_target,
+                                              damping_factor, velocity_penalty)
 from drake_traj.planners.pajak.law import DISCRETE_NAMES, PajakLaw
 from drake_traj.planners.pajak.limits import choose_scaling, scaling_interval
 from drake_traj.planners.pajak.parameters import PAPER_METHOD, PajakConfig, paper_initial_configuration, paper_parameters

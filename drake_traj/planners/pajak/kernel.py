@@ -28,16 +28,8 @@ from drake_traj.compiled import compiled
 from drake_traj.planners.laws import scaling
 from drake_traj.planners.laws.scaling import relaxed_scaling
 from drake_traj.planners.pajak import limits
-from drake_traj.planners.pajak.limits import (
-    BRAKE_LAG,
-    BRAKE_SLEW,
-    brake,
-    brake_weight,
-    choose_scaling,
-    keep_limits,
-    scaling_interval,
-    scaling_slew,
-)
+from drake_traj.planners.pajak.limits import (BRAKE_LAG, BRAKE_SLEW, brake, brake_weight, choose_scaling,
+                                              keep_limits, scaling_interval, scaling_slew)
 from drake_traj.robots import UR10E
 
 __all__ = [

@@ -86,6 +86,11 @@ class PajakPlanner(PlannerSystem):
     def task_waypoints(self) -> np.ndarray:
         return self.law.tcp_positions()
 
+    def waypoint_neighbourhood(self) -> float:
+        """ϵ [m] when the planner blends its waypoints (eq. 19), else NaN (it stops at each)."""
+        parameters = self.law.parameters
+        return float(parameters.neighbourhood) if parameters.blend_waypoints else float("nan")
+
     def _update(self, context, discrete_state):
         t, q, qd, discrete = self._law_arguments(context)
         updated = self.law.update(t, q, qd, discrete, self.speed_override(context))
