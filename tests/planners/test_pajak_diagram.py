@@ -87,9 +87,9 @@ def test_unreachable_goal_stops_with_the_reason_and_keeps_the_log(tmp_path):
     direction = (pose[:3] - pajak_parameters.SHOULDER) / np.linalg.norm(pose[:3] - pajak_parameters.SHOULDER)
     goal[:3] = pajak_parameters.SHOULDER + 1.29 * direction  # inside 1.3 m, but not reachable with this orientation
     config = P.PajakConfig(waypoints=goal[None], limit_velocity=True, limit_acceleration=False, stall_time=1.0)
-    with pytest.raises(PlanningError, match="no progress") as found:  # simulate's preflight, before the motion
+    with pytest.raises(PlanningError, match="waypoint 0 cannot be reached") as found:  # the preflight, before the motion
         simulate(P.PajakPlanner(config, Q0), max_duration=20.0)
-    assert found.value.cause is Cause.STALL and found.value.field == ("waypoints", 0)
+    assert found.value.cause is Cause.UNREACHABLE and found.value.field == ("waypoints", 0)
     result = simulate(P.PajakPlanner(config, Q0), max_duration=20.0, preflight=False)  # the run finds it too
     assert not result.succeeded
     message = result.failure.message
