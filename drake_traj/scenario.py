@@ -395,7 +395,7 @@ def make_planner(scenario: Scenario, *others) -> PlannerSystem:
     try:
         planner = make_planner_from_config(scenario.planner, robot, q_initial)
     except ValueError as error:
-        raise _in_planner_field(scenario, error) from error
+        raise _in_planner_field(scenario, error, message_leads_with_field=True) from error
     velocity = np.broadcast_to(planner.velocity_limit, (robot.num_joints,))
     above = np.flatnonzero(velocity > robot.velocity_limits * (1 + 1e-9))
     if len(above):
@@ -418,19 +418,20 @@ def preflight(scenario: Scenario, planner: PlannerSystem) -> np.ndarray | None:
     try:
         return planner.preflight()
     except ValueError as error:
-        raise _in_planner_field(scenario, error) from error
+        raise _in_planner_field(scenario, error, message_leads_with_field=False) from error
 
 
-def _in_planner_field(scenario: Scenario, error: ValueError) -> DrakeTrajError:
+def _in_planner_field(scenario: Scenario, error: ValueError, *, message_leads_with_field: bool) -> DrakeTrajError:
     """``error`` from the scenario's planner, located at the planner field it names (a field of
-    the planner's config) or at ``planner``."""
+    the planner's config) or at ``planner``. ``message_leads_with_field``: the error's text
+    begins with its field's name (the config checks: "waypoints[2] must ...") and is continued
+    from ``planner.``; otherwise (the preflight's "waypoint 2 cannot be reached ...") the field
+    is written before it."""
     if not isinstance(error, DrakeTrajError):
         error = DrakeTrajError(str(error))
     inside = bool(error.field) and error.field[0] in {item.name for item in fields(scenario.planner)}
     field = ("planner",) + (error.field if inside else ())
-    # a message that begins with its field's name ("waypoints[2] must ...") is continued from it
-    named = inside and str(error).startswith(field_text(error.field))
-    text = f"planner.{error}" if named else f"{field_text(field)}: {error}"
+    text = f"planner.{error}" if inside and message_leads_with_field else f"{field_text(field)}: {error}"
     return error.relocated(field, locate_in_scenario(scenario, field, text))
 
 

@@ -32,7 +32,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.geometry import (CollisionFilterDeclaration, Meshcat, MeshcatVisualizer, MeshcatVisualizerParams)
+from pydrake.geometry import CollisionFilterDeclaration, Meshcat, MeshcatVisualizer, MeshcatVisualizerParams
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant, MultibodyPlantConfig
 from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
@@ -44,9 +44,8 @@ from pydrake.systems.primitives import (ConstantVectorSource, Demultiplexer, Log
 from drake_traj.errors import Cause, Failure
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
-from drake_traj.robots import UR10E, Robot, get_robot
-from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, default_plant_config,
-                                 default_simulator_config, make_planner)
+from drake_traj.robots import UR10E, Robot
+from drake_traj.scenario import ControllerGains, Scenario, SpeedOverride, default_plant_config, default_simulator_config
 from drake_traj.scenario import preflight as scenario_preflight
 from drake_traj.validation import (callable_or_none, flag, instance_of, invalid, log_period_check,
                                    nonnegative_scalar, positive_scalar, real_scalar)
@@ -259,7 +258,8 @@ def make_station(scenario: Scenario, meshcat: Meshcat | None = None) -> Diagram:
 
     Simulate it with ``ApplySimulatorConfig(scenario.simulator, simulator)``: a Diagram cannot
     carry its integrator, and a plain ``Simulator`` uses Drake's default (error-controlled RK3),
-    not the scenario's (the reference then differs by about 1e-7 rad).
+    not the scenario's (the reference then differs by up to 1.2e-7 rad on ``quintic_ptp`` and
+    1.5e-6 rad on ``pajak_sim3``, measured).
 
     TypeError unless ``scenario`` is a Scenario (load one from a file or a shipped name with
     :func:`~drake_traj.scenario.load_scenario`)."""
@@ -303,26 +303,26 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
         return Failure.from_exception(error, root.get_time())
 
 
-_SCENARIO_S = object()  # an argument left to the scenario (or, for a planner, to its default)
+_UNSET = object()  # an argument not given: the scenario's value, or for a planner its default
 
 
 def simulate(
     planner: PlannerSystem | Scenario,
     *,
-    name: str = _SCENARIO_S,
-    robot: Robot = _SCENARIO_S,
+    name: str = _UNSET,
+    robot: Robot = _UNSET,
     gains: ControllerGains | None = None,
     plant_config: MultibodyPlantConfig | None = None,
     simulator_config: SimulatorConfig | None = None,
-    log_period: float = _SCENARIO_S,
-    settle_time: float = _SCENARIO_S,
-    max_duration: float = _SCENARIO_S,
-    speed_override=_SCENARIO_S,
+    log_period: float = _UNSET,
+    settle_time: float = _UNSET,
+    max_duration: float = _UNSET,
+    speed_override=_UNSET,
     meshcat: Meshcat | None = None,
     progress=None,
     add_systems=None,
     before_run=None,
-    tracking_tolerance: float | None = _SCENARIO_S,
+    tracking_tolerance: float | None = _UNSET,
     preflight: bool = True,
 ) -> SimulationResult:
     """Run a planner, or a scenario's, in a station until it finishes, plus ``settle_time`` [s].
@@ -362,22 +362,23 @@ def simulate(
                  speed_override=speed_override, tracking_tolerance=tracking_tolerance)
     if isinstance(planner, Scenario):
         scenario = planner
-        if robot is not _SCENARIO_S:
+        if robot is not _UNSET:
             raise TypeError(f"robot must not be given with a scenario: scenario {scenario.name!r} names its robot "
                             f"({scenario.robot!r})")
-        defaults = dict(name=scenario.name, robot=get_robot(scenario.robot), log_period=scenario.logging_period(),
+        arguments = scenario.station_arguments()  # its planner, robot, gains, plant and log period
+        planner = arguments["planner"]
+        defaults = dict(name=scenario.name, robot=arguments["robot"], log_period=arguments["log_period"],
                         settle_time=scenario.settle_time, max_duration=scenario.max_duration,
                         speed_override=scenario.speed_override, tracking_tolerance=scenario.tracking_tolerance)
-        gains, plant_config = gains or scenario.controller, plant_config or scenario.plant
+        gains, plant_config = gains or arguments["gains"], plant_config or arguments["plant_config"]
         simulator_config = simulator_config or scenario.simulator
-        planner = make_planner(scenario)
     else:
         scenario = None
         defaults = dict(name="run", robot=UR10E, log_period=1e-3, settle_time=0.5, max_duration=120.0,
                         speed_override=None, tracking_tolerance=DEFAULT_TRACKING_TOLERANCE)
         instance_of(planner, PlannerSystem, "planner", hint=" or a Scenario")
     name, robot, log_period, settle_time, max_duration, speed_override, tracking_tolerance = (
-        defaults[key] if value is _SCENARIO_S else value for key, value in given.items())
+        defaults[key] if value is _UNSET else value for key, value in given.items())
     # checked before the planner goes into a diagram (a planner is used in one diagram only)
     instance_of(name, str, "name")
     if simulator_config is not None:
