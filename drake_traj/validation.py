@@ -196,19 +196,21 @@ def require_finite(array: np.ndarray, name: str, unit: str = "") -> None:
     if not np.all(np.isfinite(array)):
         bad = np.argwhere(~np.isfinite(np.atleast_1d(array)))[0]
         index = [int(i) for i in bad] if array.ndim else []
-        where = "".join(f"[{i}]" for i in index) if len(index) < 2 else f"[{', '.join(map(str, index))}]"
+        where = f"[{', '.join(map(str, index))}]" if index else ""
         value = np.atleast_1d(array)[tuple(bad)]
         raise invalid(name, f"{name}{where} must be finite{f' [{unit}]' if unit else ''}, got {value}", *index)
 
 
-def require_positive(array: np.ndarray, name: str) -> None:
-    """A :class:`DrakeTrajError` at the first entry of the per-joint ``array`` that is not > 0
-    (its index and joint)."""
+def require_positive(array: np.ndarray, name: str, unit: str = "") -> None:
+    """A :class:`DrakeTrajError` at the first entry of ``array`` that is not > 0: its index and
+    joint (the last axis counts joints), and ``unit`` where given."""
     if np.any(array <= 0.0):
+        unit = f" [{unit}]" if unit else ""
         if array.ndim == 0:
-            raise invalid(name, f"{name} must be > 0, got {float(array)}")
-        j = int(np.argmax(array <= 0.0))
-        raise invalid(name, f"{name}[{j}] ({joint_label(j)}) must be > 0, got {float(array[j])}", j)
+            raise invalid(name, f"{name} must be > 0{unit}, got {float(array)}")
+        index = [int(i) for i in np.argwhere(array <= 0.0)[0]]
+        raise invalid(name, f"{name}[{', '.join(map(str, index))}] ({joint_label(index[-1])}) must be > 0{unit}, "
+                            f"got {float(array[tuple(index)])}", *index)
 
 
 def joint_bound(value, name: str, num_joints: int, unit: str) -> np.ndarray:
@@ -237,7 +239,5 @@ def joint_limit_with_unit(value, name: str, unit: str, num_joints: int) -> np.nd
         raise invalid(name, f"{name} must be a scalar or have shape ({num_joints},) [{unit}], got shape {array.shape}")
     require_finite(array, name, unit)
     array = np.broadcast_to(array, (num_joints,)).copy()
-    if np.any(array <= 0.0):
-        j = int(np.argmax(array <= 0.0))
-        raise invalid(name, f"{name}[{j}] ({joint_label(j)}) must be > 0 [{unit}], got {array[j]}", j)
+    require_positive(array, name, unit)
     return array

@@ -14,7 +14,7 @@ from drake_traj import Cause, DrakeTrajError, Failure, PlanningError, cli
 from drake_traj.errors import field_text, joint_label
 from drake_traj.scenario import ScenarioError, load_scenario, make_planner
 from drake_traj.station import make_station, simulate
-from drake_traj.validation import finite_array, positive_vector, real_scalar
+from drake_traj.validation import finite_array, positive_vector, real_scalar, require_positive
 
 from conftest import DIAGRAMS
 
@@ -37,6 +37,7 @@ def test_joints_are_named_by_their_one_based_number_and_name():
 @pytest.mark.parametrize("check, field", [
     (lambda: positive_vector([1.0, -1.0, 1.0], "velocity_limit", 3), ("velocity_limit", 1)),
     (lambda: finite_array([[0.0, 1.0], [np.nan, 2.0]], "goals", "rad"), ("goals", 1, 0)),
+    (lambda: require_positive(np.array([[1.0, 0.0]]), "velocity_limit"), ("velocity_limit", 0, 1)),  # broadcastable
     (lambda: real_scalar("fast", "speed_override.values", "-"), ("speed_override", "values")),
     (lambda: real_scalar(-1.0, "path parameter s", "-", minimum=0.0), ()),  # a phrase, not a field
 ])

@@ -29,7 +29,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, ContinuousStateIndex, EventStatus, LeafSystem, ValueProducer
 
-from drake_traj.planners.laws.contract import missing_members
+from drake_traj.planners.laws.contract import MEMBERS, missing_members
 from drake_traj.planners.laws.scaling import admissible_clock_rate, clock_at, next_clock_rate
 from drake_traj.validation import finite_array, invalid
 
@@ -200,8 +200,8 @@ class TimeLawPlanner(PlannerSystem):
     qd' = qdd (so q follows the law's own velocity, not the integrated one). Where the law's
     acceleration jumps (its ``acceleration_jumps``, law times; None: anywhere), a fixed step
     integrates the jump with an error that would stay: the update after it sets the reference
-    back on the law, (q_law(tau), q_law'(tau) c), as does every update that changes the clock, and the one that records the exact finish time (so the motion
-    ends exactly at the law's end). While c is at its goal and nothing jumps, the update changes
+    back on the law, (q_law(tau), q_law'(tau) c), as does every update that changes the clock,
+    and the one that records the exact finish time (so the motion ends exactly at the law's end). While c is at its goal and nothing jumps, the update changes
     nothing. The rates depend on the time and the clock only, and the last ones are kept by that
     key (:meth:`_rates`): the derivatives, both outputs and the update of one step share one law
     evaluation.
@@ -230,8 +230,8 @@ class TimeLawPlanner(PlannerSystem):
                             "rates come from the law): change the law, or derive from PlannerSystem")
         missing = missing_members(law)
         if missing:
-            raise TypeError(f"law must be a TimeLaw (drake_traj.planners.laws.TimeLaw: q_start, duration, "
-                            f"acceleration_jumps, rates_at, sample); a {type(law).__name__} has no {', '.join(missing)}")
+            raise TypeError(f"law must be a TimeLaw (drake_traj.planners.laws.TimeLaw: {', '.join(MEMBERS)}); "
+                            f"a {type(law).__name__} has no {', '.join(missing)}")
         if not np.isfinite(speed_cap) or not 0.0 < speed_cap <= 1.0:
             raise ValueError(f"speed_cap must be in (0, 1], got {speed_cap}")
         for name, value in (("update_period", update_period), ("scaling_rate", scaling_rate), ("clock_jerk", clock_jerk)):
@@ -266,17 +266,17 @@ class TimeLawPlanner(PlannerSystem):
 
         They depend on the time and the clock state only, so the last ones are kept by that key.
         Per step Drake asks at t (first RK2 stage), at t + h (second stage) and for the output at
-        t + h at the step's end: one law evaluation per step (counted on Li 4-DOF). The arrays are
-        read-only views of one (shared by every caller with that key).
+        t + h at the step's end: 1.1 law evaluations per step on average (counted on Li 4-DOF).
+        The arrays are read-only views of one (shared by every caller with that key).
 
         Kept on the instance, not in a Drake cache entry: the value is a function of the key alone
-        (the law does not change), so contexts with the same key may share it, and both cache
-        entries we measured cost more (planner alone under RK2 at 1 ms, medians of 5, µs per
-        step, quintic_ptp / Li 4-DOF): this memo 64 / 68; a cache entry on time and the clock
-        state 111 / 99 (Drake invalidates it at every SetTime, 3.2 law evaluations per step
-        instead of 1.1); a per-context scratch entry holding this memo 88 / 93 (its Eval from
-        Python). In the station, station / floor fell from 0.45 / 0.44 to 0.33 / 0.26 with the
-        first (examples/bench_planner_cost.py, 3-5 repeats)."""
+        (the law does not change), so contexts with the same key may share it. Two cache-entry
+        versions were tried (2026-11-25, not kept in the repository) and both cost more, planner
+        alone under RK2 at 1 ms, µs per step, quintic_ptp / Li 4-DOF: this memo 64 / 68; a cache
+        entry on time and the clock state 111 / 99 (Drake invalidates it at every SetTime: 3.2 law
+        evaluations per step instead of 1.1); a per-context entry holding this memo 88 / 93 (its
+        Eval from Python). Station / floor with examples/bench_planner_cost.py: this memo 0.45 /
+        0.44, the cache entry on time and clock 0.33 / 0.26."""
         key = (context.get_time(), *self._clock_state(context))
         if key != self._kept[0]:
             t, tau0, c_rate, c0, t0 = key

@@ -686,7 +686,9 @@ def inverse_kinematics_path(
         except SingularConfigurationError as err:
             raise SingularConfigurationError(f"path sample {i}: {err}") from err
         except ValueError as err:
-            raise DrakeTrajError(f"path sample {i}: {err}", cause=getattr(err, "cause", None)) from err
+            message = f"path sample {i}: {err}"
+            raise (err.relocated(err.field, message) if isinstance(err, DrakeTrajError)
+                   else DrakeTrajError(message)) from err
         step = np.abs(q - q_prev)
         if np.max(step) > max_step:
             joint = int(np.argmax(step))
@@ -694,7 +696,7 @@ def inverse_kinematics_path(
             raise DrakeTrajError(
                 f"path sample {i}: {joint_label(joint, JOINT_NAMES)} moves {step[joint]:.4g} rad from {where} "
                 f"(limit {max_step} rad): the path leaves the branch {ik_branch(q_prev)} "
-                f"(now {ik_branch(q)}) or is sampled too coarsely"
+                f"(now {ik_branch(q)}) or is sampled too coarsely", cause=Cause.INFEASIBLE
             )
         path[i] = q
         q_prev = q

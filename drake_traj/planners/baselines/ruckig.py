@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import ruckig
 
-from drake_traj.errors import DrakeTrajError, joint_label
+from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import instance_of, limit_or_default, positive_vector
@@ -119,7 +119,7 @@ class RuckigStopLaw:
                 raise ValueError(f"Ruckig returned {len(profiles)} sections on {where}, expected 1")
             for j, profile in enumerate(profiles[0]):
                 if profile.brake.duration != 0.0 or profile.accel.duration != 0.0:
-                    raise DrakeTrajError(f"Ruckig returned a brake/accel pre-phase on {where}, {joint_label(j)}")
+                    raise DrakeTrajError(f"Ruckig returned a brake/accel pre-phase on {where}, {joint_label(j)}", cause=Cause.PLANNING)
             # The seven jerk phases of every joint, padded by Ruckig to the synchronised duration.
             t_phase = np.array([list(profile.t) for profile in profiles[0]])  # (n, 7)
             phase_starts.append(np.concatenate([np.zeros((n, 1)), np.cumsum(t_phase, axis=1)[:, :-1]], axis=1))

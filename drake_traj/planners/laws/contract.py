@@ -15,7 +15,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-__all__ = ["TimeLaw", "missing_members"]
+__all__ = ["MEMBERS", "TimeLaw", "missing_members"]
 
 
 @runtime_checkable
@@ -45,11 +45,10 @@ class TimeLaw(Protocol):
 
 
 def missing_members(law) -> list[str]:
-    """The members of :class:`TimeLaw` that ``law`` lacks (empty for a time law)."""
-    if isinstance(law, TimeLaw):
-        return []
-    return [name for name in _MEMBERS if not hasattr(law, name)]
+    """The members of :class:`TimeLaw` that ``law`` lacks (empty for a time law: what the
+    Protocol's ``isinstance`` checks, named)."""
+    return [name for name in MEMBERS if not hasattr(law, name)]
 
 
-_MEMBERS = tuple(TimeLaw.__annotations__) + tuple(
+MEMBERS = tuple(TimeLaw.__annotations__) + tuple(
     name for name, value in vars(TimeLaw).items() if callable(value) and not name.startswith("_"))

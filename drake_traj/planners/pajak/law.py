@@ -72,13 +72,13 @@ class PajakLaw:
     def __init__(self, parameters: PajakConfig, robot: Robot = UR10E):
         if not isinstance(parameters, PajakConfig):
             raise ValueError(f"parameters must be a PajakConfig, got {type(parameters).__name__}")
+        refused = f"the Pająk planner runs on the UR10e (closed-form task kinematics), not on {robot.name!r}"
         try:
             kinematics = robot.task_kinematics()
-            if kinematics != KINEMATICS:
-                raise ValueError("its task kinematics are not the ones the compiled law is bound to")
         except ValueError as error:
-            raise ValueError(f"the Pająk planner runs on the UR10e (closed-form task kinematics), not on "
-                             f"{robot.name!r}: {error}") from None
+            raise ValueError(f"{refused}: {error}") from None
+        if kinematics != KINEMATICS:
+            raise ValueError(f"{refused}: its task kinematics are not the ones the compiled law is bound to")
         self.robot, self.kinematics = robot, kinematics
         p = parameters.validate()
         self.parameters = p

@@ -32,26 +32,6 @@ def scaling_slew(b, slew: float, budget: float) -> float:
 
 
 @compiled
-def _fmin(x: float, y: float) -> float:
-    """min ignoring NaN (numpy's fmin)."""
-    if x != x:
-        return y
-    if y != y:
-        return x
-    return min(x, y)
-
-
-@compiled
-def _fmax(x: float, y: float) -> float:
-    """max ignoring NaN (numpy's fmax)."""
-    if x != x:
-        return y
-    if y != y:
-        return x
-    return max(x, y)
-
-
-@compiled
 def scaling_interval(a, b, lower, upper):
     """(c_lo, c_hi): the interval of c with lower <= a + c b <= upper on every joint.
 
@@ -66,8 +46,8 @@ def scaling_interval(a, b, lower, upper):
     for i in range(a.shape[0]):
         to_max = (upper[i] - a[i]) / b[i]
         to_min = (lower[i] - a[i]) / b[i]
-        c_lo = max(c_lo, _fmin(to_max, to_min))
-        c_hi = min(c_hi, _fmax(to_max, to_min))
+        c_lo = max(c_lo, np.fmin(to_max, to_min))  # fmin, fmax: a NaN (0 / 0) bounds nothing
+        c_hi = min(c_hi, np.fmax(to_max, to_min))
     return c_lo, c_hi
 
 

@@ -289,16 +289,17 @@ def plan_synchronized_quintic(
         j = int(np.argmax(lower > upper))
         raise invalid("position_lower", f"position_lower[{j}] = {lower[j]} is above position_upper[{j}] = "
                                         f"{upper[j]} ({joint_label(j)})", j)
-    points = (("q_start", q0[None, :]), ("goals", goal_array))
-    for name, array in points:
-        for k, row in enumerate(array):
-            index = () if name == "q_start" else (k,)
-            for outside, bound, side in ((row < lower if lower is not None else None, lower, "below position_lower"),
-                                         (row > upper if upper is not None else None, upper, "above position_upper")):
-                if outside is not None and np.any(outside):
-                    j = int(np.argmax(outside))
-                    raise invalid(name, f"{field_text((name, *index, j))} ({joint_label(j)}) = {row[j]} rad is "
-                                        f"{side}[{j}] = {bound[j]} rad", *index, j)
+    bounds = [(bound, beyond, side) for bound, beyond, side in ((lower, np.less, "below position_lower"),
+                                                                (upper, np.greater, "above position_upper"))
+              if bound is not None]
+    rows = [("q_start", (), q0)] + [("goals", (k,), goal) for k, goal in enumerate(goal_array)]
+    for name, index, row in rows:
+        for bound, beyond, side in bounds:
+            outside = np.flatnonzero(beyond(row, bound))
+            if len(outside):
+                j = int(outside[0])
+                raise invalid(name, f"{field_text((name, *index, j))} ({joint_label(j)}) = {row[j]} rad is "
+                                    f"{side}[{j}] = {bound[j]} rad", *index, j)
 
     segments: list[QuinticSegment] = []
     t = 0.0
