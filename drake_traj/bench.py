@@ -208,7 +208,7 @@ def run_toppra(task: Task, reference: dict) -> dict:
 def _run(label, name, config, q0, repeats, keep_path) -> dict:
     try:
         planning = _planning_time(config, q0, repeats)
-        # no preflight: a task the law cannot finish is a failed run's row, found as it runs
+        # _planning_time has run the preflight already (a task it refuses is this row's failure)
         result = simulate(make_planner(config, UR10E, q0), name=name, settle_time=SETTLE_TIME,
                           max_duration=MAX_DURATION, preflight=False)
         row = _row(label, name, result, planning, _optimal_duration(result))

@@ -40,8 +40,8 @@ from drake_traj.export import FORMATS, UR_CYCLE, ExportError
 from drake_traj.meshcat import add_live_view, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
 from drake_traj.result import SimulationResult
 from drake_traj.rundir import MANIFEST, add_to_manifest, begin_output, check_output, run_files, write_manifest
-from drake_traj.scenario import (DEFAULT_SCENARIO, ScenarioError, default_scenario_path, find_scenario, load_scenario,
-                                 locate_in_scenario, preflight, scenario_variants, shipped_scenarios)
+from drake_traj.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
+                                 load_scenario, preflight, scenario_variants, shipped_scenarios)
 from drake_traj.station import simulate
 
 EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_TERMINATED = 0, 1, 2, 130, 143
@@ -105,30 +105,27 @@ def run(args) -> int:
     progress = Progress(scenario.max_duration, enabled=sys.stderr.isatty())
     interrupts = []
     try:
-        arguments = scenario.station_arguments()
+        arguments = scenario.station_arguments() | scenario.run_settings()
         planner = arguments.pop("planner")
         planned_path = None
         if args.preflight:
             progress.stage("preflight")
             planned_path = preflight(scenario, planner)
+        check_planned_duration(scenario, planner)
         duration = planner.planned_duration()
-        if np.isfinite(duration) and duration > scenario.max_duration:
-            raise ScenarioError(locate_in_scenario(
-                scenario, ("max_duration",), f"max_duration ({scenario.max_duration:g} s) is shorter than the planned "
-                                             f"motion ({duration:.3f} s at the planner's limits); raise max_duration "
-                                             "or the limits"), field=("max_duration",), cause=Cause.INFEASIBLE)
         # checked before the simulation; written (an earlier run replaced, with --overwrite) only
         # once there are results
         out_dir = check_output(Path(args.out) if args.out else Path("out") / scenario.name, overwrite=args.overwrite)
         progress.expect(duration + scenario.settle_time if np.isfinite(duration) else scenario.max_duration)
         meshcat = start_meshcat(args.port, announce=args.meshcat)
-        draw_task(meshcat, planner.task_waypoints(), planned_path=planned_path)
+        draw_task(meshcat, planner.task_waypoints(), neighbourhood=planner.waypoint_neighbourhood(),
+                  planned_path=planned_path)
         frame_task(meshcat, np.vstack([planner.task_waypoints().reshape(-1, 3),
                                        planned_path if planned_path is not None else np.zeros((0, 3))]))
-        simulator_config = scenario.simulator
         add_systems = before_run = None
         if args.meshcat:
-            simulator_config.target_realtime_rate = args.rate
+            arguments["simulator_config"].target_realtime_rate = args.rate
+            arguments["speed_override"] = None  # the live view's slider drives it
             print(f"Meshcat: {meshcat.web_url()}", file=sys.stderr, flush=True)
 
             def add_systems(builder, station):
@@ -143,11 +140,8 @@ def run(args) -> int:
                               file=sys.stderr, flush=True)
 
         progress.stage("simulating")
-        result = simulate(planner, name=scenario.name, simulator_config=simulator_config,
-                          settle_time=scenario.settle_time, max_duration=scenario.max_duration,
-                          speed_override=None if args.meshcat else scenario.speed_override, meshcat=meshcat,
-                          progress=progress.simulated, add_systems=add_systems, before_run=before_run,
-                          tracking_tolerance=scenario.tracking_tolerance, preflight=False, **arguments)
+        result = simulate(planner, meshcat=meshcat, progress=progress.simulated, add_systems=add_systems,
+                          before_run=before_run, preflight=False, **arguments)
         progress.stage("writing figures")
         with _interrupts_deferred() as interrupts:  # a second Ctrl-C must not leave half a run
             out_dir = begin_output(out_dir, overwrite=args.overwrite)
@@ -210,9 +204,9 @@ def show_scenario(args) -> int:
     """``drake-traj show``: the text of a scenario's file (a shipped one by its name), to copy
     and edit; on stderr, its path and how to run the copy."""
     path, variant = _scenario_reference(args)
-    if variant is not None:
-        load_scenario(path, variant)  # an unknown variant is named as ``run`` names it
     variants = scenario_variants(path)
+    if variant is not None and variant not in variants:
+        load_scenario(path, variant)  # refuses it, naming the file's variants as ``run`` does
     print(path.read_text(), end="")
     option = f" --variant {variant or '|'.join(variants)}" if variants else ""
     print(f"drake-traj: that is {path}; run a copy with: drake-traj run my_copy.yaml{option}", file=sys.stderr)

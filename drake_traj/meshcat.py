@@ -24,6 +24,7 @@ __all__ = [
 ]
 
 WAYPOINT_COLOUR = Rgba(1.0, 0.55, 0.0, 0.5)
+MARKER_RADIUS = 0.015  # [m] a waypoint the planner passes through or stops at
 PATH_COLOUR = Rgba(0.9, 0.1, 0.1, 1.0)
 PLANNED_COLOUR = Rgba(0.35, 0.35, 0.35, 1.0)
 SPEED_SLIDER = "speed override"
@@ -42,14 +43,18 @@ def start_meshcat(port: int | None = None, *, announce: bool = True) -> Meshcat:
         drake_log.setLevel(level)
 
 
-def draw_task(meshcat: Meshcat, waypoints, *, neighbourhood: float = 0.05, planned_path=None) -> None:
-    """Waypoint neighbourhoods (spheres of radius ``neighbourhood`` [m], default Pająk 2024's ϵ)
-    at ``waypoints`` (m, 3) [m], and the ``planned_path`` (N, 3) [m] where a planner computed it
-    before moving. Replaces what an earlier call drew."""
+def draw_task(meshcat: Meshcat, waypoints, *, neighbourhood: float = float("nan"), planned_path=None) -> None:
+    """The ``waypoints`` (m, 3) [m]: each but the last as its neighbourhood, a sphere of radius
+    ``neighbourhood`` [m] (the planner's :meth:`~drake_traj.planners.base.PlannerSystem.waypoint_neighbourhood`,
+    Pająk 2024's ϵ), the last, and every one where it is NaN, as a marker of :data:`MARKER_RADIUS`;
+    and the ``planned_path`` (N, 3) [m] where a planner computed it before moving. Replaces what
+    an earlier call drew."""
     meshcat.Delete("/drake_traj")
-    for index, point in enumerate(np.asarray(waypoints, dtype=float).reshape(-1, 3)):
+    points = np.asarray(waypoints, dtype=float).reshape(-1, 3)
+    for index, point in enumerate(points):
         path = f"/drake_traj/waypoints/{index}"
-        meshcat.SetObject(path, Sphere(neighbourhood), WAYPOINT_COLOUR)
+        turns_here = index < len(points) - 1 and np.isfinite(neighbourhood)
+        meshcat.SetObject(path, Sphere(neighbourhood if turns_here else MARKER_RADIUS), WAYPOINT_COLOUR)
         meshcat.SetTransform(path, RigidTransform(point))
     if planned_path is not None and len(planned_path) > 1:
         meshcat.SetLine("/drake_traj/planned_path", np.asarray(planned_path, dtype=float).T.copy(), 2.0, PLANNED_COLOUR)

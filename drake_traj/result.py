@@ -22,7 +22,7 @@ from matplotlib.figure import Figure
 
 from drake_traj.errors import Cause, DrakeTrajError, Failure, joint_label
 from drake_traj.export import export, reference_trajectory
-from drake_traj.robots import get_robot
+from drake_traj.robots import ROBOT_NAMES, get_robot
 from drake_traj.robots.ur10e import pose_error
 from drake_traj.rundir import OutputError, clear_run, create_folder, holds_a_run
 from drake_traj.validation import invalid, path_argument, positive_scalar, real_array
@@ -195,8 +195,9 @@ class SimulationResult:
 
     @property
     def joint_names(self) -> tuple[str, ...] | None:
-        """The robot's joint names, where the robot is known (messages name joints by them)."""
-        return tuple(get_robot(self.robot).joint_names) if self.robot else None
+        """The joint names of the robot, where it is one of ours (messages name joints by them);
+        None for a robot of one's own, which the registry does not know."""
+        return tuple(get_robot(self.robot).joint_names) if self.robot in ROBOT_NAMES else None
 
     def non_finite_failure(self) -> Failure | None:
         """A :class:`Failure` (cause "non-finite") naming the first logged array and sample that

@@ -41,7 +41,8 @@ from drake_traj.yaml_schema import ScenarioError, checked_document, locate
 __all__ = [
     "ControllerGains", "Scenario", "ScenarioError", "ScenarioSource", "ShippedScenario", "SpeedOverride",
     "default_plant_config", "default_scenario_path", "default_simulator_config", "find_scenario", "load_scenario",
-    "locate_in_scenario", "make_planner", "preflight", "scenario_variants", "shipped_scenarios",
+    "check_planned_duration", "locate_in_scenario", "make_planner", "preflight", "scenario_variants",
+    "shipped_scenarios",
 ]
 
 DEFAULT_SCENARIO = ("pajak.yaml", "sim3")  # what ``drake-traj run`` runs when given no scenario
@@ -243,6 +244,14 @@ class Scenario:
         return dict(planner=make_planner(self), robot=get_robot(self.robot), gains=self.controller,
                     plant_config=self.plant, log_period=self.logging_period())
 
+    def run_settings(self) -> dict:
+        """The keyword arguments of :func:`drake_traj.station.simulate` that this scenario sets
+        besides :meth:`station_arguments`: the run's name, integrator, times, speed override and
+        tracking tolerance."""
+        return dict(name=self.name, simulator_config=self.simulator, settle_time=self.settle_time,
+                    max_duration=self.max_duration, speed_override=self.speed_override,
+                    tracking_tolerance=self.tracking_tolerance)
+
     def logging_period(self) -> float:
         """``log_period``, or the plant's time step where it is 0 [s]."""
         return self.log_period if self.log_period != 0 else self.plant.time_step
@@ -419,6 +428,18 @@ def preflight(scenario: Scenario, planner: PlannerSystem) -> np.ndarray | None:
         return planner.preflight()
     except ValueError as error:
         raise _in_planner_field(scenario, error, message_leads_with_field=False) from error
+
+
+def check_planned_duration(scenario: Scenario, planner: PlannerSystem) -> None:
+    """A :class:`ScenarioError` (cause INFEASIBLE) at ``max_duration`` when it is shorter than
+    the motion ``planner`` plans (at its limits), which the run could never finish."""
+    duration = planner.planned_duration()
+    if np.isfinite(duration) and duration > scenario.max_duration:
+        field = ("max_duration",)
+        raise ScenarioError(locate_in_scenario(
+            scenario, field, f"max_duration ({scenario.max_duration:g} s) is shorter than the planned motion "
+                             f"({duration:.3f} s at the planner's limits); raise max_duration or the limits"),
+            field=field, cause=Cause.INFEASIBLE)
 
 
 def _in_planner_field(scenario: Scenario, error: ValueError, *, message_leads_with_field: bool) -> DrakeTrajError:

@@ -45,7 +45,8 @@ from drake_traj.errors import Cause, Failure
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
 from drake_traj.robots import UR10E, Robot
-from drake_traj.scenario import ControllerGains, Scenario, SpeedOverride, default_plant_config, default_simulator_config
+from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, check_planned_duration, default_plant_config,
+                                 default_simulator_config)
 from drake_traj.scenario import preflight as scenario_preflight
 from drake_traj.validation import (callable_or_none, flag, instance_of, invalid, log_period_check,
                                    nonnegative_scalar, positive_scalar, real_scalar)
@@ -311,9 +312,9 @@ def simulate(
     *,
     name: str = _UNSET,
     robot: Robot = _UNSET,
-    gains: ControllerGains | None = None,
-    plant_config: MultibodyPlantConfig | None = None,
-    simulator_config: SimulatorConfig | None = None,
+    gains: ControllerGains | None = _UNSET,
+    plant_config: MultibodyPlantConfig | None = _UNSET,
+    simulator_config: SimulatorConfig | None = _UNSET,
     log_period: float = _UNSET,
     settle_time: float = _UNSET,
     max_duration: float = _UNSET,
@@ -330,9 +331,11 @@ def simulate(
     Given a :class:`~drake_traj.scenario.Scenario` (``simulate(load_scenario("quintic_ptp"))``),
     this is ``drake-traj run`` without the files: the scenario's planner, robot, gains, plant,
     log period, integrator, speed override, tolerance and times, each replaced by an argument
-    given here (except ``robot``: the scenario names its own). Given a planner system, the
-    defaults are the UR10e, the robot's gains, 1 ms logs, 0.5 s settle time, 120 s at most, no
-    speed override and a 5 mm tracking tolerance.
+    given here (except ``robot``: the scenario names its own), and a ``max_duration`` shorter
+    than the planned motion refused before the run as the command line refuses it. Given a
+    planner system, the defaults are the UR10e, the robot's gains, our plant and integrator
+    (None: the same), 1 ms logs, 0.5 s settle time, 120 s at most, no speed override and a 5 mm
+    tracking tolerance.
 
     The run stops at ``max_duration`` [s] if the planner has not finished. Whatever stops the run
     early (an exception from a planner, a timeout, Ctrl-C) is caught: the result holds everything
@@ -358,27 +361,24 @@ def simulate(
 
     Every argument is checked before the run (TypeError or ValueError naming it).
     """
-    given = dict(name=name, robot=robot, log_period=log_period, settle_time=settle_time, max_duration=max_duration,
+    given = dict(name=name, robot=robot, gains=gains, plant_config=plant_config, simulator_config=simulator_config,
+                 log_period=log_period, settle_time=settle_time, max_duration=max_duration,
                  speed_override=speed_override, tracking_tolerance=tracking_tolerance)
     if isinstance(planner, Scenario):
         scenario = planner
         if robot is not _UNSET:
             raise TypeError(f"robot must not be given with a scenario: scenario {scenario.name!r} names its robot "
                             f"({scenario.robot!r})")
-        arguments = scenario.station_arguments()  # its planner, robot, gains, plant and log period
-        planner = arguments["planner"]
-        defaults = dict(name=scenario.name, robot=arguments["robot"], log_period=arguments["log_period"],
-                        settle_time=scenario.settle_time, max_duration=scenario.max_duration,
-                        speed_override=scenario.speed_override, tracking_tolerance=scenario.tracking_tolerance)
-        gains, plant_config = gains or arguments["gains"], plant_config or arguments["plant_config"]
-        simulator_config = simulator_config or scenario.simulator
+        defaults = scenario.station_arguments() | scenario.run_settings()
+        planner = defaults.pop("planner")
     else:
         scenario = None
-        defaults = dict(name="run", robot=UR10E, log_period=1e-3, settle_time=0.5, max_duration=120.0,
-                        speed_override=None, tracking_tolerance=DEFAULT_TRACKING_TOLERANCE)
+        defaults = dict(name="run", robot=UR10E, gains=None, plant_config=None, simulator_config=None, log_period=1e-3,
+                        settle_time=0.5, max_duration=120.0, speed_override=None,
+                        tracking_tolerance=DEFAULT_TRACKING_TOLERANCE)
         instance_of(planner, PlannerSystem, "planner", hint=" or a Scenario")
-    name, robot, log_period, settle_time, max_duration, speed_override, tracking_tolerance = (
-        defaults[key] if value is _UNSET else value for key, value in given.items())
+    (name, robot, gains, plant_config, simulator_config, log_period, settle_time, max_duration, speed_override,
+     tracking_tolerance) = (defaults[key] if value is _UNSET else value for key, value in given.items())
     # checked before the planner goes into a diagram (a planner is used in one diagram only)
     instance_of(name, str, "name")
     if simulator_config is not None:
@@ -395,6 +395,8 @@ def simulate(
         scenario_preflight(scenario, planner)  # its errors located in the scenario file
     elif preflight:
         planner.preflight()
+    if scenario is not None:
+        check_planned_duration(scenario, planner)
     builder = DiagramBuilder()
     station = builder.AddSystem(build_station(planner, robot=robot, gains=gains, plant_config=plant_config,
                                               log_period=log_period, meshcat=meshcat))

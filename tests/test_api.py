@@ -132,6 +132,26 @@ def test_simulate_runs_a_scenario_as_its_parts_do():
     np.testing.assert_array_equal(whole.q_meas, parts.q_meas)
 
 
+def test_simulate_refuses_a_max_duration_shorter_than_the_plan_as_the_cli_does(tmp_path, capsys):
+    path = tmp_path / "short.yaml"
+    path.write_text((DIAGRAMS / "quintic_ptp.yaml").read_text() + "max_duration: 1.0\n")
+    with pytest.raises(ScenarioError) as info:
+        simulate(load_scenario(path))
+    assert info.value.field == ("max_duration",) and info.value.cause is Cause.INFEASIBLE
+    assert "shorter than the planned motion (6.177 s" in str(info.value)
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out")]) == cli.EXIT_BAD_INPUT
+    assert str(info.value) in capsys.readouterr().err
+
+
+def test_a_result_of_ones_own_robot_names_joints_by_number():
+    result = simulate(drake_traj.planners.make_planner(
+        drake_traj.QuinticConfig(goals=[[-1.5, -1.6, -2.3, -0.8, 1.6, 0.8]]), drake_traj.get_robot("ur10e"),
+        drake_traj.get_robot("ur10e").home_configuration), settle_time=0.0)
+    assert result.joint_names[1] == "shoulder_lift_joint"
+    result.robot = "my_arm"  # a Robot of one's own: not in the registry
+    assert result.joint_names is None and result.execution_failure(0.005) is None
+
+
 def test_simulate_refuses_a_robot_beside_a_scenario():
     with pytest.raises(TypeError, match="names its robot"):
         simulate(load_scenario("quintic_ptp"), robot=drake_traj.get_robot("ur10e"))
