@@ -50,35 +50,40 @@ def orange_pixels(png):
     return int(((rgb[..., 0] > 150) & (rgb[..., 1] > 70) & (rgb[..., 1] < 170) & (rgb[..., 2] < 90)).sum())
 
 
-def loaded_screenshot(url, png, attempts: int = 4):
-    """A screenshot of a live page once it has loaded the whole scene (the arm's blue and the
-    task's orange are on it): on a busy machine a fresh page can take longer than one wait to
-    receive it, and the arm arrives before the task (seen once in CI: the arm alone, 79 orange
-    pixels)."""
-    for _ in range(attempts):
-        browser.screenshot_url(url, png, wait_ms=5000)
-        if browser.blue_pixel_fraction(png) > 0.002 and orange_pixels(png) > 100:
+def loaded_screenshots(url, folder, process, count: int = 2) -> list:
+    """``count`` screenshots of a live page, taken one after another while ``process`` (the run
+    serving it) is still moving the arm, each once the page has loaded the whole scene (the arm's
+    blue and the task's orange are on it). A fresh headless page does not always have the scene
+    within its wait: measured here, 2 of 6 pages 5 s after the start, and in CI the arm alone
+    (79 orange pixels), so shots without the scene are retaken while the motion lasts."""
+    shots = []
+    for attempt in range(20):
+        if len(shots) == count or process.poll() is not None:
             break
-    return png
+        png = browser.screenshot_url(url, folder / f"live_{attempt}.png", wait_ms=5000)
+        if browser.blue_pixel_fraction(png) > 0.002 and orange_pixels(png) > 100 and process.poll() is None:
+            shots.append(png)
+    assert len(shots) == count, f"only {len(shots)} of {count} live screenshots showed the scene during the motion"
+    return shots
 
 
 def test_live_view_shows_the_arm_the_task_and_a_growing_trail(tmp_path):
     assert CHROMIUM is not None, "CI must install chromium"
     port = browser.free_port()
     out = tmp_path / "live"
-    # A quarter of real time: the 5.3 s motion of Pająk 2024 sim 3 takes 21 s; no terminal, and
-    # --serve-after 0: it exits once the run's files are written.
+    # A tenth of real time: the 5.3 s motion of Pająk 2024 sim 3 takes 53 s, time for several
+    # screenshots (5-8 s each); no terminal, and --serve-after 0: it exits once the run's files
+    # are written.
     process = subprocess.Popen(
         [sys.executable, "-m", "drake_traj.cli", "run", "pajak_sim3", "--out", str(out), "--meshcat",
-         "--port", str(port), "--rate", "0.25", "--wait-timeout", "120", "--serve-after", "0"],
+         "--port", str(port), "--rate", "0.1", "--wait-timeout", "120", "--serve-after", "0"],
         stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     try:
         waiting = browser.read_until(process.stderr, "waiting up to", timeout=120)
         assert f"http://localhost:{port}" in waiting
         # The first browser to connect starts the motion; two more screenshots catch it mid-way.
         browser.screenshot_url(f"http://localhost:{port}", tmp_path / "start.png", wait_ms=1000)
-        early = loaded_screenshot(f"http://localhost:{port}", tmp_path / "early.png")
-        later = loaded_screenshot(f"http://localhost:{port}", tmp_path / "later.png")
+        early, later = loaded_screenshots(f"http://localhost:{port}", tmp_path, process)
         stdout, stderr = process.communicate(timeout=180)
     finally:
         process.kill()
