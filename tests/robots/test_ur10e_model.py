@@ -10,7 +10,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from pydrake.geometry import Cylinder, Role
+from pydrake.geometry import Capsule, Cylinder, Role
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import JointActuatorIndex
@@ -279,7 +279,8 @@ def test_10_visuals_are_coloured_primitives(ur10e):
     assert set(body for body, _ in visuals.values()) == {robot.BASE_FRAME, *LINK_NAMES}
     housings = 0
     for name, (body, geometry_id) in visuals.items():
-        assert isinstance(inspector.GetShape(geometry_id), Cylinder), name
+        # Tubes are capsules, housings, base and flange cylinders (tests/robots/test_ur10e_collision.py).
+        assert isinstance(inspector.GetShape(geometry_id), Capsule if name.endswith("_tube") else Cylinder), name
         rgba = inspector.GetIllustrationProperties(geometry_id).GetProperty("phong", "diffuse")
         colour = (rgba.r(), rgba.g(), rgba.b(), rgba.a())
         if "housing" in name:
@@ -308,7 +309,7 @@ def test_12_file_is_self_contained_and_loads_offline():
     text = MODEL_FILE.read_text()
     assert "package://" not in text
     assert "<mesh" not in text and "filename" not in text
-    assert '<robot name="ur10e">' in text
+    assert '<robot name="ur10e" xmlns:drake="http://drake.mit.edu">' in text  # drake:capsule's namespace
     # Drake reaches the network only to fetch remote packages (drake_models) named by package://
     # URIs; with an empty PackageMap nothing can be fetched. (DRAKE_ALLOW_NETWORK=none cannot be used
     # here: in Drake 1.51 Parser() itself then throws unless drake_models is already in the cache.)
