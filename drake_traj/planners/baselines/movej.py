@@ -188,6 +188,9 @@ class MovejBlendLaw:
         self.segment_accels = np.array(accels)
         self.blend_overlaps = overlaps
         self.duration = float(starts[-1] + durations[-1]) if m else 0.0
+        # every joint is one quadratic between the segments' starts, ramp ends and ends [s]
+        ramps_at = np.array([np.zeros(m), ramps, self.segment_durations - ramps, self.segment_durations])
+        self.polynomial_breaks = np.unique(np.append(starts + ramps_at, 0.0))
         # Plain-Python copies for the scalar hot path.
         self._starts = starts.tolist()
         self._ends = (starts + self.segment_durations).tolist()

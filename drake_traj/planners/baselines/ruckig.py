@@ -149,6 +149,7 @@ class RuckigStopLaw:
         if len(knots) < 2:  # every waypoint equal: a zero-duration law
             knots = np.array([0.0, 0.0])
         _, v_knot, a_knot = self.sample(knots[:-1])
+        self.polynomial_breaks = knots  # law times [s]: every joint is one cubic between them
         self._knots = knots[:-1].tolist()
         self._knot_v = v_knot
         self._knot_a = a_knot

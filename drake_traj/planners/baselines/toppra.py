@@ -263,6 +263,8 @@ class ToppraLaw:
         swept = np.zeros_like(velocity)
         swept[1:] = np.cumsum(h * (displacement[:-1] + h * (velocity[:-1] / 2 + step / 6)), axis=0)
         self._velocity, self._step, self._displacement, self._swept = velocity, step, displacement, swept
+        # the table's nodes [s]: q is one cubic between them (tau and tau - h cross nodes together)
+        self.polynomial_breaks = np.arange(last + 2) * h
         self._zero = np.zeros(self.num_joints)
 
     def _table(self, u: float):

@@ -29,11 +29,16 @@ class TimeLaw(Protocol):
             continuous), or None: it may jump anywhere. Where it jumps, the planner's next update
             sets the reference back on the law (a fixed integrator step integrates a jump with an
             error that would stay).
+        polynomial_breaks: increasing law times [s] from 0 to ``duration`` between which q_law is
+            one polynomial of degree <= 5, (B,): the pieces of the planner's ``plan()``
+            (:func:`~drake_traj.planners.laws.pieces.law_pieces`), exact on them. A law that is
+            not piecewise polynomial gives breaks dense enough for its quintic interpolation.
     """
 
     q_start: np.ndarray
     duration: float
     acceleration_jumps: np.ndarray | None
+    polynomial_breaks: np.ndarray
 
     def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
         """(q_law'(tau) [rad/s], q_law''(tau) [rad/s²]), each (n,), at one law time tau [s]: the

@@ -11,7 +11,33 @@ import numpy as np
 
 from drake_traj.planners.laws.polynomials import rate_peaks
 
-__all__ = ["HermiteLaw"]
+__all__ = ["HermiteLaw", "quintic_hermite_coefficients"]
+
+
+def quintic_hermite_coefficients(knots, right, left) -> np.ndarray:
+    """The quintic Hermite polynomial on each knot interval that meets (q, q̇, q̈) at both ends.
+
+    Args:
+        knots: increasing times [s], (K,).
+        right: (q, q̇, q̈) just after each knot [rad, rad/s, rad/s²], (K, 3, n); row K-1 unused.
+        left: (q, q̇, q̈) just before each knot, (K, 3, n); row 0 unused.
+
+    Returns:
+        Monomial coefficients c0..c5 in s = t - knots[k] on interval k, (K-1, 6, n): q(s) =
+        sum_j c_j s^j. The end values enter through q1 - q0, so the round-off of q [rad] reaches
+        q̈ as eps |q| / h² (6e-10 rad/s² at |q| = 3 rad, h = 1 ms).
+    """
+    knots = np.asarray(knots, dtype=float)
+    right, left = np.asarray(right, dtype=float), np.asarray(left, dtype=float)
+    h = np.diff(knots)[:, None]
+    (q0, v0, a0), (q1, v1, a1) = np.moveaxis(right[:-1], 1, 0), np.moveaxis(left[1:], 1, 0)
+    delta = q1 - q0
+    return np.stack([
+        q0, v0, 0.5 * a0,
+        (20 * delta - (8 * v1 + 12 * v0) * h - (3 * a0 - a1) * h**2) / (2 * h**3),
+        (-30 * delta + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h**2) / (2 * h**4),
+        (12 * delta - 6 * (v1 + v0) * h + (a1 - a0) * h**2) / (2 * h**5),
+    ], axis=1)
 
 
 class HermiteLaw:
@@ -37,21 +63,17 @@ class HermiteLaw:
         self.duration = float(knots[-1])
         self.q_start = right[0, 0].copy()
         self.acceleration_jumps = np.asarray(acceleration_jumps, dtype=float)
-        h = np.diff(knots)[:, None]
-        (q0, v0, a0), (q1, v1, a1) = np.moveaxis(right[:-1], 1, 0), np.moveaxis(left[1:], 1, 0)
-        delta = q1 - q0
-        # quintic Hermite in s = tau - knot, monomial coefficients c0..c5, (K-1, 6, n)
-        self._coefficients = np.stack([
-            q0, v0, 0.5 * a0,
-            (20 * delta - (8 * v1 + 12 * v0) * h - (3 * a0 - a1) * h**2) / (2 * h**3),
-            (-30 * delta + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h**2) / (2 * h**4),
-            (12 * delta - 6 * (v1 + v0) * h + (a1 - a0) * h**2) / (2 * h**5),
-        ], axis=1)
+        self._coefficients = quintic_hermite_coefficients(knots, right, left)
         # (q̇, q̈) at s as one product, powers (1, s, s², s³, s⁴) @ [j c_j | j (j - 1) c_j]: (K-1, 5, 2n)
         first = np.arange(1, 6)[None, :, None] * self._coefficients[:, 1:]
         second = np.arange(1, 5)[None, :, None] * first[:, 1:]
         self._rate_coefficients = np.concatenate([first, np.pad(second, ((0, 0), (0, 1), (0, 0)))], axis=2)
         self._end = left[-1].copy()
+
+    @property
+    def polynomial_breaks(self) -> np.ndarray:
+        """The knots [s]: the law is one quintic between them."""
+        return self.knots
 
     def interval_polynomials(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """q̇ and q̈ on each knot interval as polynomials in sigma in [-1, 1] (tau = mid + sigma

@@ -299,6 +299,11 @@ class JointSplineLaw:
         """Length of the motion [s]."""
         return self._duration
 
+    @property
+    def polynomial_breaks(self) -> np.ndarray:
+        """The knot times [s]: the B-spline is one quintic between them."""
+        return self.knot_times
+
     def interval_polynomials(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """qd and qdd on each knot interval as polynomials in sigma in [-1, 1].
 

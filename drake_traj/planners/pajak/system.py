@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from drake_traj.planners.base import PlannerSystem
+from drake_traj.planners.laws.hermite import quintic_hermite_coefficients
 from drake_traj.planners.pajak.integration import integrate
 from drake_traj.planners.pajak.kernel import Discrete
 from drake_traj.planners.pajak.law import PajakLaw
@@ -44,6 +45,7 @@ class PajakPlanner(PlannerSystem):
         self.velocity_limit = self.law.qd_max
         self.acceleration_limit = self.law.qdd_max
         self.DeclarePeriodicDiscreteUpdateEvent(update_period, 0.0, self._update)
+        self._run = None  # the preflight's integration (:func:`integrate`), kept once it finished
 
     def _law_arguments(self, context):
         state = self.reference_state(context)
@@ -74,10 +76,25 @@ class PajakPlanner(PlannerSystem):
         waypoint). A run that finishes has reached the whole pose (position within ε,
         orientation within ``orientation_accuracy``).
 
+        The integration is kept once it finished (the law does not change): a second preflight
+        and :meth:`plan` reuse it; one that failed is run again and raises again.
+
         Returns:
             The planned TCP path [m], (N, 3).
         """
-        return integrate(self.law, self.initial_positions())["tcp"][:, :3]
+        if self._run is None:
+            self._run = integrate(self.law, self.initial_positions(), dt=self.law.parameters.update_period)
+        return self._run["tcp"][:, :3]
+
+    def _plan_pieces(self) -> tuple[np.ndarray, np.ndarray]:
+        """The preflight's samples (t, q, q̇, q̈) up to the finish, one every update period,
+        joined by quintic Hermite pieces (:func:`quintic_hermite_coefficients`; q̈ the law's
+        after each step's update on both sides of its sample)."""
+        self.preflight()
+        end = self._run["finish_index"] + 1
+        times = self._run["t"][:end]
+        samples = np.stack([self._run[name][:end] for name in ("q", "qd", "qdd")], axis=1)
+        return times, quintic_hermite_coefficients(times, samples, samples)
 
     def goal_pose(self) -> np.ndarray:
         """p_f, the last waypoint [m, rad]."""

@@ -148,6 +148,11 @@ class QuinticLaw:
         """Segment start times followed by the plan's end time [s], shape (K + 1,)."""
         return np.append(self._t_starts, self.duration)
 
+    @property
+    def polynomial_breaks(self) -> np.ndarray:
+        """0, every segment's start and end [s]: the law is one quintic (or at rest) between them."""
+        return np.unique(np.concatenate([[0.0], self._t_starts, self._t_starts + self._durations]))
+
     def _locate(self, t):
         """Segment index and clipped normalised time s for every sample of ``t``."""
         t_array = real_array(t, "t", UNITS)
