@@ -116,7 +116,7 @@ def test_a_motion_of_no_length_has_no_plan():
                            get_robot(scenario.robot), scenario.start_configuration())
     with pytest.raises(PlanningError, match="no trajectory to plan"):
         planner.plan()
-    with pytest.raises(PlanningError):
+    with pytest.raises(ValueError, match="no pieces"):
         law_pieces(planner.law)
 
 

@@ -31,6 +31,7 @@ from pydrake.polynomial import Polynomial
 from pydrake.systems.framework import BasicVector, ContinuousStateIndex, EventStatus, LeafSystem, ValueProducer
 from pydrake.trajectories import PiecewisePolynomial
 
+from drake_traj.errors import Cause, PlanningError
 from drake_traj.planners.laws.contract import MEMBERS, missing_members
 from drake_traj.planners.laws.pieces import law_pieces
 from drake_traj.planners.laws.scaling import admissible_clock_rate, clock_at, next_clock_rate
@@ -363,6 +364,9 @@ class TimeLawPlanner(PlannerSystem):
     def _plan_pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The law's pieces on the clock at the speed cap (c starts there and stays without an
         override): :func:`~drake_traj.planners.laws.pieces.law_pieces`."""
+        if not self.law.duration > 0.0:
+            raise PlanningError(f"the motion lasts {self.law.duration} s (every goal equals the start): there is no "
+                                "trajectory to plan", cause=Cause.PLANNING)
         return law_pieces(self.law, self.speed_cap)
 
     def _next_clock_rate(self, tau: float, c: float, c_rate: float, goal: float) -> float:

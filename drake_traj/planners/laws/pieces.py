@@ -15,8 +15,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from drake_traj.errors import Cause, PlanningError
-
 __all__ = ["MIN_PIECE", "law_pieces", "merged_breaks"]
 
 MIN_PIECE = 1e-9
@@ -63,12 +61,11 @@ def law_pieces(law, rate: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         ``polynomial_breaks`` (:func:`merged_breaks`) in simulation time.
 
     Raises:
-        PlanningError: the law lasts 0 s (every goal equals the start): no motion to plan.
+        ValueError: the law lasts 0 s: no piece to make.
     """
     duration = float(law.duration)
     if not duration > 0.0:
-        raise PlanningError(f"the motion lasts {duration} s (every goal equals the start): there is no "
-                            "trajectory to plan", cause=Cause.PLANNING)
+        raise ValueError(f"the law lasts {duration} s: there are no pieces to make")
     breaks = merged_breaks(law.polynomial_breaks, duration)
     lengths = np.diff(breaks)  # h, law time [s]
     nodes = breaks[:-1, None] + lengths[:, None] * _NODES  # (K, 4) law times [s]
