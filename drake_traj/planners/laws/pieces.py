@@ -3,8 +3,9 @@ reference of a :class:`~drake_traj.planners.base.TimeLawPlanner` before its run.
 
 Every law in the package is a polynomial of degree <= 5 between its ``polynomial_breaks``
 (quintic moves, quintic Hermite tables, a quintic B-spline, trapezoids, Ruckig's cubics, Toppra's
-averaged table). On each piece the law is sampled at four interior points: q̈ there fixes the
-cubic q̈ (Chebyshev nodes), and q̇ and q at the first node fix the two integration constants. For
+averaged table). On each piece q̈ at four interior points (Chebyshev nodes, the law's
+``rates_at``) fixes the cubic q̈, and q̇ and q at the first node (``sample``) fix the two
+integration constants. For
 a law of degree <= 5 this is the law's own polynomial, to round-off, whatever the piece's length:
 no difference of two positions enters (a fit through q at both ends loses eps |q| / h² in q̈).
 Joint positions in rad (m for prismatic joints), times in s.
@@ -13,8 +14,6 @@ Joint positions in rad (m for prismatic joints), times in s.
 from __future__ import annotations
 
 import numpy as np
-
-from drake_traj.errors import Cause, PlanningError
 
 __all__ = ["MIN_PIECE", "law_pieces", "merged_breaks"]
 
@@ -62,21 +61,21 @@ def law_pieces(law, rate: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         ``polynomial_breaks`` (:func:`merged_breaks`) in simulation time.
 
     Raises:
-        PlanningError: the law lasts 0 s (every goal equals the start): no motion to plan.
+        ValueError: the law lasts 0 s: no piece to make.
     """
     duration = float(law.duration)
     if not duration > 0.0:
-        raise PlanningError(f"the motion lasts {duration} s (every goal equals the start): there is no "
-                            "trajectory to plan", cause=Cause.PLANNING)
+        raise ValueError(f"the law lasts {duration} s: there are no pieces to make")
     breaks = merged_breaks(law.polynomial_breaks, duration)
     lengths = np.diff(breaks)  # h, law time [s]
-    samples = np.array([law.sample(tau) for tau in (breaks[:-1, None] + lengths[:, None] * _NODES).ravel()])
-    samples = samples.reshape(len(lengths), len(_NODES), 3, -1)  # (K, node, q/q̇/q̈, n)
+    nodes = breaks[:-1, None] + lengths[:, None] * _NODES  # (K, 4) law times [s]
+    acceleration = np.array([[law.rates_at(tau)[1] for tau in row] for row in nodes])  # (K, 4, n): the hot path
+    anchor = np.array([law.sample(tau)[:2] for tau in nodes[:, 0]])  # (K, q/q̇, n)
     h = lengths[:, None]
     # in sigma = (tau - break) / h: Q'' = h² q̈_law (a cubic), Q' = h q̇_law, Q = q_law
-    second = np.einsum("ik,pin->kpn", _VANDERMONDE_INVERSE.T, samples[:, :, 2] * h[:, None] ** 2)
-    first = _antiderivative(second, _NODES[0], samples[:, 0, 1] * h)
-    position = _antiderivative(first, _NODES[0], samples[:, 0, 0])  # (6, K, n) in sigma
+    second = np.einsum("ik,pin->kpn", _VANDERMONDE_INVERSE.T, acceleration * h[:, None] ** 2)
+    first = _antiderivative(second, _NODES[0], anchor[:, 1] * h)
+    position = _antiderivative(first, _NODES[0], anchor[:, 0])  # (6, K, n) in sigma
     span = (lengths / rate)[:, None, None]  # the piece in simulation time [s]: sigma = (t - break) / span
     coefficients = np.moveaxis(position, 0, 1) / span ** np.arange(6)[None, :, None]
     return breaks / rate, coefficients

@@ -1,0 +1,146 @@
+"""planner.plan(): the planned reference before the run, as a Drake PiecewisePolynomial, equals
+what the planner system outputs in the simulation (an independent computation: the Simulator
+integrates the planner's rates), ends at the logged finish, and drives a diagram of one's own."""
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
+
+import drake_traj
+from drake_traj import MovejConfig, PlanningError, RuckigConfig, ToppraConfig, get_robot, simulate
+from drake_traj.planners import make_planner
+from drake_traj.planners.laws.pieces import law_pieces, merged_breaks
+
+STEP = 1e-3  # the shipped scenarios' integrator step and log period [s]
+
+
+def quintic_task_planner(config):
+    """A baseline on quintic_ptp's task (its start and joint goals), with that scenario."""
+    scenario = drake_traj.load_scenario("quintic_ptp")
+    return scenario, make_planner(config(scenario.planner.goals), get_robot(scenario.robot), scenario.start_configuration())
+
+
+def shipped(name):
+    scenario = drake_traj.load_scenario(name)
+    return scenario, drake_traj.make_planner(scenario)
+
+
+# name: (scenario and planner, bounds on |plan - simulated reference| for q [rad], q̇ [rad/s], q̈ [rad/s²]).
+# Time-law planners: the Simulator integrates the law's rates (functions of time only) with
+# fixed-step RK2, the trapezoid rule: q is off by up to T h²/12 max|q'''| (4.5e-6 rad on quintic_ptp)
+# and less where errors cancel; q̇ by T h²/12 max|q''''| (1.6e-5 rad/s on quintic_ptp; 2e-5
+# holds the measured 7.9e-6 on Li's), h²/8 per jump of the jerk (Ruckig's phases), and by up to
+# h |Δq̈| / 2 over the step where q̈ jumps (MoveJ's ramps, Boryga's arc ends) until the next
+# update puts the reference back on the law: bound h max|q̈| (a jump is at most 2 max|q̈|).
+# q̈ is the law at the same clock: round-off. Pająk: the plan is the preflight's RK4, the
+# simulation RK2 of the same law and updates: their difference is RK2's error (1.5e-6 rad, the
+# difference README measures between RK2 and RK3 on pajak_sim3), and the logged q̈ is the law's
+# before each update, the plan's after it.
+CASES = {
+    "quintic": (lambda: shipped("quintic_ptp"), (1e-6, 2e-5, 1e-9)),
+    "boryga": (lambda: shipped("boryga_loop_ur10e"), (1e-6, "jump", 1e-9)),
+    "li": (lambda: shipped("li_closed_path_4dof"), (1e-6, 2e-5, 1e-9)),
+    "pajak": (lambda: shipped("pajak_sim3"), (5e-6, 2e-5, 1e-3)),
+    "movej": (lambda: quintic_task_planner(lambda goals: MovejConfig(goals=goals, blend_radius=0.05)), (1e-6, "jump", 1e-9)),
+    "ruckig": (lambda: quintic_task_planner(lambda goals: RuckigConfig(goals=goals)), (1e-6, 2e-5, 1e-9)),
+    "toppra": (lambda: quintic_task_planner(lambda goals: ToppraConfig(path=goals, grid_points=1000)), (1e-6, 2e-5, 1e-9)),
+}
+
+
+def values(trajectory, times) -> np.ndarray:
+    return np.array([trajectory.value(t).ravel() for t in times])
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_plan_equals_the_simulated_reference(name):
+    build, (q_bound, qd_bound, qdd_bound) = CASES[name]
+    scenario, planner = build()
+    plan = planner.plan()
+    arguments = {key: value for key, value in scenario.station_arguments().items() if key != "planner"}
+    result = simulate(planner, **(arguments | scenario.run_settings() | {"settle_time": 0.0}))
+    assert result.succeeded, result.failure
+    assert plan.start_time() == 0.0
+    assert plan.end_time() == pytest.approx(result.duration, abs=STEP)  # the logged finish
+    if not planner.plans_online:
+        assert plan.end_time() == pytest.approx(planner.planned_duration(), abs=1e-12)
+    logged = result.t <= plan.end_time()
+    times = result.t[logged]
+    differences = [np.abs(values(trajectory, times) - reference[logged]).max()
+                   for trajectory, reference in ((plan, result.q_ref), (plan.derivative(1), result.qd_ref),
+                                                 (plan.derivative(2), result.qdd_ref))]
+    # measured [rad, rad/s, rad/s²]: boryga 1.8e-7, 3.9e-4, 6.4e-15; li 5.2e-8, 7.9e-6, 2.0e-14;
+    # movej 2.2e-7, 8.4e-4, 8.0e-15; pajak 1.5e-6, 3.1e-6, 5.7e-5; quintic 1.2e-7, 1.3e-6, 1.4e-14;
+    # ruckig 1.2e-7, 3.4e-6, 7.9e-15; toppra 1.2e-7, 1.2e-12, 1.8e-12
+    print(f"{name}: max |plan - simulated reference| q {differences[0]:.2e} rad, q̇ {differences[1]:.2e} rad/s, "
+          f"q̈ {differences[2]:.2e} rad/s²")
+    if qd_bound == "jump":
+        qd_bound = STEP * np.abs(values(plan.derivative(2), times)).max()
+    assert differences[0] < q_bound
+    assert differences[1] < qd_bound
+    assert differences[2] < qdd_bound
+
+
+def test_plan_is_kept_and_returned_as_a_copy():
+    _, planner = shipped("quintic_ptp")
+    first = planner.plan()
+    first.shiftRight(1.0)  # the caller's copy
+    second = planner.plan()
+    assert second.start_time() == 0.0
+
+
+def test_law_pieces_are_the_law_on_the_clock():
+    """At a speed cap c, q(t) = q_law(c t): q̇ scales by c and q̈ by c² (boryga_loop_ur10e is
+    slowed to its limits, c = 0.30)."""
+    _, planner = shipped("boryga_loop_ur10e")
+    assert planner.speed_cap < 0.5
+    plan = planner.plan()
+    c = planner.speed_cap
+    times = np.random.default_rng(0).uniform(0.0, plan.end_time(), 300)
+    law = np.array([np.concatenate(planner.law.sample(c * t)) for t in times])
+    n = planner.num_joints
+    np.testing.assert_allclose(values(plan, times), law[:, :n], atol=1e-12)
+    np.testing.assert_allclose(values(plan.derivative(1), times), c * law[:, n:2 * n], atol=1e-11)
+    np.testing.assert_allclose(values(plan.derivative(2), times), c * c * law[:, 2 * n:], atol=1e-9)
+
+
+def test_merged_breaks_keep_the_ends():
+    np.testing.assert_array_equal(merged_breaks([0.5, 0.5 + 1e-12, 1.0 - 1e-12], 1.0), [0.0, 0.5, 1.0])
+    np.testing.assert_array_equal(merged_breaks([2.0], 1.0), [0.0, 1.0])
+
+
+def test_a_motion_of_no_length_has_no_plan():
+    scenario = drake_traj.load_scenario("quintic_ptp")
+    planner = make_planner(type(scenario.planner)(goals=[scenario.start_configuration().tolist()]),
+                           get_robot(scenario.robot), scenario.start_configuration())
+    with pytest.raises(PlanningError, match="no trajectory to plan"):
+        planner.plan()
+    with pytest.raises(ValueError, match="no pieces"):
+        law_pieces(planner.law)
+
+
+def test_pajak_plan_raises_what_its_preflight_raises():
+    scenario = drake_traj.load_scenario("pajak_sim3")
+    axis = [[0.0, 0.0, 0.1, np.pi, 0.0, 0.75 * np.pi]]  # on the base's axis: no inverse kinematics
+    planner = make_planner(type(scenario.planner)(waypoints=axis), get_robot(scenario.robot), scenario.start_configuration())
+    with pytest.raises(PlanningError) as preflight:
+        planner.preflight()
+    with pytest.raises(PlanningError) as plan:
+        planner.plan()
+    assert (plan.value.cause, str(plan.value)) == (preflight.value.cause, str(preflight.value))
+
+
+def test_plan_drives_a_diagram_of_ones_own():
+    """TrajectorySource(planner.plan()) in a diagram with a logger: the logged [q; q̇] is the
+    planner's law (independent of the plan's pieces) at every logged time."""
+    _, planner = shipped("quintic_ptp")
+    builder = DiagramBuilder()
+    source = builder.AddSystem(TrajectorySource(planner.plan(), output_derivative_order=1))
+    logger = LogVectorOutput(source.get_output_port(), builder, 0.01)
+    simulator = Simulator(builder.Build())
+    simulator.AdvanceTo(planner.planned_duration())
+    log = logger.FindLog(simulator.get_context())
+    law = np.array([np.concatenate(planner.law.sample(t)[:2]) for t in log.sample_times()])
+    assert len(log.sample_times()) == int(planner.planned_duration() / 0.01) + 1
+    np.testing.assert_allclose(log.data().T, law, atol=1e-12)
