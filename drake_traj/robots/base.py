@@ -208,12 +208,12 @@ class Robot:
         return joint_vectors(q, self.num_joints, name, finite=False)
 
     def tcp_pose(self, q) -> np.ndarray:  # pragma: no cover - abstract
-        """[x, y, z, phi_X, phi_Y, phi_Z] of the tool in the base frame [m, rad], (..., 6) for q of
+        """[x, y, z, phi_X, phi_Y, phi_Z] of the TCP in the base frame [m, rad], (..., 6) for q of
         shape (..., n); Z-Y-X Euler angles, zeros where the robot only places a point."""
         raise NotImplementedError
 
     def tool_position(self, q) -> np.ndarray:  # pragma: no cover - abstract
-        """Tool point in the base frame [m], (..., 3) for q of shape (..., n)."""
+        """The TCP's position in the base frame [m], (..., 3) for q of shape (..., n)."""
         raise NotImplementedError
 
     def tool_motion(self, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover
