@@ -112,7 +112,8 @@ class Robot:
         """A robot equal to this one whose tool is the TCP at ``xyz`` [m] with orientation ``rpy``
         [rad] in the flange frame ``tool_frame`` (``tool0``), as a UR controller's ``set_tcp``
         makes it: every pose, motion, inverse kinematics and pose error of the returned robot is
-        the TCP's (this one is left unchanged).
+        the TCP's (this one is left unchanged). The offset is from the flange, not from an
+        earlier TCP: ``with_tcp`` on a robot made by it replaces its TCP.
 
         ``rpy`` = (roll, pitch, yaw) are fixed-axis X-Y-Z angles, Drake's ``RollPitchYaw``:
         R_FT = Rz(yaw) Ry(pitch) Rx(roll), the convention of the task poses' Z-Y-X Euler angles.

@@ -2,8 +2,9 @@
 
 Frames follow ``docs/ur10e.md`` and Pająk 2024: the base frame is standard-DH frame 0
 (UR's controller "Base" frame), the flange ``tool0`` is DH frame 6. The task-space pose is
-p = k(q) = [x, y, z, phi_X, phi_Y, phi_Z]: flange position in metres and Z-Y-X Euler angles in
-radians (R = Rz(phi_Z) Ry(phi_Y) Rx(phi_X)), as used by UR's software and by Pająk 2024.
+p = k(q) = [x, y, z, phi_X, phi_Y, phi_Z]: the TCP's position in metres and Z-Y-X Euler angles in
+radians (R = Rz(phi_Z) Ry(phi_Y) Rx(phi_X)), as used by UR's software and by Pająk 2024. The TCP is
+the flange unless a ``tool`` X_FT (4x4, the TCP in the flange frame; ``Robot.with_tcp``) is given.
 
 Everything here is plain numpy so tests and planners can call it without building a plant; the
 tests check it against Drake's MultibodyPlant.

@@ -128,6 +128,9 @@ def test_tcp_offset_is_the_flange_pose_times_the_offset():
     straight = UR10E.with_tcp([0.0, 0.0, 0.15], [0.0, 0.0, 0.0])
     np.testing.assert_allclose(straight.tool_position(q) - UR10E.tool_position(q),
                                0.15 * robot.flange_pose(q)[:3, 2], rtol=0, atol=1e-14)
+    # with_tcp on a robot with a TCP sets the TCP from the flange again (does not compose)
+    np.testing.assert_array_equal(tcp_robot.with_tcp([0.0, 0.0, 0.15], [0.0, 0.0, 0.0]).tcp_offset,
+                                  straight.tcp_offset)
 
 
 def test_inverse_kinematics_of_tcp_poses():
