@@ -72,6 +72,22 @@ def test_pajak_plans_the_tcp_through_its_waypoints(pajak_run):
     assert list(np.unique(pajak_run["waypoint"])) == [0, 1, 2, 3]
 
 
+def test_pajak_with_a_turned_tool_reaches_the_tcp_pose():
+    # an offset off the flange axis, turned: the law's pose (position and Euler angles) is the TCP's
+    tool = UR10E.with_tcp([0.0, 0.05, 0.1], [0.2, -0.1, 0.8])
+    config = P.paper_parameters(3)
+    run = integrate(PajakLaw(config, tool), Q0)
+    q = run["q"][: run["finish_index"] + 1]
+    independent = np.array([robot.flange_pose(row) @ tool.tcp_offset for row in q])
+    np.testing.assert_allclose(run["tcp"][: len(q), :3], independent[:, :3, 3], rtol=0, atol=1e-12)
+    turned = np.array([robot.rotation_from_zyx_euler(pose[3:]) for pose in run["tcp"][: len(q)]])
+    np.testing.assert_allclose(turned, independent[:, :3, :3], rtol=0, atol=1e-12)
+    final = independent[-1]
+    goal = robot.rotation_from_zyx_euler(config.waypoints[-1, 3:])
+    assert np.linalg.norm(final[:3, 3] - config.waypoints[-1, :3]) < config.accuracy
+    assert np.arccos(np.clip((np.trace(goal.T @ final[:3, :3]) - 1) / 2, -1, 1)) < config.orientation_accuracy
+
+
 def test_li_plans_the_tcp_through_its_points():
     planner = make_planner(LiConfig(), TOOL, Q0)
     points = li_closed_path() - li_closed_path()[0] + TOOL.tool_position(Q0)  # the default: from the TCP at Q0
