@@ -14,19 +14,23 @@ inverse kinematics wrapper. Subclasses (frozen dataclasses) give the dimensions,
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 from typing import Callable, ClassVar, NamedTuple
 
 import numpy as np
+from pydrake.math import RollPitchYaw
 from pydrake.multibody.parsing import Parser
 
 from drake_traj.data import data_directory
 from drake_traj.errors import Cause, DrakeTrajError
-from drake_traj.validation import invalid, real_array
+from drake_traj.validation import finite_array, invalid, real_array
 
-__all__ = ["LIMIT_TOL", "PointRobot", "Robot", "TaskKinematics"]
+__all__ = ["FLANGE", "LIMIT_TOL", "PointRobot", "Robot", "TaskKinematics"]
 
 LIMIT_TOL = 1e-12  # slack on joint limits [rad or m]
+FLANGE = np.eye(4)  # X_FT of a TCP at the flange: no tool offset
+FLANGE.flags.writeable = False
 
 
 def point_array(position) -> np.ndarray:
@@ -59,21 +63,23 @@ def stack_columns(columns) -> np.ndarray:
 
 class TaskKinematics(NamedTuple):
     """A robot's task-space kinematics for planners that integrate in task space (Pająk 2024):
-    6 joints, the tool pose k(q) = [x, y, z, φ_X, φ_Y, φ_Z] in the base frame [m, rad] with Z-Y-X
+    6 joints, the TCP pose k(q) = [x, y, z, φ_X, φ_Y, φ_Z] in the base frame [m, rad] with Z-Y-X
     Euler angles. The first three are compiled (:mod:`drake_traj.compiled`) and called from
     compiled kernels; the others are their Python faces.
 
     Attributes:
-        kinematics_into: ``(q, q̇, pose, jac, bias) -> (cos φ_Y, singularity measure)``: k(q) into
-            ``pose`` (6,), the analytic Jacobian into ``jac`` (6, 6) and J̇q̇ into ``bias`` (6,)
-            [m/s², rad/s²]; q [rad], q̇ [rad/s].
+        kinematics_into: ``(q, q̇, tool, pose, jac, bias) -> (cos φ_Y, singularity measure)``:
+            k(q) of the TCP ``tool`` (X_FT, 4x4) into ``pose`` (6,), the analytic Jacobian into
+            ``jac`` (6, 6) and J̇q̇ into ``bias`` (6,) [m/s², rad/s²]; q [rad], q̇ [rad/s].
         wrapped: an angle [rad] (float or array) wrapped into (-π, π].
         orientation_error: ``(φ, φ_goal) -> `` the angle of R_goalᵀ R [rad] for Euler angles (3,).
         wrap_angle: :attr:`wrapped` for any array-like.
         pose_error: ``(poses (..., 6), goal (6,)) -> (position error [m], orientation error
             [rad])``, each (...).
-        inverse_kinematics_all: ``pose (6,) -> q (k, n)``, every joint solution of a pose [rad];
-            ValueError for a pose out of reach, SingularConfigurationError at a singular one.
+        inverse_kinematics_all: ``pose (6,) -> q (k, n)``, every joint solution of a TCP pose
+            [rad]; ValueError for a pose out of reach, SingularConfigurationError at a singular one.
+        tool: X_FT (4, 4), the TCP in the flange frame (:attr:`Robot.tcp_offset`), the ``tool``
+            argument of ``kinematics_into``.
     """
 
     kinematics_into: Callable
@@ -82,13 +88,16 @@ class TaskKinematics(NamedTuple):
     wrap_angle: Callable
     pose_error: Callable
     inverse_kinematics_all: Callable
+    tool: np.ndarray
 
 
 class Robot:
     """The contract of a robot (subclasses give the class attributes and the kinematics).
 
     Joint vectors are ordered as ``joint_names``; revolute joints in rad, prismatic in m. Frames:
-    the model's ``base_frame`` is welded to the world; the tool point is ``tool_frame``.
+    the model's ``base_frame`` is welded to the world; the flange is ``tool_frame`` (F), and "the
+    tool" of every method below is the TCP (T) at :attr:`tcp_offset` X_FT in it: the flange
+    itself unless the robot was made by :meth:`with_tcp`.
     """
 
     name: ClassVar[str]
@@ -97,6 +106,39 @@ class Robot:
     joint_types: ClassVar[tuple[str, ...]]  # "revolute" [rad] or "prismatic" [m]
     base_frame: ClassVar[str] = "base"
     tool_frame: ClassVar[str] = "tool0"
+    tcp_offset: np.ndarray = FLANGE  # X_FT (4, 4) [m]: the TCP in the flange frame, read-only
+
+    def with_tcp(self, xyz, rpy) -> "Robot":
+        """A robot equal to this one whose tool is the TCP at ``xyz`` [m] with orientation ``rpy``
+        [rad] in the flange frame ``tool_frame`` (``tool0``), as a UR controller's ``set_tcp``
+        makes it: every pose, motion, inverse kinematics and pose error of the returned robot is
+        the TCP's (this one is left unchanged). The offset is from the flange, not from an
+        earlier TCP: ``with_tcp`` on a robot made by it replaces its TCP.
+
+        ``rpy`` = (roll, pitch, yaw) are fixed-axis X-Y-Z angles, Drake's ``RollPitchYaw``:
+        R_FT = Rz(yaw) Ry(pitch) Rx(roll), the convention of the task poses' Z-Y-X Euler angles.
+        UR's ``set_tcp(p[x, y, z, rx, ry, rz])`` takes a rotation vector instead (axis times angle
+        [rad], R_FT = exp([r]x)); the two give the same TCP when
+        ``RollPitchYaw(RotationMatrix(AngleAxis(|r|, r / |r|)))`` is ``rpy`` (PolyScope shows both).
+
+        Raises:
+            DrakeTrajError: ``xyz`` or ``rpy`` not three finite numbers (field ``xyz`` or ``rpy``),
+                or a robot without a tool orientation given a non-zero offset.
+        """
+        xyz = finite_array(xyz, "xyz", "m", shape=(3,))
+        rpy = finite_array(rpy, "rpy", "rad", shape=(3,))
+        offset = np.eye(4)
+        offset[:3, :3] = RollPitchYaw(rpy).ToRotationMatrix().matrix()
+        offset[:3, 3] = xyz
+        offset.flags.writeable = False
+        return self._with_tcp_offset(offset, xyz, rpy)
+
+    def _with_tcp_offset(self, offset: np.ndarray, xyz: np.ndarray, rpy: np.ndarray) -> "Robot":
+        """:meth:`with_tcp` once its arguments are checked: a copy with ``tcp_offset`` = ``offset``
+        (X_FT, 4x4); ``xyz`` and ``rpy`` for a refusal's message."""
+        robot = copy.copy(self)
+        robot.tcp_offset = offset
+        return robot
 
     # ---- description ---------------------------------------------------------------------------
     @property
@@ -167,12 +209,12 @@ class Robot:
         return joint_vectors(q, self.num_joints, name, finite=False)
 
     def tcp_pose(self, q) -> np.ndarray:  # pragma: no cover - abstract
-        """[x, y, z, phi_X, phi_Y, phi_Z] of the tool in the base frame [m, rad], (..., 6) for q of
+        """[x, y, z, phi_X, phi_Y, phi_Z] of the TCP in the base frame [m, rad], (..., 6) for q of
         shape (..., n); Z-Y-X Euler angles, zeros where the robot only places a point."""
         raise NotImplementedError
 
     def tool_position(self, q) -> np.ndarray:  # pragma: no cover - abstract
-        """Tool point in the base frame [m], (..., 3) for q of shape (..., n)."""
+        """The TCP's position in the base frame [m], (..., 3) for q of shape (..., n)."""
         raise NotImplementedError
 
     def tool_motion(self, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover
@@ -195,8 +237,8 @@ class Robot:
         raise NotImplementedError
 
     def task_kinematics(self) -> TaskKinematics:
-        """The robot's :class:`TaskKinematics` (the Pająk 2024 planner's only way to the robot);
-        ValueError naming the robot where it has none (this default)."""
+        """The robot's :class:`TaskKinematics` of its TCP (the Pająk 2024 planner's only way to
+        the robot); ValueError naming the robot where it has none (this default)."""
         raise ValueError(f"the {self.name} robot provides no task-space kinematics (6 joints, a tool pose with Z-Y-X "
                          "Euler angles, compiled)")
 
@@ -250,6 +292,16 @@ class PointRobot(Robot):
     def point_ik(self, points, reference=None) -> np.ndarray:
         """:meth:`ik` (the papers' robots have one solution branch; ``reference`` is unused)."""
         return self.ik(points)
+
+    def _with_tcp_offset(self, offset: np.ndarray, xyz: np.ndarray, rpy: np.ndarray) -> "Robot":
+        """This robot for a zero offset; a non-zero one is refused: the robot places a point and
+        has no model of the flange's orientation that would carry a tool offset."""
+        if np.any(xyz != 0.0) or np.any(rpy != 0.0):
+            raise invalid("xyz" if np.any(xyz != 0.0) else "rpy",
+                          f"the {self.name} robot places a point and models no flange orientation, so it takes "
+                          f"no TCP offset: got xyz = {format_point(xyz)} m, rpy = {format_point(rpy)} rad (give "
+                          "zeros, or move the task's points by the tool)")
+        return self
 
     # ---- per-robot kinematics (subclasses) --------------------------------------------------
     def fk(self, q) -> np.ndarray:  # pragma: no cover - abstract

@@ -2,8 +2,9 @@
 
 Frames follow ``docs/ur10e.md`` and Pająk 2024: the base frame is standard-DH frame 0
 (UR's controller "Base" frame), the flange ``tool0`` is DH frame 6. The task-space pose is
-p = k(q) = [x, y, z, phi_X, phi_Y, phi_Z]: flange position in metres and Z-Y-X Euler angles in
-radians (R = Rz(phi_Z) Ry(phi_Y) Rx(phi_X)), as used by UR's software and by Pająk 2024.
+p = k(q) = [x, y, z, phi_X, phi_Y, phi_Z]: the TCP's position in metres and Z-Y-X Euler angles in
+radians (R = Rz(phi_Z) Ry(phi_Y) Rx(phi_X)), as used by UR's software and by Pająk 2024. The TCP is
+the flange unless a ``tool`` X_FT (4x4, the TCP in the flange frame; ``Robot.with_tcp``) is given.
 
 Everything here is plain numpy so tests and planners can call it without building a plant; the
 tests check it against Drake's MultibodyPlant.
@@ -11,6 +12,7 @@ tests check it against Drake's MultibodyPlant.
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 from typing import ClassVar
@@ -19,7 +21,7 @@ import numpy as np
 
 from drake_traj.compiled import compiled
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError, joint_label
-from drake_traj.robots.base import Robot, TaskKinematics
+from drake_traj.robots.base import FLANGE, Robot, TaskKinematics
 from drake_traj.validation import invalid, real_array
 
 __all__ = ["UR10E", "UR10e"]
@@ -141,9 +143,12 @@ def rotation_from_zyx_euler(phi) -> np.ndarray:
     )
 
 
-def task_pose(q) -> np.ndarray:
-    """k(q) of Pająk 2024: [x, y, z, phi_X, phi_Y, phi_Z] of the flange in the base frame [m, rad]."""
+def task_pose(q, tool=FLANGE) -> np.ndarray:
+    """k(q) of Pająk 2024: [x, y, z, phi_X, phi_Y, phi_Z] of the TCP in the base frame [m, rad];
+    ``tool`` (4, 4) is X_FT, the TCP in the flange frame (default: the flange itself)."""
     pose = flange_pose(q)
+    if not _is_flange(tool):
+        pose = pose @ tool
     return np.concatenate([pose[:3, 3], zyx_euler_from_rotation(pose[:3, :3])])
 
 
@@ -225,23 +230,26 @@ def _geometric_jacobian(frames: np.ndarray) -> np.ndarray:
     return np.vstack([np.cross(axes, flange - origins).T, axes.T])
 
 
-def analytic_jacobian(q, *, min_cos_pitch: float = 1e-6) -> np.ndarray:
-    """J(q) = diag(I, B^-1(phi)) J_g(q) (Pająk 2024): d k(q)/dt = J(q) qd.
+def analytic_jacobian(q, *, min_cos_pitch: float = 1e-6, tool=FLANGE) -> np.ndarray:
+    """J(q) = diag(I, B^-1(phi)) J_g(q) (Pająk 2024): d k(q)/dt = J(q) qd, of the TCP ``tool``
+    (X_FT, default the flange).
 
     Raises SingularConfigurationError where cos(phi_Y) < ``min_cos_pitch`` (Euler gimbal lock).
     """
-    return analytic_jacobian_and_bias(q, np.zeros(NUM_JOINTS), min_cos_pitch=min_cos_pitch)[0]
+    return analytic_jacobian_and_bias(q, np.zeros(NUM_JOINTS), min_cos_pitch=min_cos_pitch, tool=tool)[0]
 
 
-def analytic_jacobian_and_bias(q, qd, *, min_cos_pitch: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
-    """(J(q), dJ/dt(q, qd) qd) of the analytic Jacobian (Pająk 2024), from :func:`ur10e_kinematics`.
+def analytic_jacobian_and_bias(q, qd, *, min_cos_pitch: float = 1e-6,
+                               tool=FLANGE) -> tuple[np.ndarray, np.ndarray]:
+    """(J(q), dJ/dt(q, qd) qd) of the analytic Jacobian (Pająk 2024) of the TCP ``tool`` (X_FT,
+    default the flange), from :func:`ur10e_kinematics`.
 
     The bias term is the second derivative of k(q(t)) when qdd = 0.
     Raises SingularConfigurationError where cos(phi_Y) < ``min_cos_pitch`` (Euler gimbal lock).
     """
     q = _as_joint_vector(q)
     qd = _as_joint_vector(qd, "qd")
-    pose, jacobian, bias, cos_pitch, _ = ur10e_kinematics(q, qd)
+    pose, jacobian, bias, cos_pitch, _ = ur10e_kinematics(q, qd, tool)
     if cos_pitch < min_cos_pitch:
         raise SingularConfigurationError(
             f"Z-Y-X Euler angles are singular at q={np.round(q, 6).tolist()}: "
@@ -263,15 +271,30 @@ def _singularity_factors(s3, s5, c2, c23, s234):
 
 
 @compiled
-def kinematics_into(q, qd, pose, jac, bias):
-    """k(q) into ``pose`` (6), the analytic J into ``jac`` (6, 6) and J̇q̇ into ``bias`` (6) of the
-    flange; returns (cos φ_Y, singularity measure). Compiled; the kernel of :func:`ur10e_kinematics`.
+def _is_flange(tool) -> bool:
+    """Whether the 4x4 ``tool`` offset is exactly the identity (the TCP is the flange)."""
+    for i in range(4):
+        for j in range(4):
+            if tool[i, j] != (1.0 if i == j else 0.0):
+                return False
+    return True
 
-    The standard-DH chain of :func:`dh_frames` written out: joint axes z_j at origins o_j, flange
-    o_6; J_g columns z_j x (o_6 - o_j) and z_j; the bias by the velocity/acceleration recursion with
-    q̈ = 0; then J = diag(I, B⁻¹) J_g and the Euler part of the bias B⁻¹ (α - Ḃ φ̇) (Pająk 2024,
-    with B's columns in k(q)'s order). At gimbal lock (cos φ_Y = 0) B⁻¹ uses 1e300 for 1/cos φ_Y:
-    callers check the returned cos φ_Y.
+
+@compiled
+def kinematics_into(q, qd, tool, pose, jac, bias):
+    """k(q) into ``pose`` (6), the analytic J into ``jac`` (6, 6) and J̇q̇ into ``bias`` (6) of the
+    TCP; returns (cos φ_Y, singularity measure). Compiled; the kernel of :func:`ur10e_kinematics`.
+
+    ``tool`` (4, 4) is X_FT, the TCP in the flange frame F (``tool0``): translation t [m] and
+    rotation R_t. The standard-DH chain of :func:`dh_frames` written out: joint axes z_j at
+    origins o_j, flange o_6; J_g columns z_j x (o_6 - o_j) and z_j; the bias by the
+    velocity/acceleration recursion with q̈ = 0. The TCP (skipped for the identity, so the flange's
+    numbers are the same bit for bit): s = R_F t, p_T = o_6 + s, R_T = R_F R_t; its velocity
+    v + ω x s, so J_v gains the columns z_j x s (J_v - [s]x J_ω), and its bias acceleration
+    J̇_ω q̇ x s + ω x (ω x s). Then J = diag(I, B⁻¹) J_g and the Euler part of the bias
+    B⁻¹ (α - Ḃ φ̇) (Pająk 2024, with B's columns in k(q)'s order), with the TCP's Euler angles
+    (ω and α are the same for every point of the last link). At gimbal lock (cos φ_Y = 0) B⁻¹
+    uses 1e300 for 1/cos φ_Y: callers check the returned cos φ_Y.
     """
     c1, s1 = math.cos(q[0]), math.sin(q[0])
     c2, s2 = math.cos(q[1]), math.sin(q[1])
@@ -325,12 +348,33 @@ def kinematics_into(q, qd, pose, jac, bias):
         l0 += al1 * r2 - al2 * r1 + w1 * u2 - w2 * u1
         l1 += al2 * r0 - al0 * r2 + w2 * u0 - w0 * u2
         l2 += al0 * r1 - al1 * r0 + w0 * u1 - w1 * u0
-    # Z-Y-X Euler angles (k(q) rows 4-6) from x6, y6 (r32) and z6 (r33)
-    r11 = c6 * x5[0] - s6 * axes[4, 0]
-    r21 = c6 * x5[1] - s6 * axes[4, 1]
-    r31 = c6 * x5[2] - s6 * axes[4, 2]
-    r32 = -s6 * x5[2] - c6 * axes[4, 2]
-    r33 = axes[5, 2]
+    # the flange's rotation R_F = [x6 y6 z6]: x6 = c6 x5 - s6 z4, y6 = -s6 x5 - c6 z4, z6 = z5
+    rotation = np.empty((3, 3))
+    for k in range(3):
+        rotation[k, 0] = c6 * x5[k] - s6 * axes[4, k]
+        rotation[k, 1] = -s6 * x5[k] - c6 * axes[4, k]
+        rotation[k, 2] = axes[5, k]
+    if not _is_flange(tool):
+        s0 = rotation[0, 0] * tool[0, 3] + rotation[0, 1] * tool[1, 3] + rotation[0, 2] * tool[2, 3]  # s = R_F t
+        s1 = rotation[1, 0] * tool[0, 3] + rotation[1, 1] * tool[1, 3] + rotation[1, 2] * tool[2, 3]
+        s2 = rotation[2, 0] * tool[0, 3] + rotation[2, 1] * tool[1, 3] + rotation[2, 2] * tool[2, 3]
+        p0 += s0
+        p1 += s1
+        p2 += s2
+        for j in range(6):  # J_v column j + z_j x s
+            jac[0, j] += axes[j, 1] * s2 - axes[j, 2] * s1
+            jac[1, j] += axes[j, 2] * s0 - axes[j, 0] * s2
+            jac[2, j] += axes[j, 0] * s1 - axes[j, 1] * s0
+        u0, u1, u2 = w1 * s2 - w2 * s1, w2 * s0 - w0 * s2, w0 * s1 - w1 * s0  # ω x s
+        l0 += al1 * s2 - al2 * s1 + w1 * u2 - w2 * u1  # + J̇_ω q̇ x s + ω x (ω x s)
+        l1 += al2 * s0 - al0 * s2 + w2 * u0 - w0 * u2
+        l2 += al0 * s1 - al1 * s0 + w0 * u1 - w1 * u0
+        flange = rotation.copy()
+        for i in range(3):  # R_T = R_F R_t
+            for k in range(3):
+                rotation[i, k] = flange[i, 0] * tool[0, k] + flange[i, 1] * tool[1, k] + flange[i, 2] * tool[2, k]
+    r11, r21, r31, r32, r33 = rotation[0, 0], rotation[1, 0], rotation[2, 0], rotation[2, 1], rotation[2, 2]
+    # Z-Y-X Euler angles (k(q) rows 4-6) from R_T's first column, r32 and r33
     cy = math.hypot(r32, r33)  # cos φ_Y >= 0
     pose[0], pose[1], pose[2] = p0, p1, p2 + 0.0
     pose[3], pose[4], pose[5] = math.atan2(r32, r33), math.atan2(-r31, cy), math.atan2(r21, r11)
@@ -355,13 +399,14 @@ def kinematics_into(q, qd, pose, jac, bias):
 
 
 @compiled
-def _kinematics_many(q, qd, pose, jac, bias, cos_pitch, measure):
+def _kinematics_many(q, qd, tool, pose, jac, bias, cos_pitch, measure):
     for k in range(q.shape[0]):
-        cos_pitch[k], measure[k] = kinematics_into(q[k], qd[k], pose[k], jac[k], bias[k])
+        cos_pitch[k], measure[k] = kinematics_into(q[k], qd[k], tool, pose[k], jac[k], bias[k])
 
 
-def ur10e_kinematics(q, qd):
-    """(k(q), J(q), J̇(q, q̇) q̇, cos φ_Y, singularity measure) of the UR10e flange.
+def ur10e_kinematics(q, qd, tool=FLANGE):
+    """(k(q), J(q), J̇(q, q̇) q̇, cos φ_Y, singularity measure) of the UR10e's TCP, ``tool``
+    (4, 4) X_FT in the flange frame (default: the flange itself).
 
     The closed form of :func:`kinematics_into` (tests check it against MultibodyPlant and finite
     differences of :func:`task_pose`), vectorised over leading dimensions (q, q̇ of shape (..., 6)).
@@ -375,7 +420,7 @@ def ur10e_kinematics(q, qd):
     qd = np.asarray(qd, dtype=float)
     if q.shape == (6,) and qd.shape == (6,):
         pose, jac, bias = np.empty(6), np.empty((6, 6)), np.empty(6)
-        cos_pitch, measure = kinematics_into(q, qd, pose, jac, bias)
+        cos_pitch, measure = kinematics_into(q, qd, tool, pose, jac, bias)
         return pose, jac, bias, cos_pitch, measure
     shape = np.broadcast_shapes(q.shape, qd.shape)
     if shape[-1] != 6:
@@ -385,7 +430,7 @@ def ur10e_kinematics(q, qd):
     count = q.shape[0]
     pose, jac, bias = np.empty((count, 6)), np.empty((count, 6, 6)), np.empty((count, 6))
     cos_pitch, measure = np.empty(count), np.empty(count)
-    _kinematics_many(q, qd, pose, jac, bias, cos_pitch, measure)
+    _kinematics_many(q, qd, tool, pose, jac, bias, cos_pitch, measure)
     lead = shape[:-1]
     return pose.reshape(lead + (6,)), jac.reshape(lead + (6, 6)), bias.reshape(lead + (6,)), \
         cos_pitch.reshape(lead), measure.reshape(lead)
@@ -483,6 +528,18 @@ def _as_flange_pose(pose, name: str = "pose") -> np.ndarray:
     return pose
 
 
+def _flange_goal(pose, tool) -> np.ndarray:
+    """The flange pose X_BF (4, 4) that puts the TCP ``tool`` (X_FT) at ``pose`` X_BT (a 4x4
+    transform or a task pose [x, y, z, phi_X, phi_Y, phi_Z]): X_BF = X_BT X_FT⁻¹."""
+    pose = _as_flange_pose(pose)
+    if _is_flange(tool):
+        return pose
+    inverse = np.eye(4)
+    inverse[:3, :3] = tool[:3, :3].T
+    inverse[:3, 3] = -tool[:3, :3].T @ tool[:3, 3]
+    return pose @ inverse
+
+
 def _ik_solve(pose: np.ndarray, tol: float):
     """All branch solutions of the 4x4 flange pose.
 
@@ -575,10 +632,12 @@ def _unique_rows(solutions, atol: float = 1e-12) -> np.ndarray:
     return np.array(rows).reshape(-1, NUM_JOINTS)
 
 
-def inverse_kinematics_all(pose, *, singular_tol: float = IK_SINGULAR_TOLERANCE) -> np.ndarray:
+def inverse_kinematics_all(pose, *, singular_tol: float = IK_SINGULAR_TOLERANCE, tool=FLANGE) -> np.ndarray:
     """All real joint solutions q (k, 6), k <= 8, with flange_pose(q) = pose; each wrapped to (-pi, pi].
 
-    ``pose``: 4x4 transform of ``tool0`` in the base frame, or task pose [x, y, z, phi_X, phi_Y, phi_Z].
+    ``pose``: 4x4 transform of ``tool0`` in the base frame, or task pose [x, y, z, phi_X, phi_Y, phi_Z];
+    with ``tool`` (X_FT, 4x4), the pose of that TCP (:func:`_flange_goal`; errors describe the
+    flange pose it needs).
     Rows are ordered by branch as in ``IK_BRANCHES`` ((shoulder, elbow, wrist) signs, see
     :func:`ik_branch`); branches without a real solution are left out, and solutions that coincide
     (at a shoulder or elbow singularity) are listed once.
@@ -586,7 +645,7 @@ def inverse_kinematics_all(pose, *, singular_tol: float = IK_SINGULAR_TOLERANCE)
     Raises ValueError naming the pose and the reason (distances) when no branch reaches the pose,
     and SingularConfigurationError at a wrist singularity (sin q5 = 0: a continuum of solutions).
     """
-    pose = _as_flange_pose(pose)
+    pose = _flange_goal(pose, tool)
     solutions, _, flags = _ik_solve(pose, singular_tol)
     if flags["wrist"]:
         _raise_wrist_singular(pose)
@@ -607,8 +666,11 @@ def inverse_kinematics(
     branch=None,
     near=None,
     singular_tol: float = IK_SINGULAR_TOLERANCE,
+    tool=FLANGE,
 ) -> np.ndarray:
-    """One joint solution q (6,) of a flange pose: 4x4 transform or task pose [x, y, z, phi_X, phi_Y, phi_Z].
+    """One joint solution q (6,) of a flange pose: 4x4 transform or task pose [x, y, z, phi_X, phi_Y, phi_Z];
+    with ``tool`` (X_FT, 4x4), of that TCP's pose (:func:`_flange_goal`; errors describe the
+    flange pose it needs).
 
     branch: (shoulder, elbow, wrist) signs, each +1 or -1 (see :func:`ik_branch`); the result is
         wrapped to (-pi, pi] unless ``near`` is also given.
@@ -623,7 +685,7 @@ def inverse_kinematics(
     radius d4 about the joint-1 axis) or elbow (sin q3 = 0) singularity when ``branch`` asks for a
     shoulder or elbow sign, which is undefined there.
     """
-    pose = _as_flange_pose(pose)
+    pose = _flange_goal(pose, tool)
     if branch is not None:
         branch = tuple(int(b) for b in np.asarray(branch).reshape(-1)) if np.size(branch) == 3 else None
         if branch is None or any(b not in (-1, 1) for b in branch):
@@ -710,7 +772,8 @@ def inverse_kinematics_path(
 
 class UR10e(Robot):
     """The UR10e under the :class:`~drake_traj.robots.base.Robot` contract (the functions of this
-    module do the work). The tool point is the flange ``tool0`` (no tool offset)."""
+    module do the work, with the TCP offset ``tcp_offset`` as their ``tool``). The tool is the
+    flange ``tool0`` unless made by :meth:`~drake_traj.robots.base.Robot.with_tcp`."""
 
     name: ClassVar[str] = "ur10e"
     model_file: ClassVar[str] = "ur10e.urdf"
@@ -752,42 +815,47 @@ class UR10e(Robot):
         """:func:`task_pose` for one q; the closed form of :func:`ur10e_kinematics` for many."""
         q = self.joint_positions(q)
         if q.ndim == 1:
-            return task_pose(q)
-        return ur10e_kinematics(q, np.zeros_like(q))[0]
+            return task_pose(q, self.tcp_offset)
+        return ur10e_kinematics(q, np.zeros_like(q), self.tcp_offset)[0]
 
     def tool_position(self, q) -> np.ndarray:
         q = self.joint_positions(q)
-        return ur10e_kinematics(q, np.zeros_like(q))[0][..., :3]
+        return ur10e_kinematics(q, np.zeros_like(q), self.tcp_offset)[0][..., :3]
 
     def tool_motion(self, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
-        _, jacobian, bias, _, _ = ur10e_kinematics(q, qd)
+        _, jacobian, bias, _, _ = ur10e_kinematics(q, qd, self.tcp_offset)
         return (np.einsum("...ij,...j->...i", jacobian[..., :3, :], qd),
                 np.einsum("...ij,...j->...i", jacobian[..., :3, :], qdd) + bias[..., :3])
 
     def point_ik(self, points, reference) -> np.ndarray:
-        """IK of flange positions at the flange orientation of ``reference``, on its IK branch,
-        each joint within 2 pi of ``reference`` (:func:`inverse_kinematics`)."""
+        """IK of TCP positions at the TCP orientation of ``reference``, on its IK branch, each
+        joint within 2 pi of ``reference`` (:func:`inverse_kinematics`)."""
         reference = _as_joint_vector(reference, "reference")
-        orientation = task_pose(reference)[3:]
+        orientation = task_pose(reference, self.tcp_offset)[3:]
         branch = ik_branch(reference)
         points = np.asarray(points, dtype=float).reshape(-1, 3)
-        return np.array([inverse_kinematics(np.concatenate([point, orientation]), branch=branch, near=reference)
+        return np.array([inverse_kinematics(np.concatenate([point, orientation]), branch=branch, near=reference,
+                                            tool=self.tcp_offset)
                          for point in points]).reshape(-1, NUM_JOINTS)
 
     def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
-        """qd = J^-1 [v; 0], qdd = J^-1 ([a; 0] - dJ/dt qd) with the analytic Jacobian (one q)."""
-        jacobian = analytic_jacobian(q)
+        """qd = J^-1 [v; 0], qdd = J^-1 ([a; 0] - dJ/dt qd) with the TCP's analytic Jacobian (one q)."""
+        jacobian = analytic_jacobian(q, tool=self.tcp_offset)
         qd = np.linalg.solve(jacobian, np.concatenate([v, np.zeros(3)]))
-        _, bias = analytic_jacobian_and_bias(q, qd)
+        _, bias = analytic_jacobian_and_bias(q, qd, tool=self.tcp_offset)
         qdd = np.linalg.solve(jacobian, np.concatenate([a, np.zeros(3)]) - bias)
         return qd, qdd
 
     def task_kinematics(self) -> TaskKinematics:
         """This module's compiled k(q), analytic Jacobian and J̇q̇ (:func:`kinematics_into`), angle
-        wrapping, orientation error, pose errors and closed-form IK."""
-        return _TASK_KINEMATICS
+        wrapping, orientation error, pose errors and closed-form IK, of the TCP ``tcp_offset``."""
+        if _is_flange(self.tcp_offset):
+            return _TASK_KINEMATICS
+        return _TASK_KINEMATICS._replace(
+            inverse_kinematics_all=functools.partial(inverse_kinematics_all, tool=self.tcp_offset),
+            tool=self.tcp_offset)
 
 
 _TASK_KINEMATICS = TaskKinematics(kinematics_into, wrapped, orientation_error, wrap_angle, pose_error,
-                                  inverse_kinematics_all)
+                                  inverse_kinematics_all, FLANGE)
 UR10E = UR10e()

@@ -66,7 +66,8 @@ class PajakLaw:
         parameters: the task and the law's settings (validated here; ValueError names the field).
         robot: the robot, reached through its :meth:`~drake_traj.robots.Robot.task_kinematics`
             only; the compiled law is bound to the UR10e's (:data:`~.kernel.KINEMATICS`), so
-            another robot is refused with a ValueError naming it.
+            another robot is refused with a ValueError naming it. Its TCP
+            (:meth:`~drake_traj.robots.Robot.with_tcp`) is the tool the waypoints place.
     """
 
     def __init__(self, parameters: PajakConfig, robot: Robot = UR10E):
@@ -77,9 +78,11 @@ class PajakLaw:
             kinematics = robot.task_kinematics()
         except ValueError as error:
             raise ValueError(f"{refused}: {error}") from None
-        if kinematics != KINEMATICS:
+        if any(getattr(kinematics, name) is not getattr(KINEMATICS, name)
+               for name in ("kinematics_into", "orientation_error", "wrapped")):
             raise ValueError(f"{refused}: its task kinematics are not the ones the compiled law is bound to")
         self.robot, self.kinematics = robot, kinematics
+        self.tool = np.ascontiguousarray(kinematics.tool, dtype=float)  # X_FT, the kernels' ``tool``
         p = parameters.validate()
         self.parameters = p
         self.waypoints = np.ascontiguousarray(p.waypoints)
@@ -149,7 +152,7 @@ class PajakLaw:
         return q, qd, discrete
 
     def _evaluate(self, t, q, qd, discrete) -> np.ndarray:
-        evaluate_kernel(float(t), *self._state(q, qd, discrete), self.vector, self.waypoints, self._out)
+        evaluate_kernel(float(t), *self._state(q, qd, discrete), self.vector, self.tool, self.waypoints, self._out)
         return self._out
 
     def acceleration(self, t: float, q, qd, discrete) -> tuple[np.ndarray, float]:
@@ -199,7 +202,8 @@ class PajakLaw:
         """
         q, qd, discrete = self._state(q, qd, discrete)
         updated = discrete.copy()
-        status = update_kernel(float(t), q, qd, updated, self.vector, self.waypoints, self.remaining, self._out)
+        status = update_kernel(float(t), q, qd, updated, self.vector, self.tool, self.waypoints, self.remaining,
+                               self._out)
         if status < 0:
             raise self.failure(status, t, q, updated, self._out)
         if self.parameters.limit_acceleration and goal != updated[Discrete.GOAL]:
@@ -210,7 +214,7 @@ class PajakLaw:
 
     def reach_failure(self, q0) -> PlanningError | None:
         """The :class:`PlanningError` (cause UNREACHABLE, time 0, field ``("waypoints", k)``) for the first waypoint whose
-        pose no IK branch of the UR10e reaches, naming it and the reason; None when every
+        TCP pose no IK branch of the UR10e reaches, naming it and the reason; None when every
         waypoint is reachable (a wrist-singular pose counts as reachable)."""
         for k, pose in enumerate(self.waypoints):
             try:
@@ -226,7 +230,7 @@ class PajakLaw:
     def finished(self, q, qd, discrete) -> bool:
         """True once the TCP is within ε of the final waypoint p_w and p_w is the active target."""
         return bool(finished_kernel(np.asarray(q, dtype=float), np.asarray(discrete, dtype=float), self.vector,
-                                    self.waypoints))
+                                    self.tool, self.waypoints))
 
     def failure(self, status: int, t: float, q, discrete, out) -> PlanningError:
         """The :class:`PlanningError` for a failure ``status`` of the kernel at time t, from the
