@@ -51,6 +51,7 @@ import numpy as np
 from distributed import Client, LocalCluster, as_completed
 from tqdm import tqdm
 
+from drake_traj.clearance import CellChecker
 from drake_traj.errors import DrakeTrajError
 from drake_traj.station import simulate
 from drake_traj.planners import (
@@ -112,9 +113,12 @@ def paper_task():
 
 def random_tasks(count: int, seed: int = 0):
     """``count`` reachable tasks: three waypoints, each the flange pose of a configuration at most
-    0.6 rad per joint from the previous one, at least 0.15 m apart, away from singularities."""
+    0.6 rad per joint from the previous one, at least 0.15 m apart, away from singularities, and
+    each configuration inside the default cell (a table flush with the base) with its clearance
+    and free of self-collision. The motions between them are checked by each run."""
     rng = np.random.default_rng(seed)
     q0 = pajak.paper_initial_configuration()
+    cell = CellChecker(UR10E)
     tasks = []
     while len(tasks) < count:
         configurations = [q0]
@@ -124,7 +128,7 @@ def random_tasks(count: int, seed: int = 0):
         far_enough = np.all(np.linalg.norm(np.diff(poses[:, :3], axis=0), axis=1) > 0.15)
         regular = all(robot.singularity_measure(q) > 0.15 and abs(np.cos(p[4])) > 0.3
                       for q, p in zip(configurations, poses))
-        if far_enough and regular:
+        if far_enough and regular and not any(cell.contacts(q) for q in configurations[1:]):
             tasks.append((q0, poses[1:]))
     return tasks
 

@@ -35,9 +35,11 @@ from tqdm import tqdm
 
 from drake_traj.version import __version__
 from drake_traj.bench import bench
-from drake_traj.errors import Cause, DrakeTrajError, PlanningError
+from drake_traj.clearance import CollisionError
+from drake_traj.errors import Cause, DrakeTrajError, Failure, PlanningError
 from drake_traj.export import FORMATS, UR_CYCLE, ExportError
 from drake_traj.meshcat import add_live_view, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
+from drake_traj.refusal import refusal_figure
 from drake_traj.result import SimulationResult
 from drake_traj.rundir import MANIFEST, add_to_manifest, begin_output, check_output, run_files, write_manifest
 from drake_traj.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
@@ -110,7 +112,10 @@ def run(args) -> int:
         planned_path = None
         if args.preflight:
             progress.stage("preflight")
-            planned_path = preflight(scenario, planner)
+            try:
+                planned_path = preflight(scenario, planner)
+            except CollisionError as error:
+                raise with_refusal_picture(error, scenario, args) from None
         check_planned_duration(scenario, planner)
         duration = planner.planned_duration()
         # checked before the simulation; written (an earlier run replaced, with --overwrite) only
@@ -167,6 +172,21 @@ def run(args) -> int:
     if result.succeeded:
         return EXIT_OK
     return EXIT_INTERRUPTED if result.failure.cause is Cause.INTERRUPTED else EXIT_RUN_FAILED
+
+
+def with_refusal_picture(error: CollisionError, scenario, args) -> CollisionError:
+    """``error`` with the path of ``refusal.png`` (:func:`drake_traj.refusal.refusal_figure`), written
+    with a ``run.json`` naming the refusal into the run's output folder when it may be written
+    (as a run's files: an earlier run there needs --overwrite); else the reason there is none."""
+    try:
+        out_dir = begin_output(Path(args.out) if args.out else Path("out") / scenario.name, overwrite=args.overwrite)
+    except DrakeTrajError as reason:
+        return error.relocated(error.field, f"{error}\n(no picture of the refused configuration: {reason})")
+    picture = out_dir / "refusal.png"
+    refusal_figure(scenario.cell_checker(), error).savefig(picture, dpi=100)
+    write_manifest(out_dir, [picture.name], scenario=scenario.name, drake_traj=__version__,
+                   failure=Failure(error.cause, str(error), error.time, tuple(error.configuration.tolist())).to_dict())
+    return error.relocated(error.field, f"{error}\n(picture of the refused configuration: {picture})")
 
 
 def serve_recording(url: str, seconds: float | None) -> None:

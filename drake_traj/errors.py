@@ -43,6 +43,8 @@ class Cause(str, enum.Enum):
     INTERRUPTED = "interrupted"  # Ctrl-C or SIGTERM
     SATURATION = "saturation"  # a joint's torque reached its effort limit
     TRACKING = "tracking"  # the arm strayed further than the tolerance from the reference
+    COLLISION = "collision"  # the arm touches (or would come closer than the clearance to) itself, its tool or its cell
+    JOINT_RANGE = "joint range"  # a joint past its position range
     OUTPUT = "output"  # an output folder or file that cannot be written
     ERROR = "error"  # any other exception during a run
 

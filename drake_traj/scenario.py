@@ -29,6 +29,8 @@ from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import PiecewisePolynomial
 
+from drake_traj.cell import Cell
+from drake_traj.clearance import CellChecker
 from drake_traj.data import data_directory
 from drake_traj.errors import Cause, DrakeTrajError, Field, field_text, joint_label
 from drake_traj.planners import PLANNER_CONFIGS, PlannerConfig, PlannerSystem, QuinticConfig
@@ -148,6 +150,8 @@ class Scenario:
             start of Pająk 2024's task). Planners that follow a tool path on the papers' robots
             start from the inverse kinematics of the path instead.
         planner: the planner's config (see :data:`drake_traj.planners.PLANNER_CONFIGS`).
+        cell: what the robot stands on, the obstacles around it, the user's own models and the
+            tool (:class:`~drake_traj.cell.Cell`; default a table flush with the base).
         controller: PD gains (empty: the robot's defaults) and the feed-forward choice.
         plant: Drake's ``MultibodyPlantConfig`` of the robot plant (default: discrete at 1 ms,
             SAP); ``plant: {time_step: 0.002}`` runs at the UR controller's 500 Hz.
@@ -168,6 +172,7 @@ class Scenario:
     robot: str = "ur10e"
     q_initial: list[float] = field(default_factory=list)
     planner: PlannerConfig = field(default_factory=QuinticConfig)
+    cell: Cell = field(default_factory=Cell)
     controller: ControllerGains = field(default_factory=ControllerGains)
     plant: MultibodyPlantConfig = field(default_factory=default_plant_config)
     simulator: SimulatorConfig = field(default_factory=default_simulator_config)
@@ -237,12 +242,40 @@ class Scenario:
             raise invalid("plant", f"plant: {error}") from None
         self.controller.for_robot(robot)
         self.speed_override.validate()
+        self.cell.validate()
+        self.robot_with_tool()
 
     def station_arguments(self) -> dict:
         """The keyword arguments of :func:`drake_traj.station.build_station` for this scenario
         (its planner made by :func:`make_planner`)."""
-        return dict(planner=make_planner(self), robot=get_robot(self.robot), gains=self.controller,
-                    plant_config=self.plant, log_period=self.logging_period())
+        return dict(planner=make_planner(self), robot=self.robot_with_tool(), gains=self.controller,
+                    plant_config=self.plant, log_period=self.logging_period(), cell=self.cell,
+                    cell_directory=self.directory())
+
+    def robot_with_tool(self) -> Robot:
+        """The scenario's robot whose tool point is ``cell.tool``'s TCP (:meth:`Robot.with_tcp`):
+        every task pose of the planner, the station's TCP and the result's are the TCP's. A
+        refusal (a point robot given an offset) names ``cell.tool.tcp_xyz``."""
+        tool = self.cell.tool
+        try:
+            return get_robot(self.robot).with_tcp(tool.tcp_xyz, tool.tcp_rpy)
+        except DrakeTrajError as error:
+            field = ("cell", "tool", "tcp_" + str(error.field[0])) if error.field else ("cell", "tool", "tcp_xyz")
+            raise error.relocated(field, f"{field_text(field)}: {error}") from None
+
+    def directory(self) -> Path | None:
+        """The folder of the scenario's file (relative model files of ``cell.directives`` are
+        taken from it); None for a scenario made in Python (the working directory)."""
+        return None if self.source is None else self.source.path.parent
+
+    def cell_checker(self) -> CellChecker:
+        """The :class:`~drake_traj.clearance.CellChecker` of this scenario's robot in its cell;
+        a malformed directive raises a ScenarioError at its line."""
+        try:
+            return CellChecker(self.robot_with_tool(), self.cell, self.directory())
+        except DrakeTrajError as error:
+            raise ScenarioError(locate_in_scenario(self, error.field, str(error)), field=error.field,
+                                cause=error.cause) from None
 
     def run_settings(self) -> dict:
         """The keyword arguments of :func:`drake_traj.station.simulate` that this scenario sets
@@ -399,7 +432,7 @@ def make_planner(scenario: Scenario, *others) -> PlannerSystem:
                         "makes a scenario's planner; make one from a planner config with "
                         "drake_traj.planners.make_planner(config, robot, q_initial)")
     instance_of(scenario, Scenario, "scenario", hint=" (load one with drake_traj.load_scenario(name_or_path, variant))")
-    robot = get_robot(scenario.robot)
+    robot = scenario.robot_with_tool()
     q_initial = scenario.start_configuration()  # its errors name q_initial, not the planner
     try:
         planner = make_planner_from_config(scenario.planner, robot, q_initial)
@@ -420,14 +453,33 @@ def make_planner(scenario: Scenario, *others) -> PlannerSystem:
 
 def preflight(scenario: Scenario, planner: PlannerSystem) -> np.ndarray | None:
     """``planner.preflight()`` (the whole task checked before t = 0), its errors located in the
-    scenario as :func:`make_planner`'s are (e.g. at ``planner.waypoints[2]``'s line).
+    scenario as :func:`make_planner`'s are (e.g. at ``planner.waypoints[2]``'s line); then the
+    planned motion in the scenario's cell (:func:`check_in_cell`).
 
     Returns the planned tool path [m], shape (N, 3) in the base frame, where the planner
     computes one, else None."""
     try:
-        return planner.preflight()
+        path = planner.preflight()
     except ValueError as error:
         raise _in_planner_field(scenario, error, message_leads_with_field=False) from error
+    check_in_cell(scenario, planner)
+    return path
+
+
+def check_in_cell(scenario: Scenario, planner: PlannerSystem, checker: CellChecker | None = None):
+    """The start configuration and the planned motion (``planner.plan()``) in the scenario's
+    cell: joint ranges, self-collision and collision with the cell, with its clearance
+    (:meth:`CellChecker.check <drake_traj.clearance.CellChecker.check>`). A refusal is a
+    :class:`~drake_traj.clearance.CollisionError` or
+    :class:`~drake_traj.clearance.JointRangeError` located at the cell's obstacle, the start
+    configuration or the planner in the scenario file. Returns the
+    :class:`~drake_traj.clearance.MotionCheck`."""
+    checker = checker or scenario.cell_checker()
+    try:
+        return checker.check_planner(planner, start_field=("q_initial",) if len(scenario.q_initial) else ("planner",))
+    except DrakeTrajError as error:
+        field = error.field or ("planner",)
+        raise error.relocated(field, locate_in_scenario(scenario, field, str(error))) from None
 
 
 def check_planned_duration(scenario: Scenario, planner: PlannerSystem) -> None:

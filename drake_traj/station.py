@@ -30,9 +30,10 @@ are declared in :func:`build_station`'s docstring.
 import os
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import CollisionFilterDeclaration, Meshcat, MeshcatVisualizer, MeshcatVisualizerParams
+from pydrake.geometry import Meshcat, MeshcatVisualizer, MeshcatVisualizerParams
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant, MultibodyPlantConfig
 from pydrake.multibody.tree import PdControllerGains
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
@@ -41,6 +42,8 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, Trigg
 from pydrake.systems.primitives import (ConstantVectorSource, Demultiplexer, LogVectorOutput, MatrixGain,
                                         Multiplexer, TrajectorySource)
 
+from drake_traj.cell import Cell, add_cell
+from drake_traj.clearance import CellChecker, geometry_owner
 from drake_traj.errors import Cause, Failure
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
@@ -114,6 +117,9 @@ def add_station(
     plant_config: MultibodyPlantConfig | None = None,
     log_period: float = 1e-3,
     meshcat: Meshcat | None = None,
+    cell: Cell | None = None,
+    cell_directory: Path | None = None,
+    before_finalize=None,
 ) -> Station:
     """Add ``planner``, the PD-controlled ``robot`` plant, the feed-forward, the loggers (and a
     Meshcat visualizer) to ``builder`` (see the module docstring for the wiring and the names).
@@ -126,7 +132,12 @@ def add_station(
         gains: PD gains and feed-forward choice (default: the robot's gains, with feed-forward).
         plant_config: the plant's configuration (default :func:`default_plant_config`).
         log_period: the loggers' period [s]: they sample at k * log_period from t = 0.
-        meshcat: when given, the robot is drawn there.
+        meshcat: when given, the robot and its cell are drawn there.
+        cell: the robot's cell and tool (default :class:`~drake_traj.cell.Cell`: a table flush
+            with the base, no tool), added to the plant (:func:`~drake_traj.cell.add_cell`).
+        cell_directory: the folder relative model files of ``cell.directives`` are taken from.
+        before_finalize: ``before_finalize(plant, scene_graph)`` adds one's own bodies and
+            geometry to the plant before it is finalized (the station finalizes it).
 
     A planner system is part of one diagram only (Drake owns it there): a second station needs a
     new planner (``make_planner`` again); ValueError otherwise.
@@ -138,6 +149,9 @@ def add_station(
     instance_of(robot, Robot, "robot")
     if meshcat is not None:
         instance_of(meshcat, Meshcat, "meshcat")
+    if cell is not None:
+        instance_of(cell, Cell, "cell")
+    callable_or_none(before_finalize, "before_finalize", "before_finalize(plant, scene_graph)")
     instance_of(gains or ControllerGains(), ControllerGains, "gains")
     gains = (gains or ControllerGains()).for_robot(robot)
     plant_config = instance_of(plant_config or default_plant_config(), MultibodyPlantConfig, "plant_config")
@@ -152,12 +166,13 @@ def add_station(
     instance = robot.add_to_plant(plant)
     for joint_name, kp, kd in zip(robot.joint_names, gains.kp, gains.kd):
         plant.GetJointActuatorByName(f"{joint_name}_actuator", instance).set_controller_gains(PdControllerGains(p=kp, d=kd))
+    # the cell's geometry, the tool's body and payload: contact with them, and between the arm's
+    # non-adjacent links, is simulated (and ends the run: run_station)
+    add_cell(plant, cell or Cell(), instance, flange_frame=robot.tool_frame, directory=cell_directory)
+    if before_finalize is not None:
+        before_finalize(plant, scene_graph)
     plant.Finalize()
     plant.SetDefaultPositions(instance, planner.initial_positions())
-    # The arm's own links never touch in the tasks we plan; keep the solver free of self-contact.
-    bodies = [plant.get_body(index) for index in plant.GetBodyIndices(instance)]
-    scene_graph.collision_filter_manager().Apply(
-        CollisionFilterDeclaration().ExcludeWithin(plant.CollectRegisteredGeometries(bodies)))
 
     planner.set_name("planner")
     builder.AddSystem(planner)
@@ -286,22 +301,52 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
     planner = station.GetSubsystemByName("planner")
     root = simulator.get_mutable_context()
     planner_context = planner.GetMyContextFromRoot(root)
-    chunk = min(0.01, max(settle_time, 1e-3))  # the finish is checked between chunks
+    chunk = min(0.01, max(settle_time, 1e-3))  # the finish and contact are checked between chunks
+    end = max_duration
     try:
-        while root.get_time() < max_duration:
-            simulator.AdvanceTo(min(root.get_time() + chunk, max_duration))
+        while root.get_time() < end:
+            simulator.AdvanceTo(min(root.get_time() + chunk, end))
             if progress is not None:
                 progress(root.get_time())
+            touching = contact_failure(station, root)
+            if touching is not None:
+                return touching
             finish = planner.finish_time(planner_context)
-            if np.isfinite(finish):
-                simulator.AdvanceTo(min(max(finish + settle_time, root.get_time()), max_duration))
-                return None
+            if np.isfinite(finish) and end == max_duration:
+                end = min(max(finish + settle_time, root.get_time()), max_duration)
+        if np.isfinite(planner.finish_time(planner_context)):
+            return None
         return Failure(Cause.TIMEOUT, f"planner did not finish within max_duration = {max_duration} s", root.get_time(),
                        tuple(planner.reference_state(planner_context)[: planner.num_joints].tolist()))
     except KeyboardInterrupt:
         return Failure(Cause.INTERRUPTED, f"interrupted at t = {root.get_time():.4f} s", root.get_time())
     except Exception as error:  # keep the log up to the failure; the reason goes in the result
         return Failure.from_exception(error, root.get_time())
+
+
+def contact_failure(station: Diagram, root_context) -> Failure | None:
+    """A COLLISION :class:`Failure` when the station's plant reports contact (the arm with
+    itself, its tool or its cell) in ``root_context``, naming the two bodies, the depth and the
+    time; None without contact. Read from the plant's contact results (point pairs and
+    hydroelastic surfaces), so a touch shorter than a check's interval may pass unseen."""
+    plant = station.GetSubsystemByName("plant")
+    plant_context = plant.GetMyContextFromRoot(root_context)
+    results = plant.get_contact_results_output_port().Eval(plant_context)
+    pairs = [(info.point_pair().id_A, info.point_pair().id_B, -info.point_pair().depth)
+             for info in map(results.point_pair_contact_info, range(results.num_point_pair_contacts()))]
+    pairs += [(info.contact_surface().id_M(), info.contact_surface().id_N(), float("nan"))
+              for info in map(results.hydroelastic_contact_info, range(results.num_hydroelastic_contacts()))]
+    if not pairs:
+        return None
+    inspector = station.GetSubsystemByName("scene_graph").model_inspector()
+    robot_instance = plant.get_joint_actuator(plant.GetJointActuatorIndices()[0]).model_instance()  # the robot's drives
+    id_a, id_b, distance = min(pairs, key=lambda pair: pair[2] if np.isfinite(pair[2]) else 0.0)
+    (body_a, _), (body_b, _) = (geometry_owner(plant, inspector, geometry, robot_instance) for geometry in (id_a, id_b))
+    t = root_context.get_time()
+    depth = f", {-distance * 1000:.1f} mm deep" if np.isfinite(distance) else ""
+    q = plant.GetPositions(plant_context, robot_instance)
+    return Failure(Cause.COLLISION, f"collision between {body_a} and {body_b} at t = {t:.3f} s{depth}", t,
+                   tuple(q.tolist()))
 
 
 _UNSET = object()  # an argument not given: the scenario's value, or for a planner its default
@@ -325,6 +370,8 @@ def simulate(
     before_run=None,
     tracking_tolerance: float | None = _UNSET,
     preflight: bool = True,
+    cell: Cell | None = _UNSET,
+    cell_directory: Path | None = _UNSET,
 ) -> SimulationResult:
     """Run a planner, or a scenario's, in a station until it finishes, plus ``settle_time`` [s].
 
@@ -356,14 +403,22 @@ def simulate(
             if a joint's torque saturates (None: no such check; see
             :meth:`SimulationResult.execution_failure`).
         preflight: check the whole task before the motion, as ``drake-traj run`` does
-            (:meth:`PlannerSystem.preflight`: a :class:`~drake_traj.errors.PlanningError` is
-            raised before the run, not recorded as a failed run; False: the run finds it).
+            (:meth:`PlannerSystem.preflight`, then the planned motion in the cell:
+            :meth:`CellChecker.check_planner <drake_traj.clearance.CellChecker.check_planner>`;
+            a :class:`~drake_traj.errors.PlanningError`, e.g. a
+            :class:`~drake_traj.clearance.CollisionError`, is raised before the run, not
+            recorded as a failed run; False: the run finds it).
+        cell: the robot's cell and tool (a scenario's own by default; for a planner, a table
+            flush with the base: :class:`~drake_traj.cell.Cell`).
+        cell_directory: the folder relative model files of ``cell.directives`` are taken from
+            (a scenario's: its file's folder; else the working directory).
 
     Every argument is checked before the run (TypeError or ValueError naming it).
     """
     given = dict(name=name, robot=robot, gains=gains, plant_config=plant_config, simulator_config=simulator_config,
                  log_period=log_period, settle_time=settle_time, max_duration=max_duration,
-                 speed_override=speed_override, tracking_tolerance=tracking_tolerance)
+                 speed_override=speed_override, tracking_tolerance=tracking_tolerance, cell=cell,
+                 cell_directory=cell_directory)
     if isinstance(planner, Scenario):
         scenario = planner
         if robot is not _UNSET:
@@ -375,10 +430,13 @@ def simulate(
         scenario = None
         defaults = dict(name="run", robot=UR10E, gains=None, plant_config=None, simulator_config=None, log_period=1e-3,
                         settle_time=0.5, max_duration=120.0, speed_override=None,
-                        tracking_tolerance=DEFAULT_TRACKING_TOLERANCE)
+                        tracking_tolerance=DEFAULT_TRACKING_TOLERANCE, cell=None, cell_directory=None)
         instance_of(planner, PlannerSystem, "planner", hint=" or a Scenario")
     (name, robot, gains, plant_config, simulator_config, log_period, settle_time, max_duration, speed_override,
-     tracking_tolerance) = (defaults[key] if value is _UNSET else value for key, value in given.items())
+     tracking_tolerance, cell, cell_directory) = (defaults[key] if value is _UNSET else value
+                                                  for key, value in given.items())
+    if cell is not None:
+        instance_of(cell, Cell, "cell")
     # checked before the planner goes into a diagram (a planner is used in one diagram only)
     instance_of(name, str, "name")
     if simulator_config is not None:
@@ -391,15 +449,17 @@ def simulate(
     callable_or_none(progress, "progress", "progress(t)")
     callable_or_none(add_systems, "add_systems", "add_systems(builder, station)")
     callable_or_none(before_run, "before_run", "before_run(simulator)")
-    if flag(preflight, "preflight") and scenario is not None:
+    if flag(preflight, "preflight") and scenario is not None and cell is scenario.cell and cell_directory == scenario.directory():
         scenario_preflight(scenario, planner)  # its errors located in the scenario file
     elif preflight:
         planner.preflight()
+        CellChecker(robot, cell, cell_directory).check_planner(planner)
     if scenario is not None:
         check_planned_duration(scenario, planner)
     builder = DiagramBuilder()
     station = builder.AddSystem(build_station(planner, robot=robot, gains=gains, plant_config=plant_config,
-                                              log_period=log_period, meshcat=meshcat))
+                                              log_period=log_period, meshcat=meshcat, cell=cell,
+                                              cell_directory=cell_directory))
     add_speed_override(builder, station, speed_override)
     if add_systems is not None:
         add_systems(builder, station)

@@ -14,7 +14,9 @@ import re
 import typing
 from pathlib import Path
 
+import numpy as np
 import yaml
+from pydrake.common.schema import Transform
 
 from drake_traj.errors import DrakeTrajError, Field, field_text
 
@@ -22,6 +24,7 @@ __all__ = ["ScenarioError", "checked_document"]
 
 _INT, _FLOAT, _BOOL, _STR, _NULL = (f"tag:yaml.org,2002:{name}" for name in ("int", "float", "bool", "str", "null"))
 _YAML12_FLOAT = re.compile(r"[-+]?(\.\d+|\d+(\.\d*)?)([eE][-+]?\d+)?")
+_OPAQUE = (Transform,)  # types whose YAML form pydrake checks itself
 _FOUND = {_INT: "an integer", _FLOAT: "a number", _BOOL: "true/false", _STR: "text", _NULL: "nothing (null)"}
 
 
@@ -94,8 +97,24 @@ class _Checker:
             self.fail(node, field, f"the tag {node.tag.split(':', 2)[-1]!r} is not allowed: scenario files hold data, "
                                    "not Python objects")
         origin = typing.get_origin(schema)
+        if origin is typing.Union and type(None) in typing.get_args(schema):  # Optional[X] (pydrake's directives)
+            (inner,) = [option for option in typing.get_args(schema) if option is not type(None)]
+            return None if node.tag == _NULL else self.check(node, inner, field)
         if origin is typing.Union:
             return self.check_union(node, typing.get_args(schema), field)
+        if origin is dict:
+            if not isinstance(node, yaml.MappingNode):
+                self.fail(node, field, f"expected a mapping, found {_describe(node)}")
+            _, item = typing.get_args(schema)
+            for key, value in self.mapping_items(node, field):
+                self.check(value, item, field + (key.value,))
+            return None
+        if schema is np.ndarray:  # a number or a list of numbers, e.g. a directive's joint positions
+            for child in node.value if isinstance(node, yaml.SequenceNode) else [node]:
+                self.check(child, float, field)
+            return None
+        if schema in _OPAQUE:  # pydrake's own variants (a Transform's !Rpy rotation): pydrake reads them
+            return None
         if origin is list:
             if not isinstance(node, yaml.SequenceNode):
                 self.fail(node, field, f"expected a list, found {_describe(node)}")

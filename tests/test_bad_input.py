@@ -147,7 +147,7 @@ YAML_CASES = [
     ("override unequal lengths", quintic("settle_time: 0.5", "settle_time: 0.5\nspeed_override: {times: [2.0], values: [0.5, 1.0]}"),
      r"speed_override.times and speed_override.values must be two lists of equal length"),
     ("binary file", b"\x89PNG\r\n\x1a\n\x00\x00\xff\xfe", r"is not a text \(UTF-8\) file"),
-    ("pajak waypoint out of reach", pajak("  waypoints:\n    - [1.5, 0, 0.2, 3.14, 0, 0]\n"), r"planner.waypoints\[0\] position .* beyond the UR10e reach"),
+    ("pajak waypoint out of reach", pajak("  waypoints:\n    - [1.5, 0, 0.2, 3.14, 0, 0]\n"), r"planner.waypoints\[0\]: waypoint 0 cannot be reached: .* out of reach"),
     ("pajak waypoints too close", pajak(PAJAK_WAYPOINTS + "    - [-0.175, -0.535, 0.730, 3.141592653589793, 0.0, 2.356194490192345]\n"),
      r"waypoints\[0\] and waypoints\[1\] are 0.0100 m apart"),
     ("pajak vartheta out of range", pajak(PAJAK_WAYPOINTS + "  vartheta: 0.7\n"), r"vartheta must be a number in \(0, 0.5\)"),

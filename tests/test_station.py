@@ -18,6 +18,7 @@ from drake_traj import SimulationResult, load_scenario, make_planner, make_stati
 from drake_traj.result import ARRAY_NAMES, LOGGERS
 from drake_traj.scenario import find_scenario
 from drake_traj.station import build_station
+from drake_traj.robots.ur10e import flange_pose
 
 DIAGRAMS = Path(__file__).resolve().parents[1] / "diagrams"
 PORTS_IN = {"speed_override": 1, "applied_generalized_force": 6}
@@ -154,3 +155,17 @@ def test_diagram_scripts_run(script, tmp_path, monkeypatch, capsys):
         error = np.linalg.norm(result.tcp_ref[:, :3] - result.tcp[:, :3], axis=1)
         assert error.max() > 5e-3  # the 60 N m pulse pushes the TCP off by millimetres (measured 10.4 mm)
         assert error[result.t > 2.0].max() < 1e-4  # and the PD loop brings it back
+
+
+def test_the_fixture_cell_script_runs_with_its_tool_and_refuses_a_taller_fixture(tmp_path, capsys):
+    namespace = runpy.run_path(str(DIAGRAMS / "fixture_cell.py"), run_name="drake_traj_test")
+    result = namespace["main"]([str(tmp_path)])
+    printed = capsys.readouterr().out
+    assert result.succeeded and result.robot == "ur10e"
+    # the result's TCP is the gripper's tip, 0.15 m below the flange (the tool points down)
+    flange = np.array([flange_pose(q)[:3, 3] for q in result.q_meas[::500]])
+    assert np.allclose(np.linalg.norm(result.tcp[::500, :3] - flange, axis=1), 0.15, atol=1e-9)
+    assert "nearest to the fixture" in printed and "with a 0.5 m fixture: refused" in printed
+    assert "fixture" in printed.split("refused:")[1]
+    for name in ("meshcat.html", "refusal.png", "tcp_path.png"):
+        assert (tmp_path / name).stat().st_size > 10_000

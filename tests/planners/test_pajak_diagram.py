@@ -15,7 +15,6 @@ from drake_traj.robots import ur10e as robot
 from drake_traj.scenario import default_plant_config, default_simulator_config
 from drake_traj.station import build_station, run_station, simulate
 from drake_traj.planners import pajak as P
-from drake_traj.planners.pajak import parameters as pajak_parameters
 from drake_traj.result import SimulationResult
 from drake_traj.scenario import load_scenario, make_planner
 
@@ -84,8 +83,9 @@ def test_sim3_acceleration_is_continuous_in_the_diagram():
 def test_unreachable_goal_stops_with_the_reason_and_keeps_the_log(tmp_path):
     pose = robot.task_pose(Q0)
     goal = pose.copy()
-    direction = (pose[:3] - pajak_parameters.SHOULDER) / np.linalg.norm(pose[:3] - pajak_parameters.SHOULDER)
-    goal[:3] = pajak_parameters.SHOULDER + 1.29 * direction  # inside 1.3 m, but not reachable with this orientation
+    shoulder = np.array([0.0, 0.0, robot.DH_D[0]])
+    direction = (pose[:3] - shoulder) / np.linalg.norm(pose[:3] - shoulder)
+    goal[:3] = shoulder + 1.29 * direction  # inside 1.3 m, but not reachable with this orientation
     config = P.PajakConfig(waypoints=goal[None], limit_velocity=True, limit_acceleration=False, stall_time=1.0)
     with pytest.raises(PlanningError, match="waypoint 0 cannot be reached") as found:  # the preflight, before the motion
         simulate(P.PajakPlanner(config, Q0), max_duration=20.0)

@@ -15,7 +15,6 @@ import pytest
 
 from drake_traj.robots import ur10e as robot
 from drake_traj.planners import pajak as P
-from drake_traj.planners.pajak import parameters as pajak_parameters
 
 Q0 = P.paper_initial_configuration()
 # Every improvement off: the paper's method as printed (with the corrections of docs/papers.md).
@@ -133,7 +132,6 @@ def test_paper_parameters_validate():
 @pytest.mark.parametrize(
     "change, field",
     [
-        (dict(waypoints=[[1.2, 0.0, 0.8, np.pi, 0.0, 0.0]]), "waypoints\\[0\\].*beyond the UR10e reach"),
         (dict(waypoints=[[0.3, -0.5, np.nan, np.pi, 0.0, 0.0]]), "waypoints\\[0\\] must be finite"),
         (dict(waypoints=np.zeros((2, 5))), "waypoints must have shape"),
         (dict(waypoints=[[0.3, -0.5, 0.5, 0.0, np.pi / 2, 0.0]]), "waypoints\\[0\\] phi_Y"),
@@ -465,8 +463,9 @@ def test_damped_inverse_keeps_motion_bounded_through_a_wrist_singularity():
 def test_unreachable_goal_fails_cleanly():
     pose = robot.task_pose(Q0)
     goal = pose.copy()
-    direction = (pose[:3] - pajak_parameters.SHOULDER) / np.linalg.norm(pose[:3] - pajak_parameters.SHOULDER)
-    goal[:3] = pajak_parameters.SHOULDER + 1.29 * direction  # inside 1.3 m, but not with this orientation
+    shoulder = np.array([0.0, 0.0, robot.DH_D[0]])
+    direction = (pose[:3] - shoulder) / np.linalg.norm(pose[:3] - shoulder)
+    goal[:3] = shoulder + 1.29 * direction  # inside 1.3 m, but not with this orientation
     law = P.PajakLaw(P.PajakConfig(waypoints=goal[None], limit_velocity=True, limit_acceleration=False, stall_time=1.0))
     # known before integrating (the inverse kinematics of every waypoint): time 0, the waypoint
     with pytest.raises(P.PlanningError) as info:
@@ -475,10 +474,23 @@ def test_unreachable_goal_fails_cleanly():
     assert isinstance(error, ValueError)
     assert error.cause == "unreachable" and error.time == 0.0 and error.partial is None
     assert "waypoint 0 cannot be reached" in str(error) and "t = " in str(error) and "q = " in str(error)
-    # goals beyond the reach are refused up front
-    goal[:3] = pajak_parameters.SHOULDER + 1.4 * direction
-    with pytest.raises(ValueError, match="beyond the UR10e reach"):
-        P.PajakLaw(P.PajakConfig(waypoints=goal[None], limit_velocity=False, limit_acceleration=False))
+    # a goal beyond any configuration's flange is refused the same way: by the inverse kinematics
+    goal[:3] = shoulder + 1.4 * direction
+    with pytest.raises(P.PlanningError, match="waypoint 0 cannot be reached.*out of reach") as info:
+        P.integrate(P.PajakLaw(P.PajakConfig(waypoints=goal[None], limit_velocity=False, limit_acceleration=False)),
+                    Q0, t_max=20.0)
+    assert info.value.cause == "unreachable"
+
+
+@pytest.mark.parametrize("q", [[0, 0, 0, 0, np.pi / 2, 0], [0, -0.2, 0, -0.3, np.pi / 2, 0.3],
+                               [0.3, -0.5, 0.05, -1.2, 1.0, 0.2]])
+def test_the_flange_pose_of_any_configuration_is_reachable_beyond_the_brochures_1_3_m(q):
+    """UR's 1.3 m is a round figure: these flange poses lie 1.318, 1.345 and 1.354 m from the
+    shoulder, and inverse kinematics reaches each (the law's reach check accepts them)."""
+    pose = robot.task_pose(np.array(q, dtype=float))
+    assert np.linalg.norm(pose[:3] - [0.0, 0.0, robot.DH_D[0]]) > 1.3
+    law = P.PajakLaw(P.PajakConfig(waypoints=pose[None], limit_velocity=False, limit_acceleration=False))
+    assert law.reach_failure(Q0) is None
 
 
 def test_gimbal_lock_and_timeout_raise_planning_error():

@@ -12,6 +12,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from drake_traj.clearance import CellChecker
 from drake_traj.planners import pajak as P
 from drake_traj.planners.pajak.kernel import Discrete
 from drake_traj.robots import ur10e as robot
@@ -22,8 +23,10 @@ TOL = 1e-9  # floating-point slack on "limit held"
 
 
 def random_tasks(count: int = 200, seed: int = 9) -> list[P.PajakConfig]:
-    """``count`` valid tasks (tasks validate() refuses are drawn again), seeded."""
+    """``count`` valid tasks (tasks validate() refuses, and tasks whose waypoint configurations
+    touch the default cell or the arm itself, are drawn again), seeded."""
     rng = np.random.default_rng(seed)
+    cell = CellChecker(robot.UR10E)
     tasks = []
     while len(tasks) < count:
         configurations = [Q0]
@@ -38,6 +41,8 @@ def random_tasks(count: int = 200, seed: int = 9) -> list[P.PajakConfig]:
         try:
             task.validate()
         except ValueError:  # e.g. two waypoints closer than the neighbourhood
+            continue
+        if any(cell.contacts(q) for q in configurations[1:]):
             continue
         tasks.append(task)
     return tasks

@@ -21,10 +21,6 @@ PAPER_METHOD = dict(
     preserve_damping=False,
 )
 
-# UR10e geometry (standard DH) for the reach check of the waypoints.
-_D1 = float(robot.DH_D[0])
-SHOULDER = np.array([0.0, 0.0, _D1])  # shoulder point (joint-2 axis on the base axis) [m]
-REACH = 1.3  # [m], UR10e reach from the shoulder (docs/ur10e.md)
 
 
 @dataclass
@@ -116,13 +112,10 @@ class PajakConfig:
         if not np.all(np.isfinite(waypoints)):
             k = int(np.argwhere(~np.isfinite(waypoints))[0, 0])
             raise invalid("waypoints", f"waypoints[{k}] must be finite, got {waypoints[k].tolist()}", k)
-        reach = np.linalg.norm(waypoints[:, :3] - SHOULDER, axis=1)
-        if np.any(reach > REACH):
-            k = int(np.argmax(reach > REACH))
-            raise DrakeTrajError(
-                f"waypoints[{k}] position {waypoints[k, :3].tolist()} is {reach[k]:.3f} m from the "
-                f"shoulder (0, 0, {_D1}), beyond the UR10e reach of {REACH} m", field=("waypoints", k),
-                cause=Cause.UNREACHABLE)
+        # No distance check here: a waypoint is out of reach only where inverse kinematics finds no
+        # configuration for it (the law's reach check, with the robot's tool); UR's 1.3 m is the
+        # brochure's round figure, and flange poses of in-range configurations lie up to 1.32 m
+        # from the shoulder.
         if np.any(np.abs(np.cos(waypoints[:, 4])) < 1e-3):
             k = int(np.argmax(np.abs(np.cos(waypoints[:, 4])) < 1e-3))
             raise SingularConfigurationError(

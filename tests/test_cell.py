@@ -1,0 +1,134 @@
+"""The cell: scenario data, geometry in the plant, the payload, and its bad input (each refused
+naming its field, with nothing run)."""
+
+import textwrap
+
+import numpy as np
+import pytest
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.systems.framework import DiagramBuilder
+
+from drake_traj import load_scenario
+from drake_traj.cell import RATED_PAYLOAD, Box, Cell, Cylinder, Pedestal, Sphere, Tool, add_cell
+from drake_traj.errors import Cause, DrakeTrajError
+from drake_traj.robots import UR10E
+from drake_traj.robots.ur10e import dh_frames
+from drake_traj.scenario import ScenarioError
+
+G = 9.81
+
+
+def plant_with(cell: Cell, directory=None):
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
+    instance = UR10E.add_to_plant(plant)
+    fields = add_cell(plant, cell, instance, directory=directory)
+    plant.Finalize()
+    return plant, instance, fields
+
+
+def test_the_default_cell_is_a_table_flush_with_the_base():
+    plant, _, fields = plant_with(Cell())
+    assert fields == {"table": ("cell", "mounting")}
+    assert plant.num_bodies() == 1 + 8  # world + the UR10e's links (base, six links, tool0): no tool body
+
+
+def test_the_payload_changes_the_static_shoulder_torque_by_m_g_r():
+    mass, com = 5.0, np.array([0.02, -0.03, 0.08])
+    q = np.array([0.3, -1.1, 1.4, -0.9, 1.2, 0.5])
+    torques = []
+    for cell in (Cell(), Cell(tool=Tool(mass=mass, center_of_mass=com.tolist(), tcp_xyz=[0, 0, 0.1]))):
+        plant, instance, _ = plant_with(cell)
+        context = plant.CreateDefaultContext()
+        plant.SetPositions(context, instance, q)
+        torques.append(-plant.CalcGravityGeneralizedForces(context))  # the torque that holds the arm
+    # independent: the payload's weight at its centre (flange frame -> base frame by the DH chain)
+    frames = dh_frames(q)
+    centre = frames[6][:3, :3] @ com + frames[6][:3, 3]
+    axis, origin = frames[1][:3, 2], frames[1][:3, 3]  # joint 2 turns about z of DH frame 1
+    expected = axis @ np.cross(centre - origin, [0.0, 0.0, -mass * G])
+    change = torques[1][1] - torques[0][1]
+    assert change == pytest.approx(-expected, rel=0.01)
+    assert abs(change) > 10.0  # a real lever: m g r with r ~ 0.5 m
+
+
+@pytest.mark.parametrize("cell, field, words", [
+    (Cell(obstacles=[Box(size=[0.3, 0.2, -0.25])]), ("cell", "obstacles", 0, "size", 2), "must be positive"),
+    (Cell(obstacles=[Box(size=[0.3, 0.0, 0.2])]), ("cell", "obstacles", 0, "size", 1), "must be positive"),
+    (Cell(obstacles=[Sphere(radius=0.1, xyz=[0.5, float("nan"), 0.2])]), ("cell", "obstacles", 0, "xyz"), "finite"),
+    (Cell(obstacles=[Cylinder(radius=0.1, length=0.2, rpy=[0, float("inf"), 0])]), ("cell", "obstacles", 0, "rpy"),
+     "finite"),
+    (Cell(mounting=Pedestal(radius=0.0)), ("cell", "mounting", "radius"), "must be positive"),
+    (Cell(tool=Tool(mass=RATED_PAYLOAD + 0.5, tcp_xyz=[0, 0, 0.2])), ("cell", "tool", "mass"), "rated payload"),
+    (Cell(tool=Tool(mass=-1.0)), ("cell", "tool", "mass"), ">= 0"),
+    (Cell(tool=Tool(mass=2.0, tcp_xyz=[0, 0, 0.1], center_of_mass=[0, 0, 0.4])), ("cell", "tool", "center_of_mass"),
+     "beyond the tool"),
+    (Cell(tool=Tool(tcp_xyz=[0, 0, float("nan")])), ("cell", "tool", "tcp_xyz"), "finite"),
+    (Cell(tool=Tool(mass=1.0, tcp_xyz=[0, 0, 0.1], inertia=[1, 1, 5, 0, 0, 0])), ("cell", "tool", "inertia"),
+     "not a physical inertia"),
+    (Cell(clearance=-0.001), ("cell", "clearance"), ">= 0"),
+])
+def test_a_malformed_cell_is_refused_naming_its_field(cell, field, words):
+    with pytest.raises(DrakeTrajError, match=words) as caught:
+        cell.validate()
+    assert caught.value.field == field
+    assert caught.value.cause in (Cause.INVALID, Cause.INFEASIBLE)
+
+
+def scenario_file(tmp_path, cell_yaml: str):
+    path = tmp_path / "cell.yaml"
+    path.write_text("name: cell_test\nplanner: !QuinticConfig\n  goals: [[-1.2, -1.6, -2.0, -0.9, 1.57, 0.8]]\n"
+                    + textwrap.indent(textwrap.dedent(cell_yaml), ""))
+    return path
+
+
+def test_a_scenario_file_locates_a_bad_size_at_its_line(tmp_path):
+    path = scenario_file(tmp_path, """\
+        cell:
+          obstacles:
+          - !Box {name: fixture, size: [0.3, 0.2, -0.25], xyz: [0.6, -0.4, 0.125]}
+        """)
+    with pytest.raises(ScenarioError, match=r"line 6.*cell\.obstacles\[0\]\.size\[2\] must be positive"):
+        load_scenario(path)
+
+
+def test_directives_add_the_users_model_from_a_path_relative_to_the_scenario(tmp_path):
+    (tmp_path / "models").mkdir()
+    (tmp_path / "models" / "post.sdf").write_text(textwrap.dedent("""\
+        <?xml version="1.0"?>
+        <sdf version="1.7"><model name="post"><link name="body">
+          <collision name="c"><geometry><cylinder><radius>0.05</radius><length>0.5</length></cylinder></geometry></collision>
+        </link></model></sdf>
+        """))
+    path = scenario_file(tmp_path, """\
+        cell:
+          directives:
+          - add_model: {name: post, file: models/post.sdf}
+          - add_weld: {parent: world, child: post::body, X_PC: {translation: [0.7, 0.0, 0.25]}}
+        """)
+    scenario = load_scenario(path)
+    checker = scenario.cell_checker()
+    post = checker.plant.GetBodyByName("body", checker.plant.GetModelInstanceByName("post"))
+    assert not post.is_floating_base_body()
+    # the post (r 0.05 m, 0.5 m tall) stands 0.7 m along +x: the arm stretched along +x, its
+    # upper arm about 0.4 m up, passes through it; turned away, it is clear
+    into = [contact for contact in checker.contacts([np.pi, -0.3, 0.0, -1.2, -1.57, 0.0]) if "post::body" in contact.bodies]
+    assert into and into[0].distance < 0
+    assert not [c for c in checker.contacts([0.0, -0.3, 0.0, -1.2, -1.57, 0.0], 0.2) if "post::body" in c.bodies]
+
+
+@pytest.mark.parametrize("directive, words, field", [
+    ("- add_model: {name: post, file: models/missing.sdf}", "no model file 'models/missing.sdf'",
+     ("cell", "directives", 0, "add_model", "file")),
+    ("- add_model: {name: post, file: broken.sdf}", "broken.sdf cannot be used", ("cell", "directives", 0, "add_model", "file")),
+    ("- add_weld: {parent: world, child: nothing::base}", "unknown frame 'nothing::base'",
+     ("cell", "directives", 0, "add_weld")),
+])
+def test_a_bad_directive_is_refused_naming_its_entry(tmp_path, directive, words, field):
+    (tmp_path / "broken.sdf").write_text("<sdf version='1.7'><model name='x'><link name='a'>")
+    path = scenario_file(tmp_path, "cell:\n  directives:\n  " + directive + "\n")
+    scenario = load_scenario(path)
+    with pytest.raises(ScenarioError, match=words) as caught:
+        scenario.cell_checker()
+    assert caught.value.field == field
+    assert f"{path}, line 6" in str(caught.value)  # the entry's line

@@ -1,0 +1,196 @@
+"""The check before the motion: joint ranges, self-collision and collision with the cell, on the
+planned reference; and contact in the closed loop. Collision-free runs are confirmed by an
+independent query (Drake's SceneGraphCollisionChecker) at every logged sample."""
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+from pydrake.planning import RobotDiagramBuilder, SceneGraphCollisionChecker
+from pydrake.trajectories import PiecewisePolynomial
+
+from drake_traj import load_scenario, make_planner, simulate
+from drake_traj.cell import Box, Cell
+from drake_traj.clearance import CellChecker, CollisionError, JointRangeError
+from drake_traj.errors import Cause
+from drake_traj.planners import QuinticConfig
+from drake_traj.planners import make_planner as planner_from_config
+from drake_traj.robots import UR10E
+from drake_traj.scenario import preflight
+
+HOME = UR10E.home_configuration
+
+
+@pytest.fixture(scope="module")
+def checker():
+    return CellChecker(UR10E)
+
+
+def independent_checker(cell: Cell):
+    """Drake's own collision checker on the same robot and cell (padding 0): contact or not."""
+    from drake_traj.cell import add_cell
+
+    builder = RobotDiagramBuilder(time_step=0.0)
+    instance = UR10E.add_to_plant(builder.plant())
+    add_cell(builder.plant(), cell, instance)
+    return SceneGraphCollisionChecker(model=builder.Build(), robot_model_instances=[instance], edge_step_size=0.01,
+                                      env_collision_padding=0.0, self_collision_padding=0.0)
+
+
+def quintic(goals, q0=HOME):
+    return planner_from_config(QuinticConfig(goals=[list(goal) for goal in goals]), UR10E, np.asarray(q0))
+
+
+def test_the_reach_bounds_every_point_speed(checker):
+    """Σ_j |q̇_j| R_j bounds the speed of every point of every collision shape (Drake's body
+    velocities, the shapes' bounding spheres), over random states."""
+    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+    from pydrake.systems.framework import DiagramBuilder
+
+    from drake_traj.clearance import _bounding_radius
+
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
+    instance = UR10E.add_to_plant(plant)
+    plant.Finalize()
+    context = plant.CreateDefaultContext()
+    inspector = scene_graph.model_inspector()
+    rng = np.random.default_rng(7)
+    worst = 0.0
+    for _ in range(200):
+        qd = rng.uniform(-1, 1, 6) * rng.uniform(0, 3)
+        plant.SetPositions(context, instance, rng.uniform(-np.pi, np.pi, 6))
+        plant.SetVelocities(context, instance, qd)
+        bound = np.abs(qd) @ checker.reach
+        for body_index in plant.GetBodyIndices(instance):
+            body = plant.get_body(body_index)
+            velocity = body.EvalSpatialVelocityInWorld(context)
+            X_WB = body.EvalPoseInWorld(context)
+            for geometry in plant.GetCollisionGeometriesForBody(body):
+                X_BG = inspector.GetPoseInFrame(geometry)
+                offset = X_WB.rotation() @ X_BG.translation()
+                speed = np.linalg.norm(velocity.translational() + np.cross(velocity.rotational(), offset))
+                speed += np.linalg.norm(velocity.rotational()) * _bounding_radius(inspector.GetShape(geometry))
+                worst = max(worst, speed / bound)
+    assert 0.3 < worst <= 1.0  # a bound, and not a loose one
+
+
+def test_a_motion_through_the_table_is_refused_naming_the_time_the_bodies_and_the_waypoint(checker):
+    # the shoulder lifts the arm down past the horizontal: the forearm and wrist go through the table
+    planner = quintic([[-1.2, -1.6, -2.0, -0.9, 1.57, 0.8], [-1.2, 0.6, -0.3, -0.9, 1.57, 0.8]])
+    with pytest.raises(CollisionError) as caught:
+        checker.check_planner(planner)
+    error = caught.value
+    assert "table" in error.bodies and error.cause is Cause.COLLISION
+    assert error.distance < checker.clearance and error.segment == "on the way to waypoint 1"
+    assert 0 < error.time < planner.plan().end_time()
+    assert f"t = {error.time:.3f} s" in str(error) and "table" in str(error)
+    # the reported configuration is the plan's at that time, and really that close to the table
+    assert np.allclose(error.configuration, planner.plan().value(error.time).ravel())
+    contact = [c for c in checker.contacts(error.configuration) if "table" in c.bodies][0]
+    assert contact.distance == pytest.approx(error.distance)
+
+
+def test_a_motion_through_the_arm_itself_is_refused(checker):
+    # the elbow folds the forearm back onto the upper arm, high above the table
+    planner = quintic([[-1.57, -1.57, 2.9, -1.57, 1.57, 0.0]], q0=[-1.57, -1.57, 0.0, -1.57, 1.57, 0.0])
+    with pytest.raises(CollisionError) as caught:
+        checker.check_planner(planner)
+    assert "table" not in caught.value.bodies
+    assert set(caught.value.bodies) <= {"base", "shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link",
+                                        "wrist_2_link", "wrist_3_link"}
+
+
+def test_a_reference_past_the_joint_range_is_refused(checker):
+    times = [0.0, 2.0]
+    q = np.column_stack([HOME, HOME + [0, 0, 0, 0, 0, 2 * np.pi]])  # wrist 3 from π/4 to π/4 + 2π > 2π
+    with pytest.raises(JointRangeError, match=r"joint 6 \(wrist_3_joint\) to 6\.28") as caught:
+        checker.check(PiecewisePolynomial.CubicShapePreserving(times, q, zero_end_point_derivatives=True))
+    error = caught.value
+    assert error.joint == 5 and error.limit == pytest.approx(2 * np.pi) and error.cause is Cause.JOINT_RANGE
+    # the first sample past the range, on the 1 ms grid
+    assert error.value > 2 * np.pi and error.value - 2 * np.pi < 0.01
+
+
+def test_the_samples_are_dense_enough_that_the_clearance_holds_between_them(checker):
+    """Accepted motions keep half the clearance at every millisecond, not only at the samples."""
+    rng = np.random.default_rng(3)
+    accepted = 0
+    for _ in range(6):
+        goal = HOME + rng.uniform(-1.0, 1.0, 6)
+        planner = quintic([goal])
+        try:
+            check = checker.check_planner(planner)
+        except (CollisionError, JointRangeError):
+            continue
+        accepted += 1
+        plan = planner.plan()
+        dense = np.arange(0.0, plan.end_time(), 1e-3)
+        assert len(check.times) < len(dense)
+        assert not any(checker.contacts(q, within=0.5 * checker.clearance) for q in plan.vector_values(dense).T)
+    assert accepted >= 2
+
+
+def blocking_box_scenario(tmp_path):
+    """quintic_ptp with a 10 cm box where its tool passes at t = 2 s."""
+    scenario = load_scenario("quintic_ptp")
+    plan = make_planner(scenario).plan()
+    centre = UR10E.tool_position(plan.value(2.0).ravel())
+    text = (scenario.source.path.read_text() + textwrap.dedent(f"""\
+        cell:
+          obstacles:
+          - !Box {{name: fixture, size: [0.1, 0.1, 0.1], xyz: [{centre[0]:.4f}, {centre[1]:.4f}, {centre[2]:.4f}]}}
+        """))
+    path = tmp_path / "blocked.yaml"
+    path.write_text(text)
+    return path, text.splitlines().index("  obstacles:") + 2  # 1-based line of the box
+
+
+def test_a_users_box_that_blocks_a_shipped_task_is_refused_at_its_line(tmp_path):
+    path, line = blocking_box_scenario(tmp_path)
+    scenario = load_scenario(path)
+    with pytest.raises(CollisionError) as caught:
+        preflight(scenario, make_planner(scenario))
+    error = caught.value
+    assert "fixture" in error.bodies and error.field == ("cell", "obstacles", 0)
+    assert str(error).startswith(f"{path}, line {line}")
+    # the command line: exit 2, nothing simulated, the picture of the refused configuration
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-m", "drake_traj.cli", "run", str(path), "--out", str(out)],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 2, done.stderr
+    assert "fixture" in done.stderr and f"line {line}" in done.stderr and "refusal.png" in done.stderr
+    assert (out / "refusal.png").stat().st_size > 10_000 and not (out / "result.npz").exists()
+
+
+def test_in_the_closed_loop_touching_the_box_fails_the_run_as_a_collision(tmp_path):
+    path, _ = blocking_box_scenario(tmp_path)
+    result = simulate(load_scenario(path), preflight=False)
+    assert result.failure is not None and result.failure.cause is Cause.COLLISION, result.failure
+    assert "fixture" in result.failure.message and result.failure.time < 2.5
+    assert not result.succeeded
+
+
+@pytest.mark.parametrize("scale", [0.7, 1.0])
+def test_random_walks_are_refused_or_run_collision_free(scale):
+    """Seeded random joint walks (1-3 goals, steps up to ``scale`` rad per joint): each is refused
+    with a collision or joint-range reason, or runs, and the run is then collision-free at
+    every logged sample by Drake's SceneGraphCollisionChecker on the measured configuration."""
+    rng = np.random.default_rng(int(scale * 10))
+    independent = independent_checker(Cell())
+    outcomes = {"refused": 0, "ran": 0}
+    for _ in range(4):
+        goals = HOME + np.cumsum(rng.uniform(-scale, scale, (rng.integers(1, 4), 6)), axis=0)
+        planner = quintic(goals)
+        try:
+            result = simulate(planner, max_duration=40.0)
+        except (CollisionError, JointRangeError) as error:
+            assert error.cause in (Cause.COLLISION, Cause.JOINT_RANGE)
+            outcomes["refused"] += 1
+            continue
+        assert result.succeeded, result.failure
+        assert all(independent.CheckConfigCollisionFree(q) for q in result.q_meas)
+        outcomes["ran"] += 1
+    assert outcomes["ran"] >= 1, outcomes
