@@ -37,6 +37,7 @@ raises, or whose worker dies, is a row with ``succeeded`` false, NaN metrics and
 
 import contextlib
 import csv
+import functools
 import importlib.metadata
 import logging
 import numbers
@@ -118,7 +119,7 @@ def random_tasks(count: int, seed: int = 0):
     and free of self-collision. The motions between them are checked by each run."""
     rng = np.random.default_rng(seed)
     q0 = pajak.paper_initial_configuration()
-    cell = CellChecker(UR10E)
+    cell = _cell_checker()
     tasks = []
     while len(tasks) < count:
         configurations = [q0]
@@ -212,14 +213,22 @@ def run_toppra(task: Task, reference: dict) -> dict:
 def _run(label, name, config, q0, repeats, keep_path) -> dict:
     try:
         planning = _planning_time(config, q0, repeats)
-        # _planning_time has run the preflight already (a task it refuses is this row's failure)
-        result = simulate(make_planner(config, UR10E, q0), name=name, settle_time=SETTLE_TIME,
-                          max_duration=MAX_DURATION, preflight=False)
+        # _planning_time has run the preflight already (a task it refuses is this row's failure);
+        # a plan that leaves the cell (the default table) or hits the arm itself is refused too
+        planner = make_planner(config, UR10E, q0)
+        _cell_checker().check_planner(planner)
+        result = simulate(planner, name=name, settle_time=SETTLE_TIME, max_duration=MAX_DURATION, preflight=False)
         row = _row(label, name, result, planning, _optimal_duration(result))
     except Exception as error:  # a run's failure is a row, not a lost task
         return {"row": failed_row(label, name, _reason(error)), "path": None}
     path = result.q_ref[: np.searchsorted(result.t, result.duration) + 1] if keep_path and result.succeeded else None
     return {"row": row, "path": path}
+
+
+@functools.cache
+def _cell_checker() -> CellChecker:
+    """The default cell's checker, one per process (a Dask worker builds its own)."""
+    return CellChecker(UR10E)
 
 
 def _planning_time(config, q0, repeats):

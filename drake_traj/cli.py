@@ -38,7 +38,7 @@ from drake_traj.bench import bench
 from drake_traj.clearance import CollisionError
 from drake_traj.errors import Cause, DrakeTrajError, Failure, PlanningError
 from drake_traj.export import FORMATS, UR_CYCLE, ExportError
-from drake_traj.meshcat import add_live_view, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
+from drake_traj.meshcat import add_live_view, draw_refusal, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
 from drake_traj.refusal import refusal_figure
 from drake_traj.result import SimulationResult
 from drake_traj.rundir import MANIFEST, add_to_manifest, begin_output, check_output, run_files, write_manifest
@@ -177,13 +177,20 @@ def run(args) -> int:
 def with_refusal_picture(error: CollisionError, scenario, args) -> CollisionError:
     """``error`` with the path of ``refusal.png`` (:func:`drake_traj.refusal.refusal_figure`), written
     with a ``run.json`` naming the refusal into the run's output folder when it may be written
-    (as a run's files: an earlier run there needs --overwrite); else the reason there is none."""
+    (as a run's files: an earlier run there needs --overwrite); else the reason there is none.
+    With --meshcat, the refused configuration is drawn there and served as after a run."""
+    checker = scenario.cell_checker()
+    if args.meshcat:
+        meshcat = start_meshcat(args.port)
+        draw_refusal(meshcat, checker, error)
+        print(f"drake-traj: the refused configuration is drawn at {meshcat.web_url()}", file=sys.stderr, flush=True)
+        serve_recording(meshcat.web_url(), args.serve_after)
     try:
         out_dir = begin_output(Path(args.out) if args.out else Path("out") / scenario.name, overwrite=args.overwrite)
     except DrakeTrajError as reason:
         return error.relocated(error.field, f"{error}\n(no picture of the refused configuration: {reason})")
     picture = out_dir / "refusal.png"
-    refusal_figure(scenario.cell_checker(), error).savefig(picture, dpi=100)
+    refusal_figure(checker, error).savefig(picture, dpi=100)
     write_manifest(out_dir, [picture.name], scenario=scenario.name, drake_traj=__version__,
                    failure=Failure(error.cause, str(error), error.time, tuple(error.configuration.tolist())).to_dict())
     return error.relocated(error.field, f"{error}\n(picture of the refused configuration: {picture})")

@@ -3,8 +3,9 @@ browser), and the standalone HTML recording.
 
 Paths in the Meshcat scene tree: ``/drake_traj/waypoints/<k>`` (each waypoint's neighbourhood,
 orange), ``/drake_traj/planned_path`` (the path a planner computed before moving, grey),
-``/drake_traj/trail`` (the measured TCP, growing live, red) and ``/drake_traj/tcp_path`` (the
-measured TCP path of a finished run, red).
+``/drake_traj/trail`` (the measured TCP, growing live, red), ``/drake_traj/tcp_path`` (the
+measured TCP path of a finished run, red) and ``/drake_traj/refusal`` (a refused configuration:
+every collision shape, the two bodies in red, their closest points joined).
 """
 
 import logging
@@ -12,14 +13,15 @@ import time
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import Meshcat, MeshcatParams, Rgba, Sphere
+from pydrake.geometry import Meshcat, MeshcatParams, Rgba, Role, Sphere
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
+from drake_traj.clearance import CellChecker, CollisionError
 from drake_traj.robots import Robot
 
 __all__ = [
-    "SPEED_SLIDER", "SpeedSlider", "TcpTrail", "add_live_view", "draw_task", "draw_tcp_path", "export_html", "frame_task",
+    "SPEED_SLIDER", "SpeedSlider", "TcpTrail", "add_live_view", "draw_refusal", "draw_task", "draw_tcp_path", "export_html", "frame_task",
     "start_meshcat", "wait_for_browser",
 ]
 
@@ -28,6 +30,26 @@ MARKER_RADIUS = 0.015  # [m] a waypoint the planner passes through or stops at
 PATH_COLOUR = Rgba(0.9, 0.1, 0.1, 1.0)
 PLANNED_COLOUR = Rgba(0.35, 0.35, 0.35, 1.0)
 SPEED_SLIDER = "speed override"
+REFUSED_COLOUR = Rgba(0.9, 0.1, 0.1, 0.9)
+OTHER_COLOUR = Rgba(0.7, 0.7, 0.7, 0.35)
+
+
+def draw_refusal(meshcat: Meshcat, checker: CellChecker, error: CollisionError) -> None:
+    """The configuration of ``error`` in ``checker``'s cell under ``/drake_traj/refusal``: every
+    collision shape at its pose, the two bodies of the error in red, the rest translucent grey,
+    and their closest points joined by a black line."""
+    meshcat.Delete("/drake_traj/refusal")
+    inspector = checker.scene_graph.model_inspector()
+    query = checker.pose_query(error.configuration)
+    for geometry in inspector.GetAllGeometryIds(Role.kProximity):
+        body, name = checker.owner(geometry)
+        path = f"/drake_traj/refusal/{body.replace('::', '/')}/{name}"
+        meshcat.SetObject(path, inspector.GetShape(geometry), REFUSED_COLOUR if body in error.bodies else OTHER_COLOUR)
+        meshcat.SetTransform(path, query.GetPoseInWorld(geometry))
+    for contact in checker.contacts(error.configuration):
+        if set(contact.bodies) == set(error.bodies):
+            meshcat.SetLine("/drake_traj/refusal/closest_points", contact.points.T.copy(), 4.0, Rgba(0, 0, 0, 1))
+            break
 
 
 def start_meshcat(port: int | None = None, *, announce: bool = True) -> Meshcat:

@@ -8,6 +8,7 @@ import textwrap
 
 import numpy as np
 import pytest
+from pydrake.geometry import Meshcat
 from pydrake.planning import RobotDiagramBuilder, SceneGraphCollisionChecker
 from pydrake.trajectories import PiecewisePolynomial
 
@@ -15,10 +16,11 @@ from drake_traj import load_scenario, make_planner, simulate
 from drake_traj.cell import Box, Cell
 from drake_traj.clearance import CellChecker, CollisionError, JointRangeError
 from drake_traj.errors import Cause
+from drake_traj.meshcat import draw_refusal
 from drake_traj.planners import QuinticConfig
 from drake_traj.planners import make_planner as planner_from_config
 from drake_traj.robots import UR10E
-from drake_traj.scenario import preflight
+from drake_traj.scenario import check_in_cell, preflight, shipped_scenarios
 
 HOME = UR10E.home_configuration
 
@@ -194,3 +196,27 @@ def test_random_walks_are_refused_or_run_collision_free(scale):
         assert all(independent.CheckConfigCollisionFree(q) for q in result.q_meas)
         outcomes["ran"] += 1
     assert outcomes["ran"] >= 1, outcomes
+
+
+@pytest.mark.parametrize("entry", shipped_scenarios(), ids=lambda entry: entry.name)
+def test_every_shipped_task_is_possible_in_its_cell(entry):
+    """Each shipped scenario's start and plan clear its cell (the default table, or the Li 4-DOF
+    task's none) and the arm itself by the clearance: the checks change none of their numbers."""
+    scenario = load_scenario(entry.path, entry.variant)
+    check = check_in_cell(scenario, make_planner(scenario))
+    assert len(check.times) > 10 and check.spacing == pytest.approx(0.5 * scenario.cell.clearance)
+
+
+def test_meshcat_draws_the_refused_configuration_with_the_two_bodies(checker):
+    planner = quintic([[-1.2, -1.6, -2.0, -0.9, 1.57, 0.8], [-1.2, 0.6, -0.3, -0.9, 1.57, 0.8]])
+    with pytest.raises(CollisionError) as caught:
+        checker.check_planner(planner)
+    meshcat = Meshcat()
+    draw_refusal(meshcat, checker, caught.value)
+    arm_body = next(body for body in caught.value.bodies if body != "table")
+    assert meshcat.HasPath(f"/drake_traj/refusal/{arm_body}") and meshcat.HasPath("/drake_traj/refusal/table/table")
+    assert meshcat.HasPath("/drake_traj/refusal/closest_points")
+    # every link is drawn, not only the two
+    for link in ("base", "shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link",
+                 "wrist_3_link"):
+        assert meshcat.HasPath(f"/drake_traj/refusal/{link}"), link

@@ -26,7 +26,7 @@ def li_run(request):
     scenario = load_scenario(DIAGRAMS / "li_closed_path.yaml", request.param)
     planner = make_planner(scenario)
     result = simulate(planner, name=scenario.name, robot=get_robot(scenario.robot), settle_time=0.1,
-                      max_duration=scenario.max_duration)
+                      max_duration=scenario.max_duration, cell=scenario.cell)
     return planner, result
 
 

@@ -104,8 +104,8 @@ def test_unreachable_goal_stops_with_the_reason_and_keeps_the_log(tmp_path):
 def test_bad_task_names_the_field():
     with pytest.raises(ValueError, match="vartheta"):
         P.PajakPlanner(P.paper_parameters(3, vartheta=0.7), Q0)
-    with pytest.raises(ValueError, match="beyond the UR10e reach"):
-        P.PajakPlanner(P.PajakConfig(waypoints=[[1.5, 0, 0.2, np.pi, 0, 0]]), Q0)
+    with pytest.raises(ValueError, match="waypoint 0 cannot be reached.*out of reach"):  # the IK, in the preflight
+        P.PajakPlanner(P.PajakConfig(waypoints=[[1.5, 0, 0.2, np.pi, 0, 0]]), Q0).preflight()
     with pytest.raises(ValueError, match="q_initial"):
         P.PajakPlanner(P.paper_parameters(3), Q0[:5])
 

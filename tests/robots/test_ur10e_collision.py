@@ -22,7 +22,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from pydrake.geometry import Box, ProximityProperties, Role
+from pydrake.geometry import Box, CollisionFilterDeclaration, GeometrySet, ProximityProperties, Role
 from pydrake.math import RigidTransform
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
@@ -152,6 +152,10 @@ def test_nothing_of_base_and_shoulder_below_the_mounting_surface():
 
 @pytest.fixture(scope="module")
 def arm():
+    return build_arm()
+
+
+def build_arm():
     """The UR10e as add_station builds it (UR10E.add_to_plant, base welded), plus a table-top box on
     the world body whose top face is z = 0. Continuous plant (time_step 0), finalized."""
     builder = DiagramBuilder()
@@ -165,6 +169,19 @@ def arm():
     return SimpleNamespace(plant=plant, scene_graph=scene_graph, instance=instance, context=context,
                            plant_context=plant.GetMyContextFromRoot(context),
                            scene_context=scene_graph.GetMyContextFromRoot(context))
+
+
+CONSTANT_GAP = frozenset(("wrist_1_link", "wrist_3_link"))  # filtered in the URDF: a constant 14.55 mm
+
+
+def arm_without_the_wrist_filter():
+    """:func:`arm` with the URDF's one filter, wrist 1 against wrist 3, lifted."""
+    unfiltered = build_arm()
+    geometries = [GeometrySet(unfiltered.plant.GetCollisionGeometriesForBody(unfiltered.plant.GetBodyByName(name)))
+                  for name in sorted(CONSTANT_GAP)]
+    unfiltered.scene_graph.collision_filter_manager(unfiltered.scene_context).Apply(
+        CollisionFilterDeclaration().AllowBetween(*geometries))
+    return unfiltered
 
 
 def distances(arm, q, max_distance=np.inf):
@@ -195,8 +212,8 @@ def table_pairs(pairs):
 
 def test_self_collision_is_on_between_every_pair_of_non_adjacent_links(arm):
     reported = {frozenset(p[1:3]) for p in self_pairs(distances(arm, UR10E.home_configuration))}
-    expected = {frozenset(pair) for pair in itertools.combinations(BODIES, 2)} - ADJACENT
-    assert len(expected) == 15
+    expected = {frozenset(pair) for pair in itertools.combinations(BODIES, 2)} - ADJACENT - {CONSTANT_GAP}
+    assert len(expected) == 14
     assert reported == expected
     # Only the arm's links see the table: the base is welded to the world, so Drake filters it.
     seen = {p[2] for p in table_pairs(distances(arm, UR10E.home_configuration))}
@@ -204,8 +221,8 @@ def test_self_collision_is_on_between_every_pair_of_non_adjacent_links(arm):
 
 
 def test_no_pair_of_non_adjacent_shapes_overlaps_at_every_configuration(arm):
-    # Why the URDF declares no collision filter group: each geometry pair Drake checks is apart at
-    # some configuration (300 random ones cover all).
+    # Why the URDF filters no pair for overlapping: each geometry pair Drake checks is apart at some
+    # configuration (300 random ones cover all).
     rng = np.random.default_rng(21)
     apart, seen = set(), set()
     for _ in range(300):
@@ -213,11 +230,13 @@ def test_no_pair_of_non_adjacent_shapes_overlaps_at_every_configuration(arm):
             seen.add((a, b))
             if distance > 0.0:
                 apart.add((a, b))
-    assert len(seen) == 28
+    assert len(seen) == 27
     assert apart == seen
 
 
 def test_the_wrist_2_housing_and_the_flange_keep_a_constant_gap(arm):
+    # ... which is why the URDF filters the pair (wrist_1_link, wrist_3_link): lifted here
+    unfiltered = arm_without_the_wrist_filter()
     # The flange starts (along the joint-6 axis) at s0 = 0.06655 from the joint-5 axis, which it
     # crosses; the joint-5 housing is a cylinder of radius r5 about that axis, and both turn about
     # their own axes only. So the gap is s0 - r5 at every configuration (independent of q5, q6).
@@ -227,7 +246,8 @@ def test_the_wrist_2_housing_and_the_flange_keep_a_constant_gap(arm):
     rng = np.random.default_rng(5)
     reported = []
     for q in rng.uniform(-2 * np.pi, 2 * np.pi, (50, 6)):
-        (pair,) = [p for p in distances(arm, q) if p[3:] == ("joint5_housing", "flange")]
+        (pair,) = [p for p in distances(unfiltered, q) if p[3:] == ("joint5_housing", "flange")]
+        assert not [p for p in distances(arm, q) if p[3:] == ("joint5_housing", "flange")]
         reported.append(pair[0])
     # Drake's distance between these two cylinders (a flat face against a curved side) comes from an
     # iterative convex solver: measured 0 to +0.55 mm above the exact gap, never below it.
@@ -247,7 +267,7 @@ def start_configurations():
 
 def test_start_configurations_have_no_self_contact(arm):
     starts = start_configurations()
-    assert len(starts) == 7  # home + boryga_loop_ur10e, li_closed_path_ur10e, pajak_sim1..3, quintic_ptp
+    assert len(starts) == 8  # home + boryga_loop_ur10e, fixture_cell, li_closed_path_ur10e, pajak_sim1..3, quintic_ptp
     for name, q in starts.items():
         pairs = distances(arm, q)
         closest = self_pairs(pairs)[0]
