@@ -54,6 +54,7 @@ from tqdm import tqdm
 
 from drake_traj.clearance import CellChecker
 from drake_traj.errors import DrakeTrajError
+from drake_traj.output import FOLDER_KINDS, OutputError, claim
 from drake_traj.station import simulate
 from drake_traj.planners import (
     MovejConfig,
@@ -440,30 +441,34 @@ def _check_arguments(count, seed, repeats, workers, scheduler, planners, extra_p
                 f"extra_planners[{name!r}] must be a new planner name with a config builder, got {build!r}")
 
 
-def _check_output_directory(out_dir) -> Path:
-    """``out_dir`` as a Path; BenchSetupError if it is a file or lies below one."""
+BENCH_SIZE = 4 * 2**20  # [bytes] about what bench.csv, bench.md and bench.png take, rounded up
+
+
+def _claim_output_directory(out_dir, overwrite: bool, command: str | None):
+    """``out_dir`` claimed for this bench (:func:`drake_traj.output.claim`): created, writable,
+    not a run's folder, not an earlier bench's unless ``overwrite``, locked; BenchSetupError if
+    not (if it is or lies below a file, say)."""
     out_dir = Path(out_dir)
     for path in (out_dir, *out_dir.parents):
         if path.exists() and not path.is_dir():
             where = "is a file" if path == out_dir else f"lies below the file {path}"
             raise BenchSetupError(f"--out {out_dir} {where}; give a directory (it is created if missing)")
-    return out_dir
-
-
-def _make_output_directory(out_dir: Path) -> None:
     try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise BenchSetupError(f"--out {out_dir}: cannot create the directory ({_reason(error)})") from None
+        return claim(out_dir, "bench", overwrite=overwrite, earlier_files=lambda directory: list(FOLDER_KINDS["bench"]),
+                     estimate=BENCH_SIZE, command=command)
+    except OutputError as error:
+        raise BenchSetupError(f"--out {out_dir}: {error}") from None
 
 
 def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers: int | None = None,
           scheduler: str | None = None, planners=PLANNERS, extra_planners: dict | None = None,
-          progress=sys.stderr) -> list[dict]:
+          progress=sys.stderr, overwrite: bool = False, command: str | None = None) -> list[dict]:
     """Run the benchmark; writes bench.csv, bench.md and bench.png into ``out_dir``.
 
     Args:
-        out_dir: output directory (created; must not be or lie below a file).
+        out_dir: output directory (created; must not be or lie below a file, nor hold a run, an
+            earlier bench or other files). The files are written whole beside the earlier ones
+            and replace them only once complete on disk (:mod:`drake_traj.output`).
         count: seeded random tasks besides the paper task (>= 0).
         seed: seed of the random tasks (>= 0).
         repeats: planning-time repeats on the paper task (>= 1).
@@ -478,6 +483,8 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers:
             [rad]). On Dask, ``build`` must be a top-level function of a module the workers
             can import. A build or planner that raises gives failed rows.
         progress: stream of the progress bar (shown only if it is a terminal), or None.
+        overwrite: replace an earlier bench in ``out_dir``.
+        command: names this process to another writer of ``out_dir`` (default its command line).
 
     Returns:
         The rows (one per run, tasks in order, planners in the order of ``planners``, then the
@@ -485,16 +492,26 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers:
 
     Raises:
         BenchSetupError: a bad argument, output directory or scheduler, before any run.
+        drake_traj.output.WriteError: the files could not be written (disk full, ...); the
+            earlier content of ``out_dir`` is intact.
     """
     planners, extra_planners = tuple(planners), dict(extra_planners or {})
     _check_arguments(count, seed, repeats, workers, scheduler, planners, extra_planners)
-    out_dir = _check_output_directory(out_dir)
     if workers is None and scheduler is None:
         workers = _default_workers()
     builders = {name: CONFIG_BUILDERS[name] for name in planners if name != "toppra"} | extra_planners
     toppra = "toppra" in planners
+    with _claim_output_directory(out_dir, overwrite, command) as claimed:
+        table, text = _bench(claimed, count, seed, repeats, workers, scheduler, (*planners, *extra_planners), builders,
+                             toppra, progress)
+    print(text)
+    return table
+
+
+def _bench(claimed, count, seed, repeats, workers, scheduler, names, builders, toppra, progress):
+    """The bench of :func:`bench` into its ``claimed`` folder (rows of the planners ``names`` in
+    order); returns the table and bench.md's text."""
     with _engine(workers, scheduler) as client:
-        _make_output_directory(out_dir)
         work = tasks(count, seed, repeats)
         bar = _Progress(len(work) * (len(builders) + toppra), progress)
         try:
@@ -504,23 +521,27 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers:
                 by_run = _run_on(client, work, builders, toppra, bar)
         finally:
             bar.close()
-    rows = [by_run[task.label, name] for task in work for name in (*planners, *extra_planners)]
+    rows = [by_run[task.label, name] for task in work for name in names]
     failed = sum(not row["succeeded"] for row in rows)
     if failed:
         print(f"{failed} of {len(rows)} runs failed (see the failure column)", file=sys.stderr)
     table = rows + (medians([row for row in rows if row["task"] != "paper"]) if count else [])
-    with open(out_dir / "bench.csv", "w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=COLUMNS)
-        writer.writeheader()
-        writer.writerows(table)
     paper_rows = [row for row in rows if row["task"] == "paper"]
     text = "## Paper task\n\n" + _markdown(paper_rows)
     if count:
         text += f"\n## Medians over {count} seeded tasks\n\n" + _markdown(table[len(rows):])
-    (out_dir / "bench.md").write_text(text)
-    bench_figure(rows).savefig(out_dir / "bench.png", dpi=110)
-    print(text)
-    return table
+    with claimed.replace() as staging:
+        staging.write("bench.csv", functools.partial(_write_csv, table))
+        staging.write("bench.md", lambda path: path.write_text(text))
+        staging.write("bench.png", lambda path: bench_figure(rows).savefig(path, dpi=110))
+    return table, text
+
+
+def _write_csv(table, path) -> None:
+    with open(path, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=COLUMNS)
+        writer.writeheader()
+        writer.writerows(table)
 
 
 def _markdown(rows) -> str:

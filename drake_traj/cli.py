@@ -5,7 +5,7 @@
     drake-traj list
     drake-traj show [SCENARIO] [--variant NAME]
     drake-traj export RUN_DIR --format csv|urscript|ros2 [--period 0.002] [--out FILE]
-    drake-traj bench [--out DIR] [--count N] [--seed S] [--repeats R]
+    drake-traj bench [--out DIR] [--overwrite] [--count N] [--seed S] [--repeats R]
 
 ``run`` writes DIR/result.npz, metrics.json, *.png, meshcat.html and run.json (the manifest);
 SCENARIO is a YAML file or the name of a shipped scenario (``drake-traj list``: the shipped
@@ -14,15 +14,17 @@ writes a run's reference for a robot or another tool (drake_traj.export). ``benc
 every planner and baseline on Pająk 2024's task and N seeded tasks and writes DIR/bench.csv,
 bench.md and bench.png.
 
-Exit codes: 0 success; 1 the run failed (its log is kept in the output folder); 2 bad input
-(nothing was run); 130 interrupted by Ctrl-C, 143 stopped by SIGTERM (in both, what was logged is
-kept). ``--debug`` shows the traceback of an error. Text the terminal's encoding cannot show is
+Exit codes: 0 success; 1 the run failed (its log is kept in the output folder), or its files could
+not be written (disk full, a permission lost: the message names the file; the folder's earlier
+content is kept); 2 bad input (nothing was run, nothing written); 130 interrupted by Ctrl-C, 143
+stopped by SIGTERM (in both, what was logged is kept). ``--debug`` shows the traceback of an error. Text the terminal's encoding cannot show is
 printed as escapes (``\u0105``), never an error.
 """
 
 import argparse
 import contextlib
 import json
+import shlex
 import signal
 import sys
 import threading
@@ -41,7 +43,8 @@ from drake_traj.export import FORMATS, UR_CYCLE, ExportError
 from drake_traj.meshcat import add_live_view, draw_refusal, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
 from drake_traj.refusal import refusal_figure
 from drake_traj.result import SimulationResult
-from drake_traj.rundir import MANIFEST, add_to_manifest, begin_output, check_output, run_files, write_manifest
+from drake_traj.output import WriteError, locked
+from drake_traj.rundir import MANIFEST, add_to_manifest, claim_run_folder, run_files, write_manifest
 from drake_traj.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
                                  load_scenario, preflight, scenario_variants, shipped_scenarios)
 from drake_traj.station import simulate
@@ -106,6 +109,7 @@ def run(args) -> int:
         raise DrakeTrajError("--out must name a folder, got empty text")
     progress = Progress(scenario.max_duration, enabled=sys.stderr.isatty())
     interrupts = []
+    claimed = None
     try:
         arguments = scenario.station_arguments() | scenario.run_settings()
         planner = arguments.pop("planner")
@@ -118,10 +122,13 @@ def run(args) -> int:
                 raise with_refusal_picture(error, scenario, args) from None
         check_planned_duration(scenario, planner)
         duration = planner.planned_duration()
-        # checked before the simulation; written (an earlier run replaced, with --overwrite) only
-        # once there are results
-        out_dir = check_output(Path(args.out) if args.out else Path("out") / scenario.name, overwrite=args.overwrite)
-        progress.expect(duration + scenario.settle_time if np.isfinite(duration) else scenario.max_duration)
+        expected = duration + scenario.settle_time if np.isfinite(duration) else scenario.max_duration
+        # checked and locked before the simulation; written (an earlier run replaced, with
+        # --overwrite) only once the new run's files are complete on disk
+        claimed = claim_run_folder(_run_folder(args, scenario), overwrite=args.overwrite,
+                                   samples=expected / scenario.logging_period(), command=args.command_line)
+        out_dir = claimed.directory
+        progress.expect(expected)
         meshcat = start_meshcat(args.port, announce=args.meshcat)
         draw_task(meshcat, planner.task_waypoints(), neighbourhood=planner.waypoint_neighbourhood(),
                   planned_path=planned_path)
@@ -148,19 +155,20 @@ def run(args) -> int:
         result = simulate(planner, meshcat=meshcat, progress=progress.simulated, add_systems=add_systems,
                           before_run=before_run, preflight=False, **arguments)
         progress.stage("writing figures")
-        with _interrupts_deferred() as interrupts:  # a second Ctrl-C must not leave half a run
-            out_dir = begin_output(out_dir, overwrite=args.overwrite)
-            result.save(out_dir)
-            files = ["result.npz", "metrics.json"] + [path.name for path in result.save_figures(out_dir)]
-            for stem, figure in planner.figures().items():
-                figure.savefig(out_dir / f"{stem}.png", dpi=110)
-                files.append(f"{stem}.png")
+        # a second Ctrl-C must not leave half a run
+        with _interrupts_deferred() as interrupts, claimed.replace() as staging:
+            result.write_into(staging)
+            for stem, figure in (result.figures() | planner.figures()).items():
+                staging.write(f"{stem}.png", lambda path: figure.savefig(path, dpi=110))
             draw_tcp_path(meshcat, result.tcp)
-            files.append(export_html(meshcat, out_dir / "meshcat.html").name)
-            write_manifest(out_dir, files, scenario=scenario.name, drake_traj=__version__,
+            staging.write("meshcat.html", lambda path: export_html(meshcat, path))
+            files = list(staging.files)
+            write_manifest(staging, files, scenario=scenario.name, drake_traj=__version__,
                            failure=None if result.failure is None else result.failure.to_dict())
     finally:
         progress.close()
+        if claimed is not None:
+            claimed.release()
     metrics = result.metrics().to_dict()
     print(json.dumps({key: metrics[key] for key in SUMMARY}, indent=2))
     print(f"wrote {out_dir}: {', '.join(sorted(files))}")
@@ -172,6 +180,11 @@ def run(args) -> int:
     if result.succeeded:
         return EXIT_OK
     return EXIT_INTERRUPTED if result.failure.cause is Cause.INTERRUPTED else EXIT_RUN_FAILED
+
+
+def _run_folder(args, scenario) -> Path:
+    """The run's output folder: --out, or out/<scenario name>."""
+    return Path(args.out) if args.out else Path("out") / scenario.name
 
 
 def with_refusal_picture(error: CollisionError, scenario, args) -> CollisionError:
@@ -186,13 +199,13 @@ def with_refusal_picture(error: CollisionError, scenario, args) -> CollisionErro
         print(f"drake-traj: the refused configuration is drawn at {meshcat.web_url()}", file=sys.stderr, flush=True)
         serve_recording(meshcat.web_url(), args.serve_after)
     try:
-        out_dir = begin_output(Path(args.out) if args.out else Path("out") / scenario.name, overwrite=args.overwrite)
+        with claim_run_folder(_run_folder(args, scenario), overwrite=args.overwrite, command=args.command_line) as claimed, \
+                claimed.replace() as staging:
+            picture = staging.write("refusal.png", lambda path: refusal_figure(checker, error).savefig(path, dpi=100))
+            write_manifest(staging, [picture.name], scenario=scenario.name, drake_traj=__version__,
+                           failure=Failure(error.cause, str(error), error.time, tuple(error.configuration.tolist())).to_dict())
     except DrakeTrajError as reason:
         return error.relocated(error.field, f"{error}\n(no picture of the refused configuration: {reason})")
-    picture = out_dir / "refusal.png"
-    refusal_figure(checker, error).savefig(picture, dpi=100)
-    write_manifest(out_dir, [picture.name], scenario=scenario.name, drake_traj=__version__,
-                   failure=Failure(error.cause, str(error), error.time, tuple(error.configuration.tolist())).to_dict())
     return error.relocated(error.field, f"{error}\n(picture of the refused configuration: {picture})")
 
 
@@ -250,10 +263,13 @@ def export_run(args) -> int:
         raise ExportError(f"--out {out} is one of the run's own files; give another file name")
     if out.exists() and not args.overwrite:
         raise ExportError(f"--out {out} exists; pass --overwrite to replace it")
-    path = result.export(out, args.format, period=args.period, lookahead_time=args.lookahead_time, gain=args.gain,
-                         approach_speed=args.approach_speed, allow_failed=args.allow_failed)
-    if into_run and (run_dir / MANIFEST).is_file():
-        add_to_manifest(run_dir, path.name)  # replacing the run (--overwrite) removes its exports too
+    # into the run's own folder: locked, so that no run replaces the folder meanwhile
+    with locked(run_dir, args.command_line) if into_run else contextlib.nullcontext():
+        path = result.export(out, args.format, period=args.period, lookahead_time=args.lookahead_time, gain=args.gain,
+                             approach_speed=args.approach_speed, allow_failed=args.allow_failed,
+                             run_folder=run_dir if into_run else None)
+        if into_run and (run_dir / MANIFEST).is_file():
+            add_to_manifest(run_dir, path.name)  # replacing the run (--overwrite) removes its exports too
     print(f"wrote {path}")
     return EXIT_OK
 
@@ -266,7 +282,7 @@ def _exports() -> list[str]:
 def run_bench(args) -> int:
     """``drake-traj bench``; bad arguments, ``--out`` or ``--scheduler`` are refused before any run."""
     bench(args.out, count=args.count, seed=args.seed, repeats=args.repeats, workers=args.workers,
-          scheduler=args.scheduler)
+          scheduler=args.scheduler, overwrite=args.overwrite, command=args.command_line)
     return EXIT_OK
 
 
@@ -341,6 +357,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench_parser = commands.add_parser("bench", help="compare every planner and baseline on UR10e tasks")
     bench_parser.set_defaults(handler=run_bench)
     bench_parser.add_argument("--out", default="out/bench", help="output directory (default: out/bench)")
+    bench_parser.add_argument("--overwrite", action="store_true", help="replace an earlier bench in the output directory")
     bench_parser.add_argument("--count", type=int, default=20, help="seeded random tasks besides the paper's")
     bench_parser.add_argument("--seed", type=int, default=0)
     bench_parser.add_argument("--repeats", type=int, default=5, help="planning-time repeats on the paper task")
@@ -357,6 +374,8 @@ def main(argv=None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as done:  # --help, --version, or a usage error argparse printed (code 2)
         return done.code
+    # names this process to another that would write the same folder
+    args.command_line = shlex.join(["drake-traj", *(sys.argv[1:] if argv is None else argv)])
     for stream in (sys.stdout, sys.stderr):  # e.g. PYTHONIOENCODING=ascii: print "ą" as \u0105
         with contextlib.suppress(AttributeError, ValueError):
             stream.reconfigure(errors="backslashreplace")
@@ -376,6 +395,9 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("drake-traj: terminated (SIGTERM)" if terminated else "drake-traj: interrupted", file=sys.stderr)
         return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED
+    except WriteError as error:  # disk full, a permission lost, ...: the earlier content is intact
+        print(f"drake-traj: error: {error}", file=sys.stderr)
+        failure, code = error, EXIT_RUN_FAILED
     except (DrakeTrajError, ValueError) as error:  # bad input: one paragraph, no traceback
         kind = "the task cannot be done" if isinstance(error, PlanningError) else "error"
         print(f"drake-traj: {kind}: {error}", file=sys.stderr)

@@ -18,6 +18,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_traj.version import __version__
 from drake_traj.errors import DrakeTrajError
+from drake_traj.output import write_file
 from drake_traj.robots import UR10E
 
 __all__ = ["FORMATS", "ExportError", "export", "reference_trajectory", "resample"]
@@ -125,7 +126,7 @@ def _ros2(result, t, q, qd, qdd, joint_names) -> str:
 
 
 def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_time: float = 0.1, gain: float = 300.0,
-           approach_speed: float = 0.3, allow_failed: bool = False) -> Path:
+           approach_speed: float = 0.3, allow_failed: bool = False, run_folder=None) -> Path:
     """Write ``result``'s reference to ``path`` as ``format`` ("csv", "urscript" or "ros2").
 
     A run that failed (its planner did not finish, or the arm could not follow) is refused unless
@@ -136,9 +137,13 @@ def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_tim
         lookahead_time: servoj's lookahead time [s], in UR's range 0.03-0.2 (URScript only).
         gain: servoj's gain, in UR's range 100-2000 (URScript only).
         approach_speed: the movej to the start configuration, [rad/s] and [rad/s²] (URScript only).
+        run_folder: the exported run's folder, the one run folder ``path`` may be in (its lock held
+            by the caller, as ``drake-traj export`` does); None: no run's or bench's folder.
 
     Returns the path written. Raises :class:`ExportError`, writing nothing, when an option is out
-    of range or the reference is not fit for the format.
+    of range or the reference is not fit for the format; :class:`~drake_traj.output.OutputError`
+    when ``path`` is a symbolic link or in another run's or bench's folder, or does not fit on the
+    disk (:func:`drake_traj.output.write_file`: the file is written whole or not at all).
     """
     if format not in FORMATS:
         raise ExportError(f"--format must be one of {sorted(FORMATS)}, got {format!r}")
@@ -164,11 +169,4 @@ def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_tim
         text = _ros2(result, t, q, qd, qdd, names)
     if result.failure is not None:  # allowed: the first line says so (a comment in all three formats)
         text = f"# FAILED RUN: {' '.join(str(result.failure).split())}\n" + text
-    path = Path(path)
-    if path.is_dir():
-        raise ExportError(f"--out {path} is a folder; give a file name")
-    try:
-        path.write_text(text)
-    except OSError as error:
-        raise ExportError(f"--out {path} cannot be written: {error.strerror}") from None
-    return path
+    return write_file(path, text, own_folder=run_folder)

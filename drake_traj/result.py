@@ -24,7 +24,8 @@ from drake_traj.errors import Cause, DrakeTrajError, Failure, joint_label
 from drake_traj.export import export, reference_trajectory
 from drake_traj.robots import ROBOT_NAMES, get_robot
 from drake_traj.robots.ur10e import pose_error
-from drake_traj.rundir import OutputError, clear_run, create_folder, holds_a_run
+from drake_traj.output import OutputError, check_writable
+from drake_traj.rundir import claim_run_folder
 from drake_traj.validation import invalid, path_argument, positive_scalar, real_array
 
 __all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult",
@@ -88,10 +89,15 @@ _SHAPES = {"t": ("N",), **{name: ("N", "n") for name in ("q_ref", "qd_ref", "qdd
 
 def _output_folder(directory) -> Path:
     """``directory`` (the argument of that name) created if needed, or TypeError/ValueError naming it."""
+    directory = path_argument(directory, "directory", "folder")
     try:
-        return create_folder(path_argument(directory, "directory", "folder"))
+        check_writable(directory)
+        directory.mkdir(parents=True, exist_ok=True)
     except OutputError as error:
         raise OutputError(f"directory: {error}") from None
+    except OSError as error:
+        raise OutputError(f"directory: output folder {directory} cannot be created: {error.strerror}") from None
+    return directory
 
 
 @dataclass(frozen=True)
@@ -341,21 +347,25 @@ class SimulationResult:
     def save(self, directory, *, overwrite: bool = False) -> Path:
         """Write ``result.npz`` (arrays) and ``metrics.json`` into ``directory``; returns it. A folder
         that holds another run is refused (:class:`~drake_traj.rundir.OutputError`) unless
-        ``overwrite``, which first removes that run's files."""
-        directory = _output_folder(directory)
-        if holds_a_run(directory):
-            if not overwrite:
-                raise OutputError(f"{directory} holds another run; save into a new folder, or pass "
-                                  "overwrite=True to replace it")
-            clear_run(directory)
+        ``overwrite``, which replaces that run once the new files are complete on disk
+        (:mod:`drake_traj.output`); so is a bench's folder or one of other files."""
+        directory = path_argument(directory, "directory", "folder")
+        with claim_run_folder(directory, overwrite=overwrite, samples=len(self.t)) as claimed, claimed.replace() as staging:
+            self.write_into(staging)
+        return directory
+
+    def write_into(self, staging) -> None:
+        """Write ``result.npz`` and ``metrics.json`` into ``staging``, the new content of a claimed
+        run folder (:meth:`drake_traj.output.Claim.replace`); :meth:`save` is the way from Python."""
         arrays = {name: getattr(self, name) for name in ARRAY_NAMES + _LIMIT_NAMES + ("goal",)}
         failure = None if self.failure is None else self.failure.to_dict()
         meta = {"name": self.name, "duration": self.duration, "failure": failure, "wall_time": self.wall_time,
                 "joint_types": list(self.joint_types), "robot": self.robot,
                 "waypoint_neighbourhood": self.waypoint_neighbourhood}
-        np.savez_compressed(directory / "result.npz", meta=json.dumps(_json_ready(meta), allow_nan=False), **arrays)
-        (directory / "metrics.json").write_text(json.dumps(self.metrics().to_dict(), indent=2, allow_nan=False))
-        return directory
+        staging.write("result.npz", lambda path: np.savez_compressed(
+            path, meta=json.dumps(_json_ready(meta), allow_nan=False), **arrays))
+        staging.write("metrics.json", lambda path: path.write_text(
+            json.dumps(self.metrics().to_dict(), indent=2, allow_nan=False)))
 
     @classmethod
     def load(cls, directory) -> "SimulationResult":
@@ -515,18 +525,18 @@ class SimulationResult:
             ax.plot_surface(*(centre[:, None, None] + radius * unit), color="tab:orange", alpha=0.15, linewidth=0,
                             label=f"neighbourhood, ϵ = {1e3 * radius:g} mm" if k == 0 else None)
 
+    def figures(self) -> dict[str, Figure]:
+        """The run's figures by file stem: joints, tracking, scaling and tcp_path."""
+        return {"joints": self.joint_figure(), "tracking": self.tracking_figure(), "scaling": self.scaling_figure(),
+                "tcp_path": self.tcp_path_figure()}
+
     def save_figures(self, directory) -> list[Path]:
         """Write joints.png, tracking.png, scaling.png and tcp_path.png into ``directory``
         (created if needed); returns the paths."""
         directory = _output_folder(directory)
         paths = []
-        for stem, make in (
-            ("joints", self.joint_figure),
-            ("tracking", self.tracking_figure),
-            ("scaling", self.scaling_figure),
-            ("tcp_path", self.tcp_path_figure),
-        ):
+        for stem, figure in self.figures().items():
             path = directory / f"{stem}.png"
-            make().savefig(path, dpi=110)
+            figure.savefig(path, dpi=110)
             paths.append(path)
         return paths
