@@ -105,11 +105,13 @@ def check_writable(directory: Path) -> None:
         raise OutputError(f"output folder {directory} cannot be written: {ancestor} is not writable")
 
 
-def check_folder(directory, kind: str, *, overwrite: bool, earlier_files) -> Path:
+def check_folder(directory, kind: str, *, overwrite: bool, earlier_files, options=("--out", "--overwrite")) -> Path:
     """Check ``directory`` before writing a ``kind`` ("run" or "bench") there, creating nothing:
     writable or creatable, not another kind's folder, not holding an earlier ``kind`` unless
     ``overwrite``, not holding files of anything else. ``earlier_files(directory)`` names the
-    files of the earlier ``kind`` there. Raises :class:`OutputError`."""
+    files of the earlier ``kind`` there; ``options`` name the folder and the overwrite option in
+    messages. Raises :class:`OutputError`."""
+    out, replace = options
     directory = Path(directory)
     try:
         check_writable(directory)
@@ -118,12 +120,12 @@ def check_folder(directory, kind: str, *, overwrite: bool, earlier_files) -> Pat
         found = folder_kind(directory)
         if found is not None and found != kind:
             raise OutputError(f"output folder {directory} holds a {found} (its {_sign(directory, found)}); a {kind} "
-                              f"is never written into a {found}'s folder: choose another --out")
+                              f"is never written into a {found}'s folder: choose another {out}")
         owned = set()
         if found == kind:
             if not overwrite:
                 raise OutputError(f"output folder {directory} holds an earlier {kind} (its {_sign(directory, kind)}); "
-                                  f"choose another --out, or pass --overwrite to replace that {kind}")
+                                  f"choose another {out}, or pass {replace} to replace that {kind}")
             owned = set(earlier_files(directory)) | set(FOLDER_KINDS[kind])
         others = sorted(path.name for path in directory.iterdir()
                         if path.name not in owned and not path.name.startswith(_OWN_PREFIX) and path.name != LOCK)
@@ -188,10 +190,11 @@ class _Lock:
 class Claim:
     """A folder claimed for one writer (:func:`claim`); :meth:`replace` writes its new content."""
 
-    def __init__(self, directory: Path, kind: str, overwrite: bool, earlier_files, estimate: int, command: str):
+    def __init__(self, directory: Path, kind: str, overwrite: bool, earlier_files, estimate: int, command: str,
+                 options: tuple[str, str]):
         self.directory, self.kind = directory, kind
-        self._overwrite, self._earlier_files = overwrite, earlier_files
-        check_folder(directory, kind, overwrite=overwrite, earlier_files=earlier_files)
+        self._earlier_files = earlier_files
+        check_folder(directory, kind, overwrite=overwrite, earlier_files=earlier_files, options=options)
         absolute = _absolute(directory)
         self._created = not absolute.exists()
         try:
@@ -203,7 +206,7 @@ class Claim:
         try:
             for leftover in absolute.glob(_OWN_PREFIX + "*"):  # of a writer that died: we hold the lock
                 shutil.rmtree(leftover) if leftover.is_dir() and not leftover.is_symlink() else leftover.unlink()
-            check_folder(directory, kind, overwrite=overwrite, earlier_files=earlier_files)  # now that it is ours
+            check_folder(directory, kind, overwrite=overwrite, earlier_files=earlier_files, options=options)  # now ours
             _check_space(absolute, estimate)
         except BaseException:
             self.release()
@@ -302,14 +305,14 @@ class Staging:
 
 
 def claim(directory, kind: str, *, overwrite: bool = False, earlier_files=lambda directory: [], estimate: int = 0,
-          command: str | None = None) -> Claim:
+          command: str | None = None, options=("--out", "--overwrite")) -> Claim:
     """Claim ``directory`` for a ``kind`` ("run" or "bench") before the work that fills it:
     checked (:func:`check_folder`), created if missing, locked against a second writer, with
     about ``estimate`` bytes free. ``command`` names this process in a refused writer's message
-    (default: its command line). Raises :class:`OutputError`; release with ``with`` or
-    :meth:`Claim.release`."""
+    (default: its command line); ``options`` name the folder and the overwrite option in
+    messages. Raises :class:`OutputError`; release with ``with`` or :meth:`Claim.release`."""
     command = command or " ".join(sys.argv)
-    return Claim(Path(directory), kind, overwrite, earlier_files, estimate, command)
+    return Claim(Path(directory), kind, overwrite, earlier_files, estimate, command, tuple(options))
 
 
 @contextlib.contextmanager

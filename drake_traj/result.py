@@ -350,7 +350,8 @@ class SimulationResult:
         ``overwrite``, which replaces that run once the new files are complete on disk
         (:mod:`drake_traj.output`); so is a bench's folder or one of other files."""
         directory = path_argument(directory, "directory", "folder")
-        with claim_run_folder(directory, overwrite=overwrite, samples=len(self.t)) as claimed, claimed.replace() as staging:
+        with claim_run_folder(directory, overwrite=overwrite, samples=len(self.t), options=("directory", "overwrite=True")) \
+                as claimed, claimed.replace() as staging:
             self.write_into(staging)
         return directory
 

@@ -15,7 +15,7 @@ from pathlib import Path
 from drake_traj.output import OutputError, check_folder, check_writable, claim, write_file
 
 __all__ = ["MANIFEST", "OutputError", "add_to_manifest", "check_output", "check_writable", "claim_run_folder",
-           "estimated_size", "holds_a_run", "run_files", "write_manifest"]
+           "estimated_size", "holds_a_run", "manifest_text", "run_files", "write_manifest"]
 
 MANIFEST = "run.json"
 _RUN_FILES = ("result.npz", "metrics.json")  # a run written before manifests is recognised by these
@@ -45,12 +45,13 @@ def estimated_size(samples: int) -> int:
     return _FIXED_SIZE + _SIZE_PER_SAMPLE * int(samples)
 
 
-def claim_run_folder(directory, *, overwrite: bool = False, samples: int = 0, command: str | None = None):
+def claim_run_folder(directory, *, overwrite: bool = False, samples: int = 0, command: str | None = None,
+                     options=("--out", "--overwrite")):
     """Claim ``directory`` for a run before it starts (:func:`drake_traj.output.claim`): checked
     (:func:`check_output`), locked against a second writer, with room for about ``samples``
     logged samples. Its ``replace()`` writes the run's files and replaces the earlier run."""
     return claim(directory, "run", overwrite=overwrite, earlier_files=_earlier_run, estimate=estimated_size(samples),
-                 command=command)
+                 command=command, options=options)
 
 
 def run_files(directory: Path) -> list[str]:

@@ -613,7 +613,7 @@ def test_overwrite_keeps_the_earlier_run_when_the_new_input_is_bad(tmp_path, cap
 def test_save_refuses_another_runs_folder(saved_run, tmp_path):
     result = SimulationResult.load(saved_run)
     earlier = fake_run(tmp_path / "other")
-    with pytest.raises(OutputError, match=r"holds an earlier run .* pass --overwrite"):
+    with pytest.raises(OutputError, match=r"holds an earlier run .*; choose another directory, or pass overwrite=True"):
         result.save(tmp_path / "other")
     assert folder_state(tmp_path / "other") == earlier
     result.save(tmp_path / "other", overwrite=True)

@@ -224,21 +224,23 @@ def test_a_bench_replaces_an_earlier_bench_with_overwrite(tmp_path, capsys):
     assert len(table) == 1 and "earlier" not in (out / "bench.md").read_text()
 
 
-def test_a_read_only_folder_is_refused_before_the_bench_runs(nothing_runs, tmp_path, capsys):
-    out = tmp_path / "read_only"
-    if not mount_tmpfs(out, "ro,size=64k"):
-        out.chmod(0o555)
-        if os.access(out, os.W_OK):
+@pytest.mark.parametrize("below", ["", "bench"], ids=["the folder", "a folder to create in it"])
+def test_a_read_only_folder_is_refused_before_the_bench_runs(nothing_runs, tmp_path, capsys, below):
+    folder = tmp_path / "read_only"
+    if not mount_tmpfs(folder, "ro,size=64k"):
+        folder.chmod(0o555)
+        if os.access(folder, os.W_OK):
             pytest.skip("cannot make a read-only folder here (root without mount)")
+    out = folder / below
     try:
-        assert cli.main(["bench", "--out", str(out / "bench"), "--count", "0", "--workers", "1"]) == 2
+        assert cli.main(["bench", "--out", str(out), "--count", "0", "--workers", "1"]) == 2
         err = capsys.readouterr().err
-        assert f"--out {out / 'bench'}: output folder {out / 'bench'} cannot be" in err, err
+        assert f"--out {out}: output folder {out} cannot be" in err, err
         assert "read-only file system" in err or "not writable" in err, err
     finally:
-        if os.path.ismount(out):
-            subprocess.run(["umount", str(out)], check=True)
-        out.chmod(0o755)
+        if os.path.ismount(folder):
+            subprocess.run(["umount", str(folder)], check=True)
+        folder.chmod(0o755)
 
 
 def test_a_deleted_working_folder_is_named(nothing_runs, tmp_path, monkeypatch, capsys):
