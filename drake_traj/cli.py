@@ -43,7 +43,7 @@ from drake_traj.export import FORMATS, UR_CYCLE, ExportError
 from drake_traj.meshcat import add_live_view, draw_refusal, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
 from drake_traj.refusal import refusal_figure
 from drake_traj.result import SimulationResult
-from drake_traj.output import WriteError, locked
+from drake_traj.output import WriteError, locked, working_folder
 from drake_traj.rundir import MANIFEST, add_to_manifest, claim_run_folder, run_files, write_manifest
 from drake_traj.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
                                  load_scenario, preflight, scenario_variants, shipped_scenarios)
@@ -389,6 +389,8 @@ def main(argv=None) -> int:
     if on_main_thread:
         previous_sigterm = signal.signal(signal.SIGTERM, terminate)
     try:
+        if args.command in ("run", "export", "bench"):
+            working_folder()  # named when it was deleted, before Drake fails on it
         check_options(args)
         code = args.handler(args)
         return EXIT_TERMINATED if code == EXIT_INTERRUPTED and terminated else code

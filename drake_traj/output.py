@@ -102,7 +102,9 @@ def check_writable(directory: Path) -> None:
     if ancestor.exists() and not ancestor.is_dir():
         raise OutputError(f"output folder {directory} cannot be created: {ancestor} is a file")
     if not os.access(ancestor, os.W_OK | os.X_OK):
-        raise OutputError(f"output folder {directory} cannot be written: {ancestor} is not writable")
+        read_only = os.statvfs(ancestor).f_flag & os.ST_RDONLY
+        raise OutputError(f"output folder {directory} cannot be written: {ancestor} is "
+                          + ("on a read-only file system" if read_only else "not writable (permission denied)"))
 
 
 def check_folder(directory, kind: str, *, overwrite: bool, earlier_files, options=("--out", "--overwrite")) -> Path:
@@ -146,7 +148,7 @@ def _check_space(directory: Path, needed: int) -> None:
     """OutputError when the file system of ``directory`` has less than ``needed`` bytes free."""
     if needed <= 0:
         return
-    free = shutil.disk_usage(directory).free
+    free = shutil.disk_usage(_absolute(directory)).free
     if free < needed:
         raise OutputError(f"not enough space for {directory}: about {needed / MiB:.1f} MiB are needed, "
                           f"{free / MiB:.1f} MiB are free there; free some space or choose another --out")
@@ -158,7 +160,7 @@ class _Lock:
     so a lock left by a dead process is taken over."""
 
     def __init__(self, directory: Path, command: str):
-        path = directory / LOCK
+        path = _absolute(directory) / LOCK
         while True:
             fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
             try:
@@ -199,7 +201,7 @@ class Claim:
         self._created = not absolute.exists()
         try:
             absolute.mkdir(parents=True, exist_ok=True)
-            self._lock = _Lock(absolute, command)
+            self._lock = _Lock(directory, command)
         except OSError as error:
             self._remove_if_created()
             raise OutputError(f"output folder {directory} cannot be written: {_reason(error, directory / LOCK)}") from None
@@ -207,7 +209,7 @@ class Claim:
             for leftover in absolute.glob(_OWN_PREFIX + "*"):  # of a writer that died: we hold the lock
                 shutil.rmtree(leftover) if leftover.is_dir() and not leftover.is_symlink() else leftover.unlink()
             check_folder(directory, kind, overwrite=overwrite, earlier_files=earlier_files, options=options)  # now ours
-            _check_space(absolute, estimate)
+            _check_space(directory, estimate)
         except BaseException:
             self.release()
             raise
@@ -321,7 +323,7 @@ def locked(directory, command: str | None = None):
     for a file written into a run's folder (an export) while no other writer replaces it."""
     directory = Path(directory)
     try:
-        lock = _Lock(_absolute(directory), command or " ".join(sys.argv))
+        lock = _Lock(directory, command or " ".join(sys.argv))
     except OSError as error:
         raise OutputError(f"folder {directory} cannot be written: {_reason(error, directory / LOCK)}") from None
     try:
@@ -351,7 +353,7 @@ def write_file(path, text: str | bytes, *, own_folder=None, what: str = "--out")
     if kind is not None and (own_folder is None or folder.resolve() != _absolute(Path(own_folder)).resolve()):
         raise OutputError(f"{what} {path} is in the folder of a {kind} ({path.parent}); a file is never written "
                           f"into another {kind}'s folder: choose another --out")
-    _check_space(folder, len(data))
+    _check_space(path.parent, len(data))
     temporary = folder / f"{_OWN_PREFIX}{path.name[:100]}-{os.getpid()}.tmp"
     try:
         with _reported(path, f"{'the earlier ' + path.name + ' is intact' if absolute.exists() else 'nothing was written'}"):
