@@ -49,8 +49,10 @@ def nothing_runs(monkeypatch):
 
 @pytest.fixture
 def simulated(monkeypatch, quintic_run_dir):
-    """``drake-traj run`` without its simulation (the quintic run's result instead): the writing alone."""
-    result = SimulationResult.load(quintic_run_dir)
+    """``drake-traj run`` without its simulation (the quintic run's result, its wall time changed,
+    instead): the writing alone."""
+    loaded = SimulationResult.load(quintic_run_dir)
+    result = SimulationResult(**{**vars(loaded), "wall_time": loaded.wall_time + 1.0})  # files unlike the earlier run's
     monkeypatch.setattr(cli, "simulate", lambda *args, **kwargs: result)
 
 
@@ -63,25 +65,25 @@ def mount_tmpfs(folder: Path, options: str) -> bool:
 
 
 @pytest.fixture
-def small_disk(tmp_path, monkeypatch):
-    """A folder on a 64 KiB file system (a tmpfs where mounting works; else os.write raising
-    ENOSPC once 64 KiB were written), without the writer's check of the free space, so that
-    the disk really fills up while writing."""
-    folder = tmp_path / "disk"
-    mounted = mount_tmpfs(folder, "size=64k")
-    if not mounted:
-        written = []
-        real_write = os.write
+def full_disk(tmp_path, monkeypatch):
+    """``full_disk(size)``: a folder on a file system of ``size`` bytes (a tmpfs where mounting
+    works; else every fsync, where the writer makes sure a file is on disk, fails with ENOSPC),
+    without the writer's check of the free space, so that the disk really fills up while writing."""
+    mounts = []
 
-        def write(fd, data):
-            written.append(len(data))
-            if sum(written) > 64 * 1024:
+    def make(size: int) -> Path:
+        folder = tmp_path / f"disk{len(mounts)}"
+        if mount_tmpfs(folder, f"size={size}"):
+            mounts.append(folder)
+        else:
+            def fsync(fd):
                 raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-            return real_write(fd, data)
-        monkeypatch.setattr(os, "write", write)
-    monkeypatch.setattr(output, "_check_space", lambda directory, needed: None)
-    yield folder
-    if mounted:
+            monkeypatch.setattr(os, "fsync", fsync)
+        monkeypatch.setattr(output, "_check_space", lambda directory, needed: None)
+        return folder
+
+    yield make
+    for folder in mounts:
         subprocess.run(["umount", str(folder)], check=True)
 
 
@@ -157,7 +159,19 @@ def test_a_run_that_cannot_fit_is_refused_before_it_starts(nothing_runs, tmp_pat
     assert not out.exists()
 
 
-def test_an_export_cut_short_by_a_full_disk_leaves_the_earlier_file(quintic_run_dir, small_disk, capsys):
+def test_a_full_disk_while_writing_a_run_keeps_the_earlier_run_on_a_real_disk(simulated, quintic_run_dir, full_disk,
+                                                                              capsys):
+    out = full_disk(8 * 2**20) / "run"  # the earlier run takes 5.2 MB of the 8 MiB, the new one would too
+    earlier = copy_run(quintic_run_dir, out)
+    assert cli.main(["run", "quintic_ptp", "--out", str(out), "--overwrite"]) == cli.EXIT_RUN_FAILED
+    err = capsys.readouterr().err
+    assert re.search(rf"no space left on device while writing {out}/[a-z_]+\.(npz|json|png|html); nothing was written: "
+                     rf"the earlier run in {out} is intact", err), err
+    assert state(out) == earlier
+
+
+def test_an_export_cut_short_by_a_full_disk_leaves_the_earlier_file(quintic_run_dir, full_disk, capsys):
+    small_disk = full_disk(64 * 1024)
     out = small_disk / "reference.csv"
     out.write_text("the earlier export\n")
     assert cli.main(["export", str(quintic_run_dir), "--format", "csv", "--out", str(out), "--overwrite"]) == 1
