@@ -5,7 +5,8 @@ check finds on seeded random tasks.
 
 1. The check's cost (``CellChecker.check_planner``: the start, the joint ranges, the sampled
    configurations) per 5 s of planned motion, beside the planning itself (the planner's
-   preflight and ``plan()``), on the shipped UR10e scenarios, median of ``--repeats``.
+   preflight and ``plan()``) and as a fraction of the closed-loop run that follows it (wall
+   times measured in turn), on the shipped UR10e scenarios, median of ``--repeats``.
 2. The closed loop with 10 obstacles (boxes and cylinders around the table's edge, clear of the
    arm) against the default cell, on ``quintic_ptp``: wall-time ratio of runs made in turn.
 3. Seeded random Pająk 2024 tasks (a joint-space walk of 1-4 waypoints from the paper's q(0), up
@@ -36,12 +37,13 @@ UR10E_SCENARIOS = ("pajak_sim3", "quintic_ptp", "boryga_loop_ur10e", "li_closed_
 
 
 def check_cost(repeats: int) -> None:
-    print("| scenario | motion [s] | samples | check [s] | per 5 s of motion [s] | preflight + plan [s] |")
-    print("|---|---|---|---|---|---|")
+    print("| scenario | motion [s] | samples | check [s] | per 5 s of motion [s] | preflight + plan [s] | "
+          "check / closed-loop run |")
+    print("|---|---|---|---|---|---|---|")
     for name in UR10E_SCENARIOS:
         scenario = load_scenario(name if name != "fixture_cell" else "diagrams/fixture_cell.yaml")
         checker = scenario.cell_checker()
-        checks, plans = [], []
+        checks, plans, ratios = [], [], []
         for _ in range(repeats):
             planner = make_planner(scenario)
             start = time.perf_counter()
@@ -51,10 +53,13 @@ def check_cost(repeats: int) -> None:
             start = time.perf_counter()
             result = checker.check_planner(planner)
             checks.append(time.perf_counter() - start)
+            run = simulate(scenario, preflight=False)
+            assert run.succeeded, run.failure
+            ratios.append(checks[-1] / run.wall_time)
         duration = planner.plan().end_time()
         check = statistics.median(checks)
         print(f"| {name} | {duration:.2f} | {len(result.times)} | {check:.3f} | {check / duration * 5:.3f} | "
-              f"{statistics.median(plans):.3f} |")
+              f"{statistics.median(plans):.3f} | {statistics.median(ratios):.3f} |")
 
 
 def ten_obstacles() -> list:

@@ -13,6 +13,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from drake_traj.robots import task_space
 from drake_traj.robots import ur10e as robot
 from drake_traj.planners import pajak as P
 
@@ -73,7 +74,7 @@ def test_closed_form_kinematics_match_robot_module():
         pose_ref = robot.task_pose(q[k])
         pose, jac, bias, cos_pitch, _ = robot.ur10e_kinematics(q[k], qd[k])  # single (float) path
         for p, j, b in ((pose, jac, bias), (pose_b[k], jac_b[k], bias_b[k])):
-            np.testing.assert_allclose(robot.task_pose_error(p, pose_ref), 0.0, atol=1e-12)
+            np.testing.assert_allclose(task_space.task_pose_error(p, pose_ref), 0.0, atol=1e-12)
             np.testing.assert_allclose(j, jac_ref, atol=1e-9, rtol=1e-9)
             np.testing.assert_allclose(b, bias_ref, atol=1e-9, rtol=1e-9)
         assert cos_pitch == pytest.approx(np.cos(pose_ref[4]), abs=1e-12)

@@ -14,6 +14,7 @@ import pytest
 
 from drake_traj.planners import pajak as P
 from drake_traj.planners.pajak.kernel import Discrete
+from drake_traj.robots import task_space
 from drake_traj.robots import ur10e as robot
 
 Q0 = P.paper_initial_configuration()
@@ -144,7 +145,7 @@ def test_jerk_budget_keeps_qdd_continuous(random_runs, index, cause):
         goal = task.waypoints[-1]
         closing = []
         for q, qd in zip(result["q"], result["qd"]):
-            error_now = robot.task_pose_error(robot.task_pose(q), goal)
+            error_now = task_space.task_pose_error(robot.task_pose(q), goal)
             closing.append(P.approach_rate(error_now, robot.analytic_jacobian(q) @ qd, 1e-4 * task.accuracy))
         final = result["waypoint"] == len(task.waypoints) - 1
         assert np.any(final & (d[:, Discrete.APPROACH] > np.array(closing) + 1.0))

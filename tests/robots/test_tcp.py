@@ -14,6 +14,7 @@ from pydrake.multibody.tree import FixedOffsetFrame, JacobianWrtVariable
 
 from drake_traj.errors import DrakeTrajError
 from drake_traj.robots import LI_4DOF, UR10E
+from drake_traj.robots import task_space
 from drake_traj.robots import ur10e as robot
 from drake_traj.robots.boryga_robots import AnthropomorphicArm, ScaraArm
 
@@ -69,7 +70,7 @@ def test_tcp_kinematics_match_multibody_plant(plant_with_tcps):
             translational = plant.CalcJacobianTranslationalVelocity(context, JacobianWrtVariable.kV, frames[k],
                                                                      np.zeros(3), world, world)
             # Euler rows: ω = B(φ_T) φ̇, B of the TCP's angles
-            rate_matrix = robot.euler_rate_matrix(pose[3:])
+            rate_matrix = task_space.euler_rate_matrix(pose[3:])
             drake_bias = plant.CalcBiasTranslationalAcceleration(context, JacobianWrtVariable.kV, frames[k],
                                                                  np.zeros(3), world, world)
             worst["pose"] = max(worst["pose"], np.max(np.abs(pose[:3] - transform.translation())))
@@ -93,8 +94,8 @@ def test_euler_bias_of_the_tcp_matches_finite_differences():
             if cos_pitch < 0.1:
                 continue
             ahead, behind = robot.task_pose(q + h * qd, tcp), robot.task_pose(q - h * qd, tcp)
-            second = (robot.task_pose_error(ahead, pose) + robot.task_pose_error(behind, pose)) / h**2
-            first = robot.task_pose_error(ahead, behind) / (2 * h)
+            second = (task_space.task_pose_error(ahead, pose) + task_space.task_pose_error(behind, pose)) / h**2
+            first = task_space.task_pose_error(ahead, behind) / (2 * h)
             np.testing.assert_allclose(jacobian @ qd, first, rtol=0, atol=1e-5)
             np.testing.assert_allclose(bias, second, rtol=0, atol=2e-4)
 

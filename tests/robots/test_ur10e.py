@@ -10,6 +10,7 @@ from pydrake.math import RollPitchYaw
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable
 
+from drake_traj.robots import task_space
 from drake_traj.robots import ur10e as robot
 from drake_traj.robots import UR10E
 
@@ -36,7 +37,7 @@ def test_k_of_seed_000_start_is_p0():
     pose = robot.task_pose(Q0)
     np.testing.assert_allclose(pose[:3], [-0.17415, -0.52400, 0.27270], atol=5e-6)
     np.testing.assert_allclose(pose[:3], [-0.174, -0.524, 0.273], atol=5e-4)
-    np.testing.assert_allclose(robot.task_pose_error(pose, [0, 0, 0, np.pi, 0, 3 * np.pi / 4])[3:], 0, atol=1e-12)
+    np.testing.assert_allclose(task_space.task_pose_error(pose, [0, 0, 0, np.pi, 0, 3 * np.pi / 4])[3:], 0, atol=1e-12)
 
 
 def test_euler_angles_match_drake_roll_pitch_yaw():
@@ -78,14 +79,14 @@ def test_analytic_jacobian_and_bias_match_finite_differences():
     for q, qd in zip(*random_configurations(100, seed=2)):
         jacobian, jdot_qd = robot.analytic_jacobian_and_bias(q, qd)
         numeric = np.column_stack(
-            [robot.task_pose_error(robot.task_pose(q + step * e), robot.task_pose(q - step * e)) / (2 * step) for e in np.eye(6)]
+            [task_space.task_pose_error(robot.task_pose(q + step * e), robot.task_pose(q - step * e)) / (2 * step) for e in np.eye(6)]
         )
         np.testing.assert_allclose(jacobian, numeric, atol=2e-8)
         # Along q(t) = q + t qd (so qdd = 0), d^2 k/dt^2 = dJ/dt qd.
         h = 1e-4
         centre = robot.task_pose(q)
-        second = (robot.task_pose_error(robot.task_pose(q + h * qd), centre)
-                  + robot.task_pose_error(robot.task_pose(q - h * qd), centre)) / h**2
+        second = (task_space.task_pose_error(robot.task_pose(q + h * qd), centre)
+                  + task_space.task_pose_error(robot.task_pose(q - h * qd), centre)) / h**2
         np.testing.assert_allclose(jdot_qd, second, atol=2e-5 * max(1.0, np.abs(jdot_qd).max()))
 
 
@@ -103,8 +104,8 @@ def test_angular_bias_matches_multibody_plant_through_euler_rates(plant_and_cont
         jacobian, jdot_qd = robot.analytic_jacobian_and_bias(q, qd)
         phi = robot.task_pose(q)[3:]
         phi_dot = jacobian[3:] @ qd
-        b_dot = (robot.euler_rate_matrix(phi + h * phi_dot) - robot.euler_rate_matrix(phi - h * phi_dot)) / (2 * h)
-        np.testing.assert_allclose(robot.euler_rate_matrix(phi) @ jdot_qd[3:] + b_dot @ phi_dot, alpha, atol=1e-7)
+        b_dot = (task_space.euler_rate_matrix(phi + h * phi_dot) - task_space.euler_rate_matrix(phi - h * phi_dot)) / (2 * h)
+        np.testing.assert_allclose(task_space.euler_rate_matrix(phi) @ jdot_qd[3:] + b_dot @ phi_dot, alpha, atol=1e-7)
 
 
 def test_gimbal_lock_raises_a_clear_error():
