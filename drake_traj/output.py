@@ -11,7 +11,7 @@ checked (writable, not another run's or bench's folder, free space roughly enoug
 lock file, ``.drake-traj.lock``, that refuses a second writer and names it (pid and command). A
 lock whose process has died is taken over. Files named ``.drake-traj-*`` are the writer's own
 (the lock, staging folders, temporary files); a crash may leave them, and the next claim removes
-them. Symbolic links are never followed out of a folder: a file path that is a link is refused.
+them, except earlier content set aside by a replacement cut short, which it names instead. Symbolic links are never followed out of a folder: a file path that is a link is refused.
 """
 
 from __future__ import annotations
@@ -189,6 +189,22 @@ class _Lock:
             self._fd = None
 
 
+def _clear_leftovers(directory: Path, absolute: Path) -> None:
+    """Remove what a writer that died left in the folder (the caller holds its lock): staging
+    folders, temporary files, and the earlier content it set aside once its new content was all
+    in place. Content set aside by a replacement cut short while moving in (its staging folder
+    not empty) is left for the user, and named (OutputError): which files are whose is unknown."""
+    for aside in absolute.glob(f"{_OWN_PREFIX}replaced-*"):
+        staging = absolute / aside.name.replace("replaced-", "staging-", 1)
+        if staging.is_dir() and not staging.is_symlink() and any(staging.iterdir()):
+            raise OutputError(f"output folder {directory}: a writer that died (pid {aside.name.rsplit('-', 1)[-1]}) "
+                              f"was replacing its content: the earlier files are in {directory / aside.name}, the new "
+                              f"ones not yet moved in are in {directory / staging.name}; put back what you want to keep "
+                              "and remove those two folders")
+    for leftover in absolute.glob(_OWN_PREFIX + "*"):
+        shutil.rmtree(leftover) if leftover.is_dir() and not leftover.is_symlink() else leftover.unlink()
+
+
 class Claim:
     """A folder claimed for one writer (:func:`claim`); :meth:`replace` writes its new content."""
 
@@ -206,8 +222,7 @@ class Claim:
             self._remove_if_created()
             raise OutputError(f"output folder {directory} cannot be written: {_reason(error, directory / LOCK)}") from None
         try:
-            for leftover in absolute.glob(_OWN_PREFIX + "*"):  # of a writer that died: we hold the lock
-                shutil.rmtree(leftover) if leftover.is_dir() and not leftover.is_symlink() else leftover.unlink()
+            _clear_leftovers(directory, absolute)
             check_folder(directory, kind, overwrite=overwrite, earlier_files=earlier_files, options=options)  # now ours
             _check_space(directory, estimate)
         except BaseException:

@@ -130,6 +130,19 @@ def test_a_lock_left_by_a_dead_process_is_taken_over(tmp_path):
         assert (out / output.LOCK).read_text().startswith(f"pid {os.getpid()}: the next one")
         assert not (out / ".drake-traj-staging-99999").exists()
     assert list(out.iterdir()) == []  # the lock goes with its holder
+    # a writer that died while moving its new files in: the earlier ones it had set aside are kept
+    (out / ".drake-traj-replaced-99999").mkdir()
+    (out / ".drake-traj-replaced-99999" / "result.npz").write_bytes(b"the earlier run")
+    (out / ".drake-traj-staging-99999").mkdir()
+    (out / ".drake-traj-staging-99999" / "metrics.json").write_bytes(b"the new run")
+    cut_short = state(out)
+    with pytest.raises(output.OutputError, match=rf"a writer that died \(pid 99999\) was replacing its content: the "
+                                                 rf"earlier files are in {out}/.drake-traj-replaced-99999"):
+        output.claim(out, "run", overwrite=True)
+    assert state(out) == cut_short
+    (out / ".drake-traj-staging-99999" / "metrics.json").unlink()  # all moved in: what was set aside goes
+    with output.claim(out, "run", overwrite=True):
+        assert list(out.iterdir()) == [out / output.LOCK]
     with output.claim(tmp_path / "new", "run"):
         assert (tmp_path / "new").is_dir()
     assert not (tmp_path / "new").exists()  # created by the claim, nothing written: removed
