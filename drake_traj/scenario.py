@@ -157,7 +157,7 @@ class Scenario:
         plant: Drake's ``MultibodyPlantConfig`` of the robot plant (default: discrete at 1 ms,
             SAP); ``plant: {time_step: 0.002}`` runs at the UR controller's 500 Hz.
         simulator: Drake's ``SimulatorConfig`` (integration scheme, step, accuracy, real-time
-            rate: 0, as fast as it goes, or 0.1-10; default fixed-step RK2 at 1 ms, see
+            rate: 0, as fast as it goes, or 0.1-1000; default fixed-step RK2 at 1 ms, see
             ``station.default_simulator_config``).
         log_period: the loggers' period [s], a whole multiple of ``plant.time_step``; 0 (the
             default): the plant's time step.
