@@ -38,7 +38,7 @@ from drake_traj.planners import make_planner as make_planner_from_config
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE
 from drake_traj.robots import Robot, get_robot
 from drake_traj.validation import (MAX_RUN_DURATION, flag, instance_of, invalid, log_period_check, path_argument,
-                                   real_array, realtime_rate, run_duration, settle_duration)
+                                   real_array, realtime_rate, run_duration, settle_duration, step_size)
 from drake_traj.yaml_schema import ScenarioError, checked_document, locate
 
 __all__ = [
@@ -229,6 +229,8 @@ class Scenario:
                 raise invalid(label, f"{label} must be a finite, positive number of {unit}, got {value}")
         run_duration(self.max_duration)
         settle_duration(self.settle_time)
+        step_size(self.plant.time_step, "plant.time_step")
+        step_size(self.simulator.max_step_size, "simulator.max_step_size")
         realtime_rate(self.simulator.target_realtime_rate, "simulator.target_realtime_rate")
         for label, value, largest in (("plant.time_step", self.plant.time_step, MAX_TIME_STEP),
                                       ("log_period", self.logging_period(), MAX_LOG_PERIOD)):

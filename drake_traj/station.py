@@ -52,7 +52,7 @@ from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, check
                                  default_simulator_config)
 from drake_traj.scenario import preflight as scenario_preflight
 from drake_traj.validation import (callable_or_none, flag, instance_of, invalid, log_period_check, positive_scalar,
-                                   real_scalar, realtime_rate, run_duration, settle_duration)
+                                   real_scalar, realtime_rate, run_duration, settle_duration, step_size)
 
 __all__ = [
     "Station", "add_speed_override", "add_station", "build_station", "make_station", "run_station", "simulate",
@@ -159,7 +159,7 @@ def add_station(
     n = robot.num_joints
     if planner.num_joints != n:
         raise invalid("robot", f"the planner has {planner.num_joints} joints, robot {robot.name} has {n}")
-    time_step = positive_scalar(plant_config.time_step, "plant.time_step", "s")
+    time_step = step_size(plant_config.time_step, "plant.time_step")
     log_period = positive_scalar(log_period, "log_period", "s")
     log_period_check(log_period, time_step)
 
@@ -462,6 +462,7 @@ def simulate(
         instance_of(meshcat, Meshcat, "meshcat")
     if simulator_config is not None:
         realtime_rate(simulator_config.target_realtime_rate, "simulator_config.target_realtime_rate")
+        step_size(simulator_config.max_step_size, "simulator_config.max_step_size")
     run_duration(max_duration)
     settle_duration(settle_time)
     if tracking_tolerance is not None:

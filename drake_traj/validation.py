@@ -102,6 +102,7 @@ def nonnegative_scalar(value, name: str, unit: str) -> float:
 # its log (1 ms samples by default, about 0.3 kB each) fits in memory.
 MAX_RUN_DURATION = 600.0  # [s] max_duration, and the preflight's horizon: 10 minutes of simulated motion
 MAX_SETTLE_TIME = 60.0  # [s] settle_time, the run after the planner finishes
+MIN_STEP = 1e-5  # [s] plant.time_step, simulator.max_step_size, a planner's update period: 100 kHz at most
 REALTIME_RATES = (0.1, 1000.0)  # a live run's pace (--rate, simulator.target_realtime_rate; 0: as fast as it goes)
 
 
@@ -119,6 +120,16 @@ def settle_duration(value, name: str = "settle_time") -> float:
     value = nonnegative_scalar(value, name, "s")
     if value > MAX_SETTLE_TIME:
         raise invalid(name, f"{name} must be at most {MAX_SETTLE_TIME:g} s after the planner finishes, got {value:g} s")
+    return value
+
+
+def step_size(value, name: str) -> float:
+    """A simulation step or update period [s]: finite and at least :data:`MIN_STEP` (a finer
+    one would take hours for a run of seconds)."""
+    value = positive_scalar(value, name, "s")
+    if value < MIN_STEP:
+        raise invalid(name, f"{name} must be at least {MIN_STEP:g} s (a finer step would take hours to simulate a "
+                            f"run of seconds), got {value:g} s")
     return value
 
 

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from pydrake.systems.analysis import Simulator
+from pydrake.multibody.plant import MultibodyPlantConfig
+from pydrake.systems.analysis import Simulator, SimulatorConfig
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from drake_traj import Cause, DrakeTrajError, PlanningError, SimulationResult, cli, load_scenario, make_planner, simulate
@@ -125,6 +126,9 @@ def test_a_scheduler_that_is_not_dask_is_refused_in_time(kind, pattern, listener
 
 @pytest.mark.parametrize("old, new, pattern", [
     ("settle_time: 0.5", "settle_time: 0.5\nmax_duration: 1.0e9", r"line 21, column 15: max_duration must be at most 600 s"),
+    ("  time_step: 0.001", "  time_step: 1.0e-9", r"line 19, column 14: plant.time_step must be at least 1e-05 s"),
+    ("settle_time: 0.5", "settle_time: 0.5\nsimulator:\n  max_step_size: 1.0e-9",
+     r"line 22, column 18: simulator.max_step_size must be at least 1e-05 s"),
     ("settle_time: 0.5", "settle_time: 1.0e5", r"line 20, column 14: settle_time must be at most 60 s after the planner finishes"),
     ("settle_time: 0.5", "settle_time: 0.5\nsimulator:\n  target_realtime_rate: 1.0e-9",
      r"line 22, column 25: simulator.target_realtime_rate must be 0 \(as fast as it goes\) or from 0.1 to 1000 times"),
@@ -134,7 +138,7 @@ def test_run_times_and_pace_out_of_range_are_located(old, new, pattern, tmp_path
     path.write_text(quintic(old, new))
     with pytest.raises(ScenarioError, match=re.escape(str(path)) + ", " + pattern) as info:
         load_scenario(path)
-    assert info.value.field[0] in ("max_duration", "settle_time", "simulator")
+    assert info.value.field[0] in ("max_duration", "settle_time", "simulator", "plant")
 
 
 def test_the_stated_ranges_are_accepted_at_their_ends(tmp_path):
@@ -156,6 +160,10 @@ def test_live_rate_out_of_range_is_refused_before_anything(rate, shown, tmp_path
 @pytest.mark.parametrize("arguments, pattern", [
     (dict(settle_time=1e5, max_duration=1e9), r"max_duration must be at most 600 s"),
     (dict(settle_time=1e5), r"settle_time must be at most 60 s"),
+    (dict(simulator_config=SimulatorConfig(target_realtime_rate=1e-9)),
+     r"simulator_config.target_realtime_rate must be 0 \(as fast as it goes\) or from 0.1"),
+    (dict(simulator_config=SimulatorConfig(max_step_size=1e-9)), r"simulator_config.max_step_size must be at least 1e-05 s"),
+    (dict(plant_config=MultibodyPlantConfig(time_step=1e-9)), r"plant.time_step must be at least 1e-05 s"),
 ])
 def test_simulate_refuses_times_out_of_range(arguments, pattern):
     with pytest.raises(DrakeTrajError, match=pattern):
@@ -211,6 +219,12 @@ def test_a_task_longer_than_max_duration_is_refused_at_max_duration(tmp_path):
     # from Python, simulate looks as far ahead as the max_duration given
     with pytest.raises(PlanningError, match=r"did not finish within 20 s, the preflight's horizon"):
         simulate(scenario, max_duration=20.0)
+
+
+def test_an_update_period_finer_than_the_stated_step_is_refused(tmp_path, capsys):
+    path = slow_pajak(tmp_path, 30.0, update_period=1.0e-9)
+    code = cli.main(["run", str(path), "--variant", "sim3", "--no-preflight", "--out", str(tmp_path / "run")])
+    clean_refusal(code, capsys, r"line 31, column 18: planner.update_period must be at least 1e-05 s")
 
 
 def test_a_preflight_of_too_many_steps_names_the_update_period(tmp_path, capsys):
