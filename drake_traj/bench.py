@@ -35,6 +35,8 @@ raises, or whose worker dies, is a row with ``succeeded`` false, NaN metrics and
 ``failure``, never a lost task.
 """
 
+import asyncio
+import concurrent.futures
 import contextlib
 import csv
 import functools
@@ -50,6 +52,7 @@ from pathlib import Path
 
 import numpy as np
 from distributed import Client, LocalCluster, as_completed
+from distributed.comm import connect as dask_connect
 from tqdm import tqdm
 
 from drake_traj.clearance import CellChecker
@@ -360,16 +363,40 @@ def _default_workers() -> int:
         return os.cpu_count() or 1
 
 
+async def _dask_handshake(address: str, timeout: float) -> None:
+    """Open a Dask connection to ``address`` and close it; raises unless a Dask peer answers
+    Dask's handshake within ``timeout`` [s] (Dask's own connect waits for the handshake without
+    a time limit: a listener that is not Dask would hold it forever)."""
+    # Dask retries a refused connection for 0.8 of the time, so that a refusal is told from silence
+    comm = await asyncio.wait_for(dask_connect(address, timeout=0.8 * timeout), timeout)
+    await comm.close()
+
+
 def _connect(scheduler: str) -> Client:
-    """A client of the Dask scheduler at ``scheduler`` whose workers have our drake_traj."""
+    """A client of the Dask scheduler at ``scheduler`` whose workers have our drake_traj; a
+    BenchSetupError naming the address within :data:`SCHEDULER_TIMEOUT` otherwise."""
+    advice = ("Give the address a running scheduler prints (e.g. tcp://host:8786), or leave --scheduler out to run "
+              "on this machine.")
+    try:  # in a thread of its own: bench may be called where an event loop runs (a notebook)
+        with concurrent.futures.ThreadPoolExecutor(1) as pool:
+            pool.submit(asyncio.run, _dask_handshake(scheduler, SCHEDULER_TIMEOUT)).result()
+    except (asyncio.TimeoutError, TimeoutError):
+        raise BenchSetupError(f"--scheduler {scheduler}: something accepts connections there but did not answer as a "
+                              f"Dask scheduler within {SCHEDULER_TIMEOUT:g} s. {advice}") from None
+    except OSError as error:  # refused (Dask retries until the timeout), unreachable, closed at once
+        raise BenchSetupError(f"--scheduler {scheduler}: no Dask scheduler answered there ({_reason(error)}; "
+                              f"waited at most {SCHEDULER_TIMEOUT:g} s). {advice}") from None
+    except ValueError as error:  # a malformed address
+        raise BenchSetupError(f"--scheduler {scheduler}: not an address Dask can connect to ({_reason(error)}). "
+                              f"{advice}") from None
+    except Exception as error:  # e.g. MemoryError: a peer's bytes read as a Dask message length
+        raise BenchSetupError(f"--scheduler {scheduler}: what answers there does not speak Dask's protocol (reading "
+                              f"its reply as Dask's gave {type(error).__name__}). {advice}") from None
     try:
-        client = Client(scheduler)
-    except Exception as error:  # OSError (unreachable, timed out), ValueError (malformed), ...
-        raise BenchSetupError(
-            f"--scheduler {scheduler}: cannot reach a Dask scheduler at that address ({_reason(error)}). "
-            "Give the address a running scheduler prints (e.g. tcp://host:8786), or leave --scheduler out "
-            "to run on this machine; the connect timeout is Dask's distributed.comm.timeouts.connect."
-        ) from None
+        client = Client(scheduler, timeout=SCHEDULER_TIMEOUT)
+    except Exception as error:  # a Dask peer that is not a scheduler (a worker), ...
+        raise BenchSetupError(f"--scheduler {scheduler}: cannot connect to a Dask scheduler there ({_reason(error)}). "
+                              f"{advice}") from None
     ours = importlib.metadata.version("drake_traj")
     try:
         theirs = set(client.run(importlib.metadata.version, "drake_traj").values())
@@ -412,18 +439,20 @@ def _engine(workers, scheduler):
 
 
 MAX_COUNT = 10_000  # seeded tasks per bench: each costs about 10 s of one core here (all planners)
+SCHEDULER_TIMEOUT = 10.0  # [s] a --scheduler address answers as a Dask scheduler within this, or is refused
 
 
 def _check_arguments(count, seed, repeats, workers, scheduler, planners, extra_planners) -> None:
-    def whole(value, name, option, least, most=2**32 - 1):
+    def whole(value, name, option, least, most=2**32 - 1, why=""):
         if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not least <= value <= most:
-            raise BenchSetupError(f"{name} ({option}) must be a whole number from {least} to {most}, got {value!r}")
+            raise BenchSetupError(f"{name} ({option}) must be a whole number from {least} to {most}{why}, got {value!r}")
 
     whole(count, "count", "--count", 0, MAX_COUNT)
     whole(seed, "seed", "--seed", 0)
     whole(repeats, "repeats", "--repeats", 1, 1000)
     if workers is not None:
-        whole(workers, "workers", "--workers", 1)
+        whole(workers, "workers", "--workers", 1, _default_workers(),
+              " (this machine's cores, a process each; for more, a Dask cluster: --scheduler)")
         if scheduler is not None:
             raise BenchSetupError(
                 f"workers (--workers {workers}) sizes the local cluster; with --scheduler {scheduler} the runs go "
@@ -472,11 +501,14 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers:
         count: seeded random tasks besides the paper task (>= 0).
         seed: seed of the random tasks (>= 0).
         repeats: planning-time repeats on the paper task (>= 1).
-        workers: processes of the local Dask cluster (>= 1; default one per core); 1 runs every
-            unit in this process, in order, without Dask. The cluster's processes are spawned and
-            import the main module: from a script, call ``bench`` under ``if __name__ == "__main__":``.
+        workers: processes of the local Dask cluster (1 to the machine's cores; default one per
+            core); 1 runs every unit in this process, in order, without Dask. The cluster's
+            processes are spawned and import the main module: from a script, call ``bench`` under
+            ``if __name__ == "__main__":``.
         scheduler: address of an existing Dask scheduler (e.g. ``tcp://host:8786``) to run the
-            units on instead of a local cluster; its workers need the same drake_traj.
+            units on instead of a local cluster; its workers need the same drake_traj. An address
+            that does not answer as a Dask scheduler within :data:`SCHEDULER_TIMEOUT` (10 s) is
+            refused.
         planners: the names of :data:`PLANNERS` to run (toppra needs pajak_blend).
         extra_planners: more planners to run on every task: name -> ``build(poses, joints)``
             returning a planner config (poses (m, 6) [m, rad], joint waypoints (m + 1, 6)

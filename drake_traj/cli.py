@@ -48,6 +48,7 @@ from drake_traj.rundir import MANIFEST, add_to_manifest, claim_run_folder, run_f
 from drake_traj.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
                                  load_scenario, preflight, scenario_variants, shipped_scenarios)
 from drake_traj.station import simulate
+from drake_traj.validation import REALTIME_RATES
 
 EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_TERMINATED = 0, 1, 2, 130, 143
 # [s] how long the live view's recording stays served after the run when no terminal is attached
@@ -137,11 +138,11 @@ def run(args) -> int:
         add_systems = before_run = None
         if args.meshcat:
             arguments["simulator_config"].target_realtime_rate = args.rate
-            arguments["speed_override"] = None  # the live view's slider drives it
+            profile = arguments.pop("speed_override")  # the live view's slider scales it
             print(f"Meshcat: {meshcat.web_url()}", file=sys.stderr, flush=True)
 
             def add_systems(builder, station):
-                add_live_view(builder, station, meshcat, arguments["robot"])
+                add_live_view(builder, station, meshcat, arguments["robot"], speed_override=profile)
 
             def before_run(simulator):
                 if args.wait:
@@ -291,7 +292,8 @@ def check_options(args) -> None:
     checks = []
     if args.command == "run":
         checks = [("--port", args.port is None or 1 <= args.port <= 65535, args.port, "a port number 1-65535"),
-                  ("--rate", np.isfinite(args.rate) and args.rate > 0, args.rate, "a positive real-time rate"),
+                  ("--rate", REALTIME_RATES[0] <= args.rate <= REALTIME_RATES[1], args.rate,
+                   "a positive real-time rate from {:g} to {:g}".format(*REALTIME_RATES)),
                   ("--wait-timeout", np.isfinite(args.wait_timeout) and args.wait_timeout >= 0, args.wait_timeout,
                    "a number of seconds >= 0"),
                   ("--serve-after", args.serve_after is None or (np.isfinite(args.serve_after) and args.serve_after >= 0),
@@ -330,7 +332,8 @@ def build_parser() -> argparse.ArgumentParser:
     live = run_parser.add_argument_group("live view")
     live.add_argument("--meshcat", action="store_true", help="show the run live in Meshcat, in real time")
     live.add_argument("--port", type=int, default=None, help="Meshcat's port (default: the first free from 7000)")
-    live.add_argument("--rate", type=float, default=1.0, help="real-time rate of the live run (default 1)")
+    live.add_argument("--rate", type=float, default=1.0,
+                      help="real-time rate of the live run, {:g}-{:g} (default 1)".format(*REALTIME_RATES))
     live.add_argument("--no-wait", dest="wait", action="store_false", help="start the motion without waiting for a browser")
     live.add_argument("--wait-timeout", type=float, default=60.0, help="how long to wait for a browser [s] (default 60)")
     live.add_argument("--serve-after", type=float, default=None, metavar="S",

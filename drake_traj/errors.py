@@ -40,6 +40,7 @@ class Cause(str, enum.Enum):
     PLANNING = "planning"  # the planner could not complete the task for another reason
     NON_FINITE = "non-finite"  # NaN or an infinity in the law or the log
     TIMEOUT = "timeout"  # not finished within the run's or the preflight's time
+    NOT_RUN = "not run"  # a result of a station that has not run (less than one log period logged)
     INTERRUPTED = "interrupted"  # Ctrl-C or SIGTERM
     SATURATION = "saturation"  # a joint's torque reached its effort limit
     TRACKING = "tracking"  # the arm strayed further than the tolerance from the reference
@@ -146,7 +147,8 @@ class Failure:
 
     Attributes:
         cause: a :class:`Cause`: a :class:`PlanningError`'s (STALL, SINGULAR, ...), TIMEOUT
-            (``max_duration`` reached), INTERRUPTED, SATURATION, TRACKING, NON_FINITE, or ERROR
+            (``max_duration`` reached, or a log that ends before the planner finished), NOT_RUN
+            (a station that has not run), INTERRUPTED, SATURATION, TRACKING, NON_FINITE, or ERROR
             (any other exception).
         message: the human-readable reason (for an exception: its type, time and text).
         time: simulation time of the failure [s], if known.

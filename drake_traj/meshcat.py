@@ -8,7 +8,9 @@ measured TCP path of a finished run, red) and ``/drake_traj/refusal`` (a refused
 every collision shape, the two bodies in red, their closest points joined).
 """
 
+import errno
 import logging
+import socket
 import time
 from pathlib import Path
 
@@ -18,7 +20,10 @@ from pydrake.math import RigidTransform
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from drake_traj.clearance import CellChecker, CollisionError
+from drake_traj.errors import DrakeTrajError
 from drake_traj.robots import Robot
+from drake_traj.scenario import SpeedOverride
+from drake_traj.validation import instance_of
 
 __all__ = [
     "SPEED_SLIDER", "SpeedSlider", "TcpTrail", "add_live_view", "draw_refusal", "draw_task", "draw_tcp_path", "export_html", "frame_task",
@@ -54,15 +59,37 @@ def draw_refusal(meshcat: Meshcat, checker: CellChecker, error: CollisionError) 
 
 def start_meshcat(port: int | None = None, *, announce: bool = True) -> Meshcat:
     """A Meshcat server (on ``port``, or the first free one from 7000). Drake announces its URL on
-    the console; ``announce=False`` keeps it quiet (a server used only to write a recording)."""
+    the console; ``announce=False`` keeps it quiet (a server used only to write a recording).
+    A port that cannot be opened raises a DrakeTrajError naming it and why (in use, reserved)."""
     drake_log = logging.getLogger("drake")
     level = drake_log.level
     if not announce:
         drake_log.setLevel(logging.WARNING)
     try:
         return Meshcat(MeshcatParams(port=port)) if port is not None else Meshcat()
+    except RuntimeError as error:  # Drake: "Meshcat failed to open a websocket port."
+        if port is None:
+            raise DrakeTrajError(f"Meshcat found no free port from 7000 ({error}); give one with --port",
+                                 field=("port",)) from None
+        raise DrakeTrajError(f"port {port} (--port) cannot be opened for Meshcat: {_port_problem(port)}; choose "
+                             "another port, or leave --port out for the first free one from 7000",
+                             field=("port",)) from None
     finally:
         drake_log.setLevel(level)
+
+
+def _port_problem(port: int) -> str:
+    """Why the TCP ``port`` cannot be listened on, as found by binding it."""
+    with socket.socket() as probe:
+        try:
+            probe.bind(("", port))
+        except OSError as error:
+            if error.errno == errno.EADDRINUSE:
+                return "another program is listening there"
+            if error.errno == errno.EACCES:
+                return "this user may not open it (ports below 1024 are reserved)"
+            return error.strerror or str(error)
+    return "Meshcat could not open it"
 
 
 def draw_task(meshcat: Meshcat, waypoints, *, neighbourhood: float = float("nan"), planned_path=None) -> None:
@@ -139,20 +166,31 @@ class TcpTrail(LeafSystem):
 
 
 class SpeedSlider(LeafSystem):
-    """A Meshcat slider ``speed override`` (0 to 1) as a source for a station's speed_override."""
+    """A Meshcat slider ``speed override`` (0 to 1) as a source for a station's speed_override.
+    With a ``profile`` (a scenario's :class:`~drake_traj.scenario.SpeedOverride`, not empty), the
+    slider scales it: the output is the slider's value times the profile's at that time."""
 
-    def __init__(self, meshcat: Meshcat, *, initial: float = 1.0):
+    def __init__(self, meshcat: Meshcat, *, initial: float = 1.0, profile: SpeedOverride | None = None):
         super().__init__()
         self._meshcat = meshcat
+        if profile is not None:
+            instance_of(profile, SpeedOverride, "profile")
+        self._profile = profile.trajectory() if profile is not None and np.size(profile.times) else None
         meshcat.AddSlider(SPEED_SLIDER, 0.0, 1.0, 0.01, initial)
-        self.DeclareVectorOutputPort("speed_override", 1,
-                                     lambda context, out: out.SetAtIndex(0, meshcat.GetSliderValue(SPEED_SLIDER)))
+        self.DeclareVectorOutputPort("speed_override", 1, self._output)
+
+    def _output(self, context, out):
+        value = self._meshcat.GetSliderValue(SPEED_SLIDER)
+        if self._profile is not None:
+            value *= float(self._profile.value(context.get_time())[0, 0])
+        out.SetAtIndex(0, value)
 
 
-def add_live_view(builder: DiagramBuilder, station, meshcat: Meshcat, robot: Robot) -> None:
+def add_live_view(builder: DiagramBuilder, station, meshcat: Meshcat, robot: Robot, *,
+                  speed_override: SpeedOverride | None = None) -> None:
     """Add a :class:`TcpTrail` on the station's measured state and a :class:`SpeedSlider` on its
-    ``speed_override`` input."""
+    ``speed_override`` input, scaling the scenario's ``speed_override`` profile where given."""
     trail = builder.AddNamedSystem("tcp_trail", TcpTrail(meshcat, robot))
     builder.Connect(station.GetOutputPort("measured_state"), trail.get_input_port())
-    slider = builder.AddNamedSystem("speed_slider", SpeedSlider(meshcat))
+    slider = builder.AddNamedSystem("speed_slider", SpeedSlider(meshcat, profile=speed_override))
     builder.Connect(slider.get_output_port(), station.GetInputPort("speed_override"))

@@ -87,6 +87,24 @@ _SHAPES = {"t": ("N",), **{name: ("N", "n") for name in ("q_ref", "qd_ref", "qdd
            "acceleration_limit": ("n",), "effort_limit": ("n",), "waypoints": (None, 3), "goal": (6,)}
 
 
+def _over_samples(reduce, array: np.ndarray) -> np.ndarray:
+    """``reduce`` (np.min, np.max) of ``array`` over its samples (axis 0); NaN where it holds none
+    (a station that has not run)."""
+    return reduce(array, axis=0) if len(array) else np.full(array.shape[1:], np.nan)
+
+
+def _unfinished_failure(samples: int, time: float, finish: float) -> Failure | None:
+    """Why a station's log that no failure explains is not a success: ``samples`` logged up to
+    the context's ``time`` [s], the planner's ``finish`` [s] (NaN before it finished)."""
+    if samples < 2:
+        return Failure(Cause.NOT_RUN, f"the station has not run: {samples} sample(s) logged up to t = {time:g} s, less "
+                                      "than one log period; advance its simulator (run_station) before from_station", time)
+    if not np.isfinite(finish):
+        return Failure(Cause.TIMEOUT, f"the planner had not finished when the log ends at t = {time:.4f} s; advance the "
+                                      "simulator until it finishes (run_station), or pass the run's failure", time)
+    return None
+
+
 def _output_folder(directory) -> Path:
     """``directory`` (the argument of that name) created if needed, or TypeError/ValueError naming it."""
     directory = path_argument(directory, "directory", "folder")
@@ -275,19 +293,19 @@ class SimulationResult:
             duration_s=self.duration,
             samples=int(len(self.t)),
             log_period_s=self.log_period or None,
-            qd_min=self.qd_ref.min(axis=0).tolist(),
-            qd_max=self.qd_ref.max(axis=0).tolist(),
-            qdd_min=self.qdd_ref.min(axis=0).tolist(),
-            qdd_max=self.qdd_ref.max(axis=0).tolist(),
-            max_velocity_over_limit=float(np.max(np.abs(self.qd_ref) / self.velocity_limit)),
-            max_acceleration_over_limit=float(np.max(np.abs(self.qdd_ref) / self.acceleration_limit)),
+            qd_min=_over_samples(np.min, self.qd_ref).tolist(),
+            qd_max=_over_samples(np.max, self.qd_ref).tolist(),
+            qdd_min=_over_samples(np.min, self.qdd_ref).tolist(),
+            qdd_max=_over_samples(np.max, self.qdd_ref).tolist(),
+            max_velocity_over_limit=float(np.max(_over_samples(np.max, np.abs(self.qd_ref) / self.velocity_limit))),
+            max_acceleration_over_limit=float(np.max(_over_samples(np.max, np.abs(self.qdd_ref) / self.acceleration_limit))),
             max_jerk=float(np.abs(jerk).max()) if len(jerk) else 0.0,
-            tracking_error_joint_max_rad=float(np.abs(self.q_ref - self.q_meas).max()),
-            tracking_error_tcp_max_m=float(tcp_error.max()),
+            tracking_error_joint_max_rad=float(np.max(_over_samples(np.max, np.abs(self.q_ref - self.q_meas)))),
+            tracking_error_tcp_max_m=float(_over_samples(np.max, tcp_error)),
             final_position_error_m=final_position,
             final_orientation_error_rad=final_orientation,
-            peak_torque_nm=np.abs(self.tau).max(axis=0).tolist(),
-            peak_torque_over_limit=(np.abs(self.tau).max(axis=0) / self.effort_limit).tolist(),
+            peak_torque_nm=_over_samples(np.max, np.abs(self.tau)).tolist(),
+            peak_torque_over_limit=(_over_samples(np.max, np.abs(self.tau)) / self.effort_limit).tolist(),
             time_at_effort_limit_s=(self._saturated().sum(axis=0) * self.log_period).tolist(),
             simulated_time_s=simulated,
             wall_time_s=self.wall_time,
@@ -301,8 +319,10 @@ class SimulationResult:
         loggers, its planner and its robot. ``station_context`` is the station's context (for a
         station inside a larger diagram: ``station.GetMyContextFromRoot(root_context)``).
         The TCP poses are computed from the logged joint positions. A run without ``failure``
-        fails all the same where the arm did not do what was planned
-        (:meth:`execution_failure` with ``tracking_tolerance`` [m]; None skips the check)."""
+        fails all the same where the station has not run (fewer than two samples logged: cause
+        NOT_RUN), where the planner had not finished when the log ends (TIMEOUT), or where the
+        arm did not do what was planned (:meth:`execution_failure` with ``tracking_tolerance``
+        [m]; None skips that check)."""
         if tracking_tolerance is not None:
             positive_scalar(tracking_tolerance, "tracking_tolerance", "m")
         planner = station.GetSubsystemByName("planner")
@@ -339,6 +359,8 @@ class SimulationResult:
             robot=robot.name,
             waypoint_neighbourhood=planner.waypoint_neighbourhood(),
         )
+        if result.failure is None:
+            result.failure = _unfinished_failure(count, station_context.get_time(), result.duration)
         if result.failure is None and tracking_tolerance is not None:
             result.failure = result.execution_failure(tracking_tolerance)
         return result

@@ -37,7 +37,8 @@ from drake_traj.planners import PLANNER_CONFIGS, PlannerConfig, PlannerSystem, Q
 from drake_traj.planners import make_planner as make_planner_from_config
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE
 from drake_traj.robots import Robot, get_robot
-from drake_traj.validation import flag, instance_of, invalid, log_period_check, path_argument, real_array
+from drake_traj.validation import (MAX_RUN_DURATION, flag, instance_of, invalid, log_period_check, path_argument,
+                                   real_array, realtime_rate, run_duration, settle_duration, step_size)
 from drake_traj.yaml_schema import ScenarioError, checked_document, locate
 
 __all__ = [
@@ -156,15 +157,17 @@ class Scenario:
         plant: Drake's ``MultibodyPlantConfig`` of the robot plant (default: discrete at 1 ms,
             SAP); ``plant: {time_step: 0.002}`` runs at the UR controller's 500 Hz.
         simulator: Drake's ``SimulatorConfig`` (integration scheme, step, accuracy, real-time
-            rate; default fixed-step RK2 at 1 ms, see ``station.default_simulator_config``).
+            rate: 0, as fast as it goes, or 0.1-1000; default fixed-step RK2 at 1 ms, see
+            ``station.default_simulator_config``).
         log_period: the loggers' period [s], a whole multiple of ``plant.time_step``; 0 (the
             default): the plant's time step.
         speed_override: a speed-override profile (times [s], values in [0, 1]), like a pendant's
             speed slider; empty: none.
         tracking_tolerance: the run fails if the measured TCP is ever further than this from the
             reference [m] (default 5 mm: 40x the shipped scenarios' worst, 0.13 mm).
-        settle_time: how long the run goes on after the planner finishes [s].
-        max_duration: the run stops with a failure if the planner has not finished by then [s].
+        settle_time: how long the run goes on after the planner finishes [s], at most 60 s.
+        max_duration: the run stops with a failure if the planner has not finished by then [s],
+            at most 600 s; the preflight integrates an online planner's law this far ahead.
     """
 
     name: str = "unnamed"
@@ -224,6 +227,11 @@ class Scenario:
             if not np.isfinite(value) or value < smallest_allowed:
                 unit = "metres" if label == "tracking_tolerance" else "seconds"
                 raise invalid(label, f"{label} must be a finite, positive number of {unit}, got {value}")
+        run_duration(self.max_duration)
+        settle_duration(self.settle_time)
+        step_size(self.plant.time_step, "plant.time_step")
+        step_size(self.simulator.max_step_size, "simulator.max_step_size")
+        realtime_rate(self.simulator.target_realtime_rate, "simulator.target_realtime_rate")
         for label, value, largest in (("plant.time_step", self.plant.time_step, MAX_TIME_STEP),
                                       ("log_period", self.logging_period(), MAX_LOG_PERIOD)):
             if value > largest:
@@ -333,7 +341,8 @@ def shipped_scenarios() -> list[ShippedScenario]:
 
 def find_scenario(reference: str, variant: str | None = None) -> tuple[Path, str | None]:
     """(file, variant) of a scenario given as a path, or as the name of a shipped scenario
-    (``pajak_sim3``) or of a shipped file (``pajak``, with ``variant``)."""
+    (``pajak_sim3``; with ``variant``, that variant of its file: ``pajak_sim3``, ``"sim1"`` is
+    ``pajak_sim1``) or of a shipped file (``pajak``, with ``variant``)."""
     path = Path(reference)
     try:
         return _find_scenario(path, reference, variant)
@@ -358,8 +367,8 @@ def _find_scenario(path: Path, reference: str, variant: str | None) -> tuple[Pat
         raise ScenarioError(f"scenario file {path} not found")
     shipped = shipped_scenarios()
     for entry in shipped:
-        if entry.name == reference and variant in (None, entry.variant):
-            return entry.path, entry.variant
+        if entry.name == reference:  # with a variant: that variant of the scenario's file
+            return entry.path, entry.variant if variant is None else variant
     stem = shipped_directory() / f"{reference}.yaml"
     if stem.is_file():
         return stem, variant
@@ -451,15 +460,24 @@ def make_planner(scenario: Scenario, *others) -> PlannerSystem:
     return planner
 
 
-def preflight(scenario: Scenario, planner: PlannerSystem) -> np.ndarray | None:
-    """``planner.preflight()`` (the whole task checked before t = 0), its errors located in the
-    scenario as :func:`make_planner`'s are (e.g. at ``planner.waypoints[2]``'s line); then the
-    planned motion in the scenario's cell (:func:`check_in_cell`).
+def preflight(scenario: Scenario, planner: PlannerSystem, horizon: float | None = None) -> np.ndarray | None:
+    """``planner.preflight(horizon)`` (the whole task checked before t = 0, up to ``horizon`` [s],
+    default the scenario's ``max_duration``), its errors located in the scenario as
+    :func:`make_planner`'s are (e.g. at ``planner.waypoints[2]``'s line; a task that does not
+    finish within the horizon at ``max_duration``'s); then the planned motion in the scenario's
+    cell (:func:`check_in_cell`).
 
     Returns the planned tool path [m], shape (N, 3) in the base frame, where the planner
     computes one, else None."""
     try:
-        path = planner.preflight()
+        path = planner.preflight(scenario.max_duration if horizon is None else horizon)
+    except DrakeTrajError as error:
+        if error.cause is not Cause.TIMEOUT:
+            raise _in_planner_field(scenario, error, message_leads_with_field=False) from error
+        field = ("max_duration",)
+        raise error.relocated(field, locate_in_scenario(
+            scenario, field, f"max_duration: {error}; raise max_duration (at most {MAX_RUN_DURATION:g} s) or the "
+                             "planner's limits")) from error
     except ValueError as error:
         raise _in_planner_field(scenario, error, message_leads_with_field=False) from error
     check_in_cell(scenario, planner)

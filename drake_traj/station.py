@@ -51,8 +51,8 @@ from drake_traj.robots import UR10E, Robot
 from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, check_planned_duration, default_plant_config,
                                  default_simulator_config)
 from drake_traj.scenario import preflight as scenario_preflight
-from drake_traj.validation import (callable_or_none, flag, instance_of, invalid, log_period_check,
-                                   nonnegative_scalar, positive_scalar, real_scalar)
+from drake_traj.validation import (callable_or_none, flag, instance_of, invalid, log_period_check, positive_scalar,
+                                   real_scalar, realtime_rate, run_duration, settle_duration, step_size)
 
 __all__ = [
     "Station", "add_speed_override", "add_station", "build_station", "make_station", "run_station", "simulate",
@@ -142,6 +142,7 @@ def add_station(
     A planner system is part of one diagram only (Drake owns it there): a second station needs a
     new planner (``make_planner`` again); ValueError otherwise.
     """
+    instance_of(builder, DiagramBuilder, "builder", hint=" (pydrake.systems.framework.DiagramBuilder())")
     instance_of(planner, PlannerSystem, "planner")
     if planner.GetSystemPathname().count("::") > 1:  # "::parent::planner" once built into a diagram
         raise invalid("planner", f"planner is already part of a diagram ({planner.GetSystemPathname()}): a planner system "
@@ -158,7 +159,7 @@ def add_station(
     n = robot.num_joints
     if planner.num_joints != n:
         raise invalid("robot", f"the planner has {planner.num_joints} joints, robot {robot.name} has {n}")
-    time_step = positive_scalar(plant_config.time_step, "plant.time_step", "s")
+    time_step = step_size(plant_config.time_step, "plant.time_step")
     log_period = positive_scalar(log_period, "log_period", "s")
     log_period_check(log_period, time_step)
 
@@ -281,6 +282,8 @@ def make_station(scenario: Scenario, meshcat: Meshcat | None = None) -> Diagram:
     :func:`~drake_traj.scenario.load_scenario`)."""
     hint = " (load one with drake_traj.load_scenario(name_or_path, variant))"
     instance_of(scenario, Scenario, "scenario", hint=hint if isinstance(scenario, (str, os.PathLike)) else "")
+    if meshcat is not None:
+        instance_of(meshcat, Meshcat, "meshcat")
     from_scenario = scenario.station_arguments()
     return build_station(from_scenario.pop("planner"), meshcat=meshcat, **from_scenario)
 
@@ -294,13 +297,26 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
     logs stay as they were when it happened. ``progress(t)`` is called with the simulated time
     every 10 ms of it. Returns None when the planner finished, else the :class:`Failure`
     (cause "interrupted" for Ctrl-C).
+
+    TypeError unless ``simulator`` is a ``Simulator`` and ``station`` a station Diagram in its
+    diagram; ValueError for a ``max_duration`` outside (0, 600] s or a ``settle_time`` outside
+    [0, 60] s (:data:`~drake_traj.validation.MAX_RUN_DURATION`, ``MAX_SETTLE_TIME``).
     """
-    max_duration = positive_scalar(max_duration, "max_duration", "s")
-    settle_time = nonnegative_scalar(settle_time, "settle_time", "s")
+    instance_of(simulator, Simulator, "simulator")
+    instance_of(station, Diagram, "station", hint=" (make_station(scenario) or build_station(planner))")
+    max_duration = run_duration(max_duration)
+    settle_time = settle_duration(settle_time)
     callable_or_none(progress, "progress", "progress(t)")
+    if not station.HasSubsystemNamed("planner"):
+        raise invalid("station", f"station must be a station (make_station, build_station): {station.get_name()!r} has no "
+                                 "subsystem named 'planner'")
     planner = station.GetSubsystemByName("planner")
     root = simulator.get_mutable_context()
-    planner_context = planner.GetMyContextFromRoot(root)
+    try:
+        planner_context = planner.GetMyContextFromRoot(root)
+    except RuntimeError:
+        raise invalid("station", f"station {station.get_name()!r} is not part of the simulator's diagram "
+                                 f"({simulator.get_system().get_name()!r})") from None
     chunk = min(0.01, max(settle_time, 1e-3))  # the finish and contact are checked between chunks
     end = max_duration
     try:
@@ -384,7 +400,8 @@ def simulate(
     (None: the same), 1 ms logs, 0.5 s settle time, 120 s at most, no speed override and a 5 mm
     tracking tolerance.
 
-    The run stops at ``max_duration`` [s] if the planner has not finished. Whatever stops the run
+    The run stops at ``max_duration`` [s] (at most 600 s; the preflight looks as far ahead) if
+    the planner has not finished; ``settle_time`` is at most 60 s. Whatever stops the run
     early (an exception from a planner, a timeout, Ctrl-C) is caught: the result holds everything
     logged up to that point and ``failure`` gives the reason. With ``meshcat``, the run is recorded
     there (see :func:`drake_traj.meshcat.export_html`).
@@ -441,8 +458,13 @@ def simulate(
     instance_of(name, str, "name")
     if simulator_config is not None:
         instance_of(simulator_config, SimulatorConfig, "simulator_config")
-    positive_scalar(max_duration, "max_duration", "s")
-    nonnegative_scalar(settle_time, "settle_time", "s")
+    if meshcat is not None:
+        instance_of(meshcat, Meshcat, "meshcat")
+    if simulator_config is not None:
+        realtime_rate(simulator_config.target_realtime_rate, "simulator_config.target_realtime_rate")
+        step_size(simulator_config.max_step_size, "simulator_config.max_step_size")
+    run_duration(max_duration)
+    settle_duration(settle_time)
     if tracking_tolerance is not None:
         positive_scalar(tracking_tolerance, "tracking_tolerance", "m")
     speed_override_source(speed_override)
@@ -450,9 +472,9 @@ def simulate(
     callable_or_none(add_systems, "add_systems", "add_systems(builder, station)")
     callable_or_none(before_run, "before_run", "before_run(simulator)")
     if flag(preflight, "preflight") and scenario is not None and cell is scenario.cell and cell_directory == scenario.directory():
-        scenario_preflight(scenario, planner)  # its errors located in the scenario file
+        scenario_preflight(scenario, planner, max_duration)  # its errors located in the scenario file
     elif preflight:
-        planner.preflight()
+        planner.preflight(max_duration)
         CellChecker(robot, cell, cell_directory).check_planner(planner)
     if scenario is not None:
         check_planned_duration(scenario, planner)

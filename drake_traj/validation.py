@@ -98,6 +98,52 @@ def nonnegative_scalar(value, name: str, unit: str) -> float:
     return real_scalar(value, name, unit, minimum=0.0)
 
 
+# The bounds of a run's times and pace (README "When something goes wrong"): every run ends, and
+# its log (1 ms samples by default, about 0.3 kB each) fits in memory.
+MAX_RUN_DURATION = 600.0  # [s] max_duration, and the preflight's horizon: 10 minutes of simulated motion
+MAX_SETTLE_TIME = 60.0  # [s] settle_time, the run after the planner finishes
+MIN_STEP = 1e-5  # [s] plant.time_step, simulator.max_step_size, a planner's update period: 100 kHz at most
+REALTIME_RATES = (0.1, 1000.0)  # a live run's pace (--rate, simulator.target_realtime_rate; 0: as fast as it goes)
+
+
+def run_duration(value, name: str = "max_duration") -> float:
+    """A run's ``max_duration`` [s]: finite, > 0 and at most :data:`MAX_RUN_DURATION`."""
+    value = positive_scalar(value, name, "s")
+    if value > MAX_RUN_DURATION:
+        raise invalid(name, f"{name} must be at most {MAX_RUN_DURATION:g} s (the longest run simulated and logged), "
+                            f"got {value:g} s")
+    return value
+
+
+def settle_duration(value, name: str = "settle_time") -> float:
+    """A run's ``settle_time`` [s]: finite, >= 0 and at most :data:`MAX_SETTLE_TIME`."""
+    value = nonnegative_scalar(value, name, "s")
+    if value > MAX_SETTLE_TIME:
+        raise invalid(name, f"{name} must be at most {MAX_SETTLE_TIME:g} s after the planner finishes, got {value:g} s")
+    return value
+
+
+def step_size(value, name: str) -> float:
+    """A simulation step or update period [s]: finite and at least :data:`MIN_STEP` (a finer
+    one would take hours for a run of seconds)."""
+    value = positive_scalar(value, name, "s")
+    if value < MIN_STEP:
+        raise invalid(name, f"{name} must be at least {MIN_STEP:g} s (a finer step would take hours to simulate a "
+                            f"run of seconds), got {value:g} s")
+    return value
+
+
+def realtime_rate(value, name: str) -> float:
+    """A simulator's ``target_realtime_rate``: 0 (as fast as it goes) or within
+    :data:`REALTIME_RATES` (a slower pace would leave a run hanging for hours)."""
+    value = nonnegative_scalar(value, name, "times real time")
+    low, high = REALTIME_RATES
+    if value != 0 and not low <= value <= high:
+        raise invalid(name, f"{name} must be 0 (as fast as it goes) or from {low:g} to {high:g} times real time, "
+                            f"got {value:g}")
+    return value
+
+
 def finite_array(value, name: str, unit: str, *, shape: tuple | None = None) -> np.ndarray:
     """``value`` as a float array (copy) of ``shape`` (any if None) with finite entries."""
     array = real_array(value, name, unit)

@@ -61,18 +61,46 @@ def _is_record(schema) -> bool:
     return isinstance(schema, type) and (dataclasses.is_dataclass(schema) or hasattr(schema, "__fields__"))
 
 
+class Marks(dict):
+    """{field path: YAML node} of a checked scenario, for locating later value errors, and
+    ``replaced``: {field path: (the key node, the merged value node it replaces)} for each mapping
+    a merge key (``<<: *anchor``) brought in and the document's own key replaced whole (YAML's
+    merge is shallow), to explain an error inside it."""
+
+    def __init__(self, *args):
+        super().__init__(*args)
+        self.replaced: dict[Field, tuple] = {}
+
+
+def _replacement_note(marks: Marks, field: Field) -> str:
+    """Where ``field`` lies in a mapping that replaced a merged one: what happened and what to do."""
+    for length in range(len(field), 0, -1):
+        if field[:length] in marks.replaced:
+            key, merged = marks.replaced[field[:length]]
+            name = field_text(field[:length])
+            tag = f" {merged.tag}" if merged.tag.startswith("!") else ""
+            return (f" (note: {name} at line {key.start_mark.line + 1} replaces the whole {name}{tag} merged from line "
+                    f"{merged.start_mark.line + 1}: a YAML merge (<<) is shallow, so only the fields given at line "
+                    f"{key.start_mark.line + 1} count; give the tag and every field there, or merge the anchor's {name} "
+                    f"into it with an anchor of its own)")
+    return ""
+
+
 class _Checker:
     def __init__(self, path: Path, loader: _Loader):
         self.path = path
         self.loader = loader
-        self.marks: dict[Field, object] = {}  # field path -> node, for value errors found later
+        self.marks = Marks()  # field path -> node, for value errors found later
 
     def fail(self, node, field: Field, message: str) -> typing.NoReturn:
         where = f"{_where(self.path, node)}: " if node is not None else f"{self.path}: "
-        raise ScenarioError(f"{where}{field_text(field) + ': ' if field else ''}{message}", field=field)
+        note = _replacement_note(self.marks, field)
+        raise ScenarioError(f"{where}{field_text(field) + ': ' if field else ''}{message}{note}", field=field)
 
     def mapping_items(self, node, field: Field):
-        """The (key, value) nodes of a mapping, merge keys applied, duplicate keys refused."""
+        """The (key, value) nodes of a mapping, merge keys applied (a key of the mapping's own
+        replaces a merged one whole: recorded in ``marks.replaced`` where both are mappings),
+        duplicate keys refused."""
         seen = {}
         for key, _ in node.value:
             if not isinstance(key, yaml.ScalarNode):
@@ -89,7 +117,12 @@ class _Checker:
         except yaml.MarkedYAMLError as error:  # e.g. << merging a list or a scalar
             raise ScenarioError(f"{self.path}: {field_text(field) + ': ' if field else ''}{_mark_message(error)}",
                                 field=field) from None
-        return node.value
+        last = {key.value: (key, value) for key, value in node.value}  # flattened: merged first, own last
+        for key, value in node.value:
+            own_key, own_value = last[key.value]
+            if own_key is not key and isinstance(value, yaml.MappingNode) and isinstance(own_value, yaml.MappingNode):
+                self.marks.replaced[field + (key.value,)] = (own_key, value)
+        return [(key, value) for key, value in node.value if last[key.value][0] is key]
 
     def check(self, node, schema, field: Field) -> None:
         self.marks[field] = node
@@ -221,22 +254,24 @@ def checked_document(path: Path, schema, variant_keys=None) -> tuple[object, dic
             if not key.value.startswith("_"):
                 variants[key.value] = value
 
-    def check(node, prefix: Field = ()) -> dict:
-        checker.marks = {}
+    def check(node, prefix: Field = ()) -> Marks:
+        checker.marks = Marks()
         try:
             checker.check_record(node, schema, prefix)
         except RecursionError:
             raise ScenarioError(f"{path}: the document is nested too deeply to be a scenario") from None
-        return dict(checker.marks)
+        return checker.marks
 
     return root, variants, check
 
 
 def locate(marks: dict, path: Path, field: Field, message: str) -> str:
     """``message`` prefixed with the file and the line of ``field`` (a path such as
-    ``("planner", "waypoints", 1)``) where the marks hold it, or the list it indexes."""
-    node = marks.get(tuple(field))
-    if node is None and field and isinstance(field[-1], int):  # an entry of a list given in one line
-        node = marks.get(tuple(field[:-1]))
+    ``("planner", "waypoints", 1)``) where the marks hold it, else of the nearest field that
+    holds it (the list it indexes, the mapping a missing field belongs in); with a note where
+    the field lies in a mapping that replaced a merged one (:class:`Marks`)."""
+    field = tuple(field)
+    node = next((marks[field[:length]] for length in range(len(field), 0, -1) if field[:length] in marks), None)
     where = _where(path, node) if node is not None else str(path)
-    return f"{where}: {message}"
+    note = _replacement_note(marks, field) if isinstance(marks, Marks) else ""
+    return f"{where}: {message}{note}"

@@ -35,9 +35,11 @@ from drake_traj.errors import Cause, PlanningError
 from drake_traj.planners.laws.contract import MEMBERS, missing_members
 from drake_traj.planners.laws.pieces import law_pieces
 from drake_traj.planners.laws.scaling import admissible_clock_rate, clock_at, next_clock_rate
-from drake_traj.validation import finite_array, invalid
+from drake_traj.validation import finite_array, invalid, run_duration
 
 _DID_NOTHING = EventStatus.DidNothing()  # returned by the time-law update in the common case
+# [s] how far ahead :meth:`PlannerSystem.preflight` looks when not told: a run's default max_duration
+DEFAULT_PREFLIGHT_HORIZON = 120.0
 
 
 def piecewise_trajectory(breaks, coefficients) -> PiecewisePolynomial:
@@ -108,15 +110,18 @@ class PlannerSystem(LeafSystem):
         """q at t = 0 [rad]: where the robot starts."""
         return self._q_initial.copy()
 
-    def preflight(self) -> np.ndarray | None:
+    def preflight(self, horizon: float = DEFAULT_PREFLIGHT_HORIZON) -> np.ndarray | None:
         """Check the whole task before t = 0; raise :class:`~drake_traj.errors.PlanningError` if
-        it cannot be completed. Planners that plan the whole motion when they are made have
-        nothing left to check (this default); online planners run their law ahead of time.
+        it cannot be completed within ``horizon`` [s] (a run's ``max_duration``, at most
+        :data:`~drake_traj.validation.MAX_RUN_DURATION`; a task that takes longer fails with
+        cause TIMEOUT). Planners that plan the whole motion when they are made have nothing left
+        to check (this default); online planners run their law ahead of time, up to ``horizon``.
 
         Returns:
             The planned tool path [m], shape (N, 3) in the base frame, where the check computes
             it (for drawing before the motion), else None.
         """
+        run_duration(horizon, "horizon")
         return None
 
     def planned_duration(self) -> float:

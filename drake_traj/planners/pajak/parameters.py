@@ -6,7 +6,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from drake_traj.robots import ur10e as robot
-from drake_traj.validation import flag, invalid, positive_vector, real_array
+from drake_traj.validation import flag, invalid, positive_vector, real_array, step_size
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
 
 __all__ = ["PAPER_METHOD", "PajakConfig", "paper_initial_configuration", "paper_parameters"]
@@ -66,7 +66,7 @@ class PajakConfig:
             PlanningError.
         blend_length: σ = path length through the ball / (blend_length · ϵ) (eq. 19 reading).
         update_period: period of the planner system's discrete update (eq. 18 anchor, waypoint
-            switching) [s].
+            switching) [s], at least 1e-5 s.
 
     Gains and limits are one number for every joint (task component) in a scenario file; from
     Python they may also be 6 values.
@@ -135,6 +135,7 @@ class PajakConfig:
             if not np.isfinite(value) or value <= 0:
                 raise invalid(name, f"{name} must be finite and > 0, got {value}")
             values[name] = float(value)
+        step_size(values["update_period"], "update_period")
         vartheta = self.vartheta
         if isinstance(vartheta, bool) or not isinstance(vartheta, (int, float, np.floating)) or not (
             0.0 < vartheta < 0.5

@@ -4,16 +4,21 @@ from __future__ import annotations
 
 import numpy as np
 
-from drake_traj.planners.base import PlannerSystem
+from drake_traj.errors import Cause, PlanningError
+from drake_traj.planners.base import DEFAULT_PREFLIGHT_HORIZON, PlannerSystem
 from drake_traj.planners.laws.hermite import quintic_hermite_coefficients
 from drake_traj.planners.pajak.integration import integrate
 from drake_traj.planners.pajak.kernel import Discrete
 from drake_traj.planners.pajak.law import PajakLaw
 from drake_traj.planners.pajak.parameters import PajakConfig
 from drake_traj.robots import UR10E, Robot
-from drake_traj.validation import finite_array
+from drake_traj.validation import finite_array, invalid, run_duration
 
-__all__ = ["PajakPlanner", "make"]
+__all__ = ["MAX_PREFLIGHT_STEPS", "PajakPlanner", "make"]
+
+# The preflight's integration steps at most: its log holds 45 values a step (360 MB at this bound;
+# 600 s, the longest run, at the default 1 ms update period is 6e5 steps)
+MAX_PREFLIGHT_STEPS = 1_000_000
 
 
 class PajakPlanner(PlannerSystem):
@@ -67,14 +72,16 @@ class PajakPlanner(PlannerSystem):
         fallback braking; improvement 2)."""
         return int(context.get_discrete_state(self.task_state_index).get_value()[Discrete.SATURATED - Discrete.C0 - 1])
 
-    def preflight(self) -> np.ndarray:
-        """Run the whole task ahead of time (:func:`integrate`, the law alone) before t = 0.
+    def preflight(self, horizon: float = DEFAULT_PREFLIGHT_HORIZON) -> np.ndarray:
+        """Run the whole task ahead of time (:func:`integrate`, the law alone) before t = 0, up
+        to ``horizon`` [s] (a run's ``max_duration``; at most :data:`MAX_PREFLIGHT_STEPS` update
+        periods).
 
         Raises the :class:`PlanningError` that the motion would end with: a waypoint out of
         reach (before integrating), a stall, gimbal lock, non-finite values or no finish within
-        30 s, naming the time, the configuration and the cause (the stall message names the
-        waypoint). A run that finishes has reached the whole pose (position within ε,
-        orientation within ``orientation_accuracy``).
+        ``horizon`` (cause TIMEOUT), naming the time, the configuration and the cause (the stall
+        message names the waypoint). A run that finishes has reached the whole pose (position
+        within ε, orientation within ``orientation_accuracy``).
 
         The integration is kept once it finished (the law does not change): a second preflight
         and :meth:`plan` reuse it; one that failed is run again and raises again.
@@ -82,8 +89,24 @@ class PajakPlanner(PlannerSystem):
         Returns:
             The planned TCP path [m], (N, 3).
         """
+        horizon = run_duration(horizon, "horizon")
+        update_period = self.law.parameters.update_period
+        if horizon / update_period > MAX_PREFLIGHT_STEPS:
+            raise invalid("update_period", f"update_period = {update_period:g} s would take {horizon / update_period:.3g} "
+                                           f"steps to look {horizon:g} s ahead (max_duration); at most "
+                                           f"{MAX_PREFLIGHT_STEPS:.0e}: raise update_period or lower max_duration")
         if self._run is None:
-            self._run = integrate(self.law, self.initial_positions(), dt=self.law.parameters.update_period)
+            try:
+                self._run = integrate(self.law, self.initial_positions(), dt=update_period, t_max=horizon)
+            except PlanningError as error:
+                if error.cause is not Cause.TIMEOUT:
+                    raise
+                raise PlanningError(f"the task did not finish within {horizon:g} s, the preflight's horizon (the run's "
+                                    "max_duration)", time=error.time, configuration=error.configuration,
+                                    cause=Cause.TIMEOUT, partial=error.partial) from None
+        elif self._run["T"] > horizon:
+            raise PlanningError(f"the task takes {self._run['T']:.3f} s, longer than {horizon:g} s, the preflight's "
+                                "horizon (the run's max_duration)", cause=Cause.TIMEOUT)
         return self._run["tcp"][:, :3]
 
     def _plan_pieces(self) -> tuple[np.ndarray, np.ndarray]:
