@@ -35,7 +35,7 @@ from pydrake.trajectories import PiecewisePolynomial, Trajectory
 from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import piecewise_trajectory
 from drake_traj.planners.baselines.ruckig import default_jerk_limit
-from drake_traj.planners.baselines.toppra import geometric_path_from_samples, time_optimal_along_path
+from drake_traj.planners.baselines.toppra import time_optimal_along_path
 from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coefficients
 from drake_traj.planners.laws.polynomials import rate_peaks
 from drake_traj.validation import positive_scalar, positive_vector, real_array, require_finite
@@ -69,8 +69,9 @@ class SmoothTiming:
         path: the geometric path q(s) that was timed.
         stretch: the factor (>= 1) the repair stretched the time by so every limit holds (1: none).
         peaks: max |q̇|, |q̈|, |q⃛| over the limit per joint, exact ((3, n)).
-        deviation: an upper bound [rad] of the largest joint deviation from the path (the pieces
-            against q(s(t)) with s(t) the same Hermite interpolation of the path speed).
+        deviation: a bound [rad] of the largest joint deviation from the given path: the spline's
+            from the samples (0 for a Trajectory) plus the pieces' from the spline (against q(s(t))
+            with s(t) the same Hermite interpolation of the path speed, 4 points per piece).
         iterations: linear programs solved.
     """
 
@@ -84,9 +85,10 @@ class SmoothTiming:
     iterations: int
 
 
-def check_path(path, name: str = "path") -> Trajectory:
-    """``path`` as a Drake Trajectory q(s): a Trajectory as it is, joint samples (N, n) as the C2
-    cubic spline through them by arc length (:func:`geometric_path_from_samples`).
+def check_path(path, name: str = "path") -> tuple[Trajectory, float]:
+    """``path`` as a Drake Trajectory q(s) and its largest deviation from what was given [rad]:
+    a Trajectory as it is (0), joint samples (N, n) as the C2 cubic spline through knots picked
+    from them (:func:`sample_path`).
 
     Raises:
         InfeasibleTimingError: samples that turn back (two consecutive steps more than 120°
@@ -102,6 +104,7 @@ def check_path(path, name: str = "path") -> Trajectory:
             raise DrakeTrajError(f"{name} must have a positive length in s, got [{path.start_time()}, {path.end_time()}]",
                                  field=(name,))
         _check_corners(path, name)
+        fit = 0.0
     else:
         samples = real_array(path, name, "rad")
         if samples.ndim != 2 or samples.shape[0] < 2 or samples.shape[1] < 1:
@@ -109,12 +112,54 @@ def check_path(path, name: str = "path") -> Trajectory:
                                  field=(name,))
         require_finite(samples, name, "rad")
         _check_reversals(samples, name)
-        try:
-            path = geometric_path_from_samples(samples)
-        except ValueError as error:
-            raise DrakeTrajError(f"{name}: {error}", field=(name,)) from None
+        path, fit = sample_path(samples, name=name)
     _check_cusps(path, name)
-    return path
+    return path, fit
+
+
+def sample_path(samples, max_knots: int = 200, *, name: str = "path") -> tuple[PiecewisePolynomial, float]:
+    """The C2 cubic spline q(s) through knots picked from joint samples (N, n) [rad], s the
+    arc length through the knots [rad], and its largest deviation from the samples [rad].
+
+    Knots are spaced evenly in arc length plus turning angle (each half of the total), so a
+    tight turn gets as many knots as a long straight stretch (a path from Pająk's law turns
+    through tens of degrees within 0.1 mrad where it slows down). Repeated samples (closer than
+    1e-9 rad) are dropped. Where the spline strays from a sample by more than a fifth of
+    :data:`PATH_TOLERANCE`, the knots are doubled (up to 4 × ``max_knots``).
+
+    Raises:
+        InfeasibleTimingError: fewer than two distinct samples, or a spline that still strays.
+    """
+    q = np.asarray(samples, dtype=float)
+    step = np.linalg.norm(np.diff(q, axis=0), axis=1)
+    q = q[np.concatenate([[True], step > 1e-9])]
+    if len(q) < 2:
+        raise InfeasibleTimingError(f"{name} must hold at least 2 distinct configurations", field=(name,))
+    steps = np.diff(q, axis=0)
+    length = np.linalg.norm(steps, axis=1)
+    arc = np.concatenate([[0.0], np.cumsum(length)])
+    if len(q) == 2:
+        return PiecewisePolynomial.FirstOrderHold(arc, q.T), 0.0
+    unit = steps / length[:, None]
+    turn = np.arccos(np.clip(np.sum(unit[1:] * unit[:-1], axis=1), -1.0, 1.0))
+    measure = arc + np.concatenate([[0.0], np.cumsum(turn), [turn.sum()]]) * (arc[-1] / max(turn.sum(), 1e-12))
+    knots = max_knots
+    while True:
+        index = np.unique(np.concatenate([[0, len(q) - 1],
+                                          np.searchsorted(measure, np.linspace(0, measure[-1], knots)).clip(0, len(q) - 1)]))
+        chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(q[index], axis=0), axis=1))])
+        path = (PiecewisePolynomial.FirstOrderHold(chord, q[index].T) if len(index) == 2 else
+                PiecewisePolynomial.CubicWithContinuousSecondDerivatives(chord, q[index].T, periodic_end_condition=False))
+        at = np.interp(arc, arc[index], chord)  # each sample's parameter, by arc length between knots
+        deviation = float(np.abs(path.vector_values(at).T - q).max())
+        if deviation <= 0.2 * PATH_TOLERANCE or knots >= 4 * max_knots or len(index) == len(q):
+            break
+        knots *= 2
+    if deviation > 0.2 * PATH_TOLERANCE:
+        raise InfeasibleTimingError(f"{name}: no spline through {len(index)} of its samples stays within "
+                                    f"{0.2 * PATH_TOLERANCE:g} rad of them ({deviation:.3g} rad): the samples are "
+                                    "too sparse or too noisy for a C2 path", field=(name,))
+    return path, deviation
 
 
 def _check_reversals(samples: np.ndarray, name: str) -> None:
@@ -182,9 +227,17 @@ def _grid(path, velocity, acceleration, points: int) -> np.ndarray:
     except ValueError as error:
         raise InfeasibleTimingError(f"path: the bang-bang optimum does not exist ({error})", field=("path",)) from None
     s_of_t = trajectory.time_scaling()
+    breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
+    points = max(points - len(breaks), points // 2)
     s = np.array([s_of_t.value(t)[0, 0] for t in np.linspace(0.0, optimal, points)])
     s = np.maximum.accumulate(np.clip(s, path.start_time(), path.end_time()))
     s[0], s[-1] = path.start_time(), path.end_time()
+    # the path's own breaks are nodes (q''' may jump there); grid nodes too close to one are dropped
+    if len(breaks):
+        spacing = np.interp(breaks, s[1:], np.diff(s))
+        near = (np.abs(s[:, None] - breaks[None, :]) < 0.3 * spacing[None, :]).any(axis=1)
+        near[[0, -1]] = False
+        s = np.sort(np.concatenate([s[~near], breaks]))
     keep = np.concatenate([[True], np.diff(s) > 1e-9 * (s[-1] - s[0])])
     s = s[keep]
     s[-1] = path.end_time()
@@ -224,7 +277,11 @@ class _Program:
         N, n = len(s), path.rows()
         h = np.diff(s)
         self.s, self.num_nodes, self.num_joints = s, N, n
-        d1, d2, d3 = _path_derivatives(path, s)
+        d1, d2, _ = _path_derivatives(path, s)
+        # q''' on each side of the nodes (it jumps at the breaks of a cubic spline)
+        offset = 1e-9 * (s[-1] - s[0])
+        after = _path_derivatives(path, np.minimum(s + offset, s[-1]))[2]
+        before = _path_derivatives(path, np.maximum(s - offset, s[0]))[2]
         self.d1, self.d2 = d1, d2
         sp = scipy.sparse
         X = sp.hstack([sp.identity(N), sp.csr_matrix((N, N))], format="csr")
@@ -247,10 +304,11 @@ class _Program:
         for j in range(n):
             accel.append(sp.diags(d2[inner, j]) @ X[inner] + sp.diags(0.5 * d1[inner, j]) @ P[inner])
             accel.append(sp.diags(m2[:, j]) @ x_mid + sp.diags(0.5 * m1[:, j]) @ p_mid)
-            node = sp.diags(d3[inner, j]) @ X[inner] + sp.diags(1.5 * d2[inner, j]) @ P[inner]
+            node = sp.diags(1.5 * d2[inner, j]) @ P[inner]
             q1 = sp.diags(0.5 * d1[inner, j])
-            jerk_rows.append(node + q1 @ curvature[1:])  # node i, on interval i (its left end)
-            jerk_rows.append(node + q1 @ curvature[:-1])  # node i, on interval i - 1 (its right end)
+            # node i on interval i (its left end), then on interval i - 1 (its right end)
+            jerk_rows.append(node + q1 @ curvature[1:] + sp.diags(after[inner, j]) @ X[inner])
+            jerk_rows.append(node + q1 @ curvature[:-1] + sp.diags(before[inner, j]) @ X[inner])
         self.accel = sp.vstack(accel, format="csr")
         self.accel_bound = LIMIT_MARGIN * np.concatenate([np.full(N - 2 + len(mid), acceleration[j]) for j in range(n)])
         self.jerk = sp.vstack(jerk_rows, format="csr")
@@ -260,8 +318,11 @@ class _Program:
             mid_bound = np.min(velocity**2 / np.maximum(m1**2, 1e-300), axis=1)
         self.velocity_bound = LIMIT_MARGIN**2 * bound
         self.velocity_bound[[0, -1]] = 0.0
-        self.mid = x_mid.tocsr()  # 0 <= x_mid <= velocity bound
-        self.mid_bound = LIMIT_MARGIN**2 * mid_bound
+        # x_mid <= the velocity bound, and x_mid >= (x_i + x_{i+1}) / 4, which keeps the quadratic
+        # x >= x_i (1 - w)² + x_{i+1} w² > 0 across the interval (w in [0, 1]): a finite time
+        self.mid = sp.vstack([x_mid, x_mid - 0.25 * (X[1:N - 2] + X[2:N - 1])], format="csr")
+        self.mid_low = np.concatenate([np.full(len(mid), -np.inf), np.zeros(len(mid))])
+        self.mid_bound = np.concatenate([LIMIT_MARGIN**2 * mid_bound, np.full(len(mid), np.inf)])
         w = np.zeros(N)
         w[:-1] += 0.5 * h
         w[1:] += 0.5 * h
@@ -273,7 +334,7 @@ class _Program:
         N = self.num_nodes
         upper = self.velocity_bound.copy()
         rows = [self.accel, self.mid, self.equality]
-        lows = [-self.accel_bound, np.zeros(self.mid.shape[0]), np.zeros(self.equality.shape[0])]
+        lows = [-self.accel_bound, self.mid_low, np.zeros(self.equality.shape[0])]
         highs = [self.accel_bound, self.mid_bound, np.zeros(self.equality.shape[0])]
         cost = np.concatenate([-self.weights, np.zeros(N)])
         if previous is not None:
@@ -391,7 +452,7 @@ def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid
             motion that leaves the path by more than :data:`PATH_TOLERANCE`.
         DrakeTrajError: malformed limits (naming the limit and the joint) or path.
     """
-    path = check_path(path)
+    path, fit = check_path(path)
     velocity, acceleration, jerk = _limits(path, velocity_limit, acceleration_limit, jerk_limit)
     max_duration = positive_scalar(max_duration, "max_duration", "s")
     s = _grid(path, velocity, acceleration, grid_points)
@@ -421,7 +482,7 @@ def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid
     limits = np.stack([velocity, acceleration, jerk])
     ratio = exact_peaks(t, coefficients) / limits
     # the repair: stretch time by k, which scales q̇, q̈, q⃛ by 1/k, 1/k², 1/k³
-    stretch = max(1.0, *(ratio.max(axis=1) ** (1.0 / np.arange(1, 4)) * (1 + 1e-9)))
+    stretch = max(1.0, *(ratio.max(axis=1) ** (1.0 / np.arange(1, 4)) * (1 + 1e-6)))
     if stretch > 1.0:
         t = t * stretch
         joint_samples = joint_samples / stretch ** np.arange(3)[None, :, None]
@@ -432,7 +493,7 @@ def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid
         k, j = np.unravel_index(np.argmax(ratio), ratio.shape)
         raise InfeasibleTimingError(f"the timed motion exceeds the {('velocity', 'acceleration', 'jerk')[k]} limit of "
                                     f"{joint_label(j)} by a factor {ratio[k, j]:.6g} after the repair", field=("path",))
-    deviation = _deviation(path, t, coefficients, path_samples)
+    deviation = fit + _deviation(path, t, coefficients, path_samples)
     if deviation > PATH_TOLERANCE:
         raise InfeasibleTimingError(
             f"the timed motion leaves the path by {deviation:.3g} rad > {PATH_TOLERANCE:g} rad (grid_points "
