@@ -42,10 +42,10 @@ def random_task(rng, scale: float):
             return q, velocity * rng.uniform(0.5, 1.5, 6), acceleration * rng.uniform(0.5, 1.5, 6)
 
 
-def measure(path, velocity, acceleration):
+def measure(path, velocity, acceleration, grid_points):
     """(T / T_opt, planning time [s], peaks over the limits (3,), path deviation [rad]) of one path."""
     start = time.perf_counter()
-    timing = time_path(path, velocity, acceleration)
+    timing = time_path(path, velocity, acceleration, grid_points=grid_points)
     planning = time.perf_counter() - start
     optimal = time_optimal_along_path(timing.path, velocity, acceleration)[0]
     return timing.duration / optimal, planning, timing.peaks.max(axis=1), timing.deviation
@@ -65,13 +65,14 @@ def main():
     parser.add_argument("--count", type=int, default=20)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--sets", nargs="+", default=["waypoints", "pajak"])
+    parser.add_argument("--grid-points", type=int, default=250)
     args = parser.parse_args()
     time_path(np.linspace(np.zeros(6), np.ones(6), 3), 1.0, 1.0)  # warm-up (imports, first calls)
     for scale in (0.7, 1.0):
         rng = np.random.default_rng([args.seed, int(scale * 10)])
         tasks = [random_task(rng, scale) for _ in range(args.count)]
         if "waypoints" in args.sets:
-            summary(f"waypoints {scale} rad", [measure(waypoint_path(q), v, a) for q, v, a in tasks])
+            summary(f"waypoints {scale} rad", [measure(waypoint_path(q), v, a, args.grid_points) for q, v, a in tasks])
         if "pajak" in args.sets:
             rows, refused = [], 0
             for q, v, a in tasks:
@@ -82,7 +83,7 @@ def main():
                 except DrakeTrajError:
                     refused += 1  # the Pająk law does not finish this task: no path to re-time
                     continue
-                rows.append(measure(samples, v, a))
+                rows.append(measure(samples, v, a, args.grid_points))
             summary(f"pajak {scale} rad", rows)
             print(f"{'':<22} ({refused} of {len(tasks)} tasks not finished by the Pająk law)")
 

@@ -179,22 +179,24 @@ def _check_reversals(samples: np.ndarray, name: str) -> None:
 
 
 def _check_corners(path: Trajectory, name: str) -> None:
+    """A corner error where q' or q'' jumps at a break of ``path`` (relative to their size)."""
     breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
     if not len(breaks):
         return
-    length = path.end_time() - path.start_time()
-    delta = 1e-9 * length
-    scale = max(np.abs(path.EvalDerivative(s, 2)).max() for s in np.linspace(path.start_time(), path.end_time(), 50))
-    for s in breaks:
-        left, right = path.EvalDerivative(s - delta, 2).ravel(), path.EvalDerivative(s + delta, 2).ravel()
-        jump = np.abs(right - left).max()
-        if jump > 1e-6 * max(scale, 1.0):
-            turn = np.dot(path.EvalDerivative(s - delta, 1).ravel(), path.EvalDerivative(s + delta, 1).ravel())
-            kind = "turns back" if turn < 0 else "is not C2"
-            raise InfeasibleTimingError(
-                f"{name} {kind} at s = {s:.6g}: q'' jumps by {jump:.3g} rad there (a corner), so q̈ would jump "
-                "unless the motion stops there; give a C2 path (e.g. PiecewisePolynomial."
-                "CubicWithContinuousSecondDerivatives) or time the parts on either side separately", field=(name,))
+    delta = 1e-9 * (path.end_time() - path.start_time())
+    s_all = np.linspace(path.start_time(), path.end_time(), 50)
+    for order, symbol in ((1, "q'"), (2, "q''")):
+        scale = max(1.0, max(np.abs(path.EvalDerivative(s, order)).max() for s in s_all))
+        for s in breaks:
+            left, right = path.EvalDerivative(s - delta, order).ravel(), path.EvalDerivative(s + delta, order).ravel()
+            jump = np.abs(right - left).max()
+            if jump > 1e-6 * scale:
+                turn = np.dot(path.EvalDerivative(s - delta, 1).ravel(), path.EvalDerivative(s + delta, 1).ravel())
+                kind = "turns back" if turn < 0 else "is not C2"
+                raise InfeasibleTimingError(
+                    f"{name} {kind} at s = {s:.6g}: {symbol} jumps by {jump:.3g} there (a corner), so q̈ would jump "
+                    "unless the motion stops there; give a C2 path (e.g. PiecewisePolynomial."
+                    "CubicWithContinuousSecondDerivatives) or time the parts on either side separately", field=(name,))
 
 
 def _check_cusps(path: Trajectory, name: str) -> None:
@@ -455,6 +457,13 @@ def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid
     path, fit = check_path(path)
     velocity, acceleration, jerk = _limits(path, velocity_limit, acceleration_limit, jerk_limit)
     max_duration = positive_scalar(max_duration, "max_duration", "s")
+    s_all = np.linspace(path.start_time(), path.end_time(), 2001)
+    travel = np.trapezoid(np.abs(path.MakeDerivative(1).vector_values(s_all)), s_all, axis=1)  # per joint [rad]
+    if not np.max(travel / velocity) <= max_duration:  # the velocity limit alone takes longer
+        j = int(np.argmax(travel / velocity))
+        raise InfeasibleTimingError(
+            f"the limits are too small for the path: {joint_label(j)} travels {travel[j]:.4g} rad at most "
+            f"{velocity[j]:.4g} rad/s (velocity_limit), longer than max_duration {max_duration:g} s", field=("path",))
     s = _grid(path, velocity, acceleration, grid_points)
     program = _Program(path, s, velocity, acceleration, jerk)
     x, p = program.solve(None, np.inf)
