@@ -221,17 +221,23 @@ def _limits(path, velocity_limit, acceleration_limit, jerk_limit):
     return velocity, acceleration, jerk
 
 
-def _grid(path, velocity, acceleration, points: int) -> np.ndarray:
+def _grid(path, velocity, acceleration, jerk, points: int) -> np.ndarray:
     """Grid nodes s: evenly spaced in the time of the bang-bang optimum (Drake's Toppra), so
-    the nodes crowd where the path is slow and near the ends (s ∝ t² there)."""
-    try:
-        optimal, trajectory = time_optimal_along_path(path, velocity, acceleration)
-    except ValueError as error:
-        raise InfeasibleTimingError(f"path: the bang-bang optimum does not exist ({error})", field=("path",)) from None
-    s_of_t = trajectory.time_scaling()
+    the nodes crowd where the path is slow and near the ends (s ∝ t² there), plus the path's
+    breaks. Where Toppra finds no parameterisation (its reachability analysis fails on some
+    paths with tight turns), the bang-bang profile of our own first linear program on nodes
+    evenly spaced in s takes its place."""
     breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
     points = max(points - len(breaks), points // 2)
-    s = np.array([s_of_t.value(t)[0, 0] for t in np.linspace(0.0, optimal, points)])
+    try:
+        optimal, trajectory = time_optimal_along_path(path, velocity, acceleration)
+        s_of_t = trajectory.time_scaling()
+        s = np.array([s_of_t.value(t)[0, 0] for t in np.linspace(0.0, optimal, points)])
+    except ValueError:
+        even = np.unique(np.concatenate([np.linspace(path.start_time(), path.end_time(), points), breaks]))
+        x, p = _Program(path, even, velocity, acceleration, jerk).solve(None, np.inf)
+        times = _node_times(even, x, p)
+        s = np.interp(np.linspace(0.0, times[-1], points), times, even)
     s = np.maximum.accumulate(np.clip(s, path.start_time(), path.end_time()))
     s[0], s[-1] = path.start_time(), path.end_time()
     # the path's own breaks are nodes (q''' may jump there); grid nodes too close to one are dropped
@@ -464,7 +470,7 @@ def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid
         raise InfeasibleTimingError(
             f"the limits are too small for the path: {joint_label(j)} travels {travel[j]:.4g} rad at most "
             f"{velocity[j]:.4g} rad/s (velocity_limit), longer than max_duration {max_duration:g} s", field=("path",))
-    s = _grid(path, velocity, acceleration, grid_points)
+    s = _grid(path, velocity, acceleration, jerk, grid_points)
     program = _Program(path, s, velocity, acceleration, jerk)
     x, p = program.solve(None, np.inf)
     done, duration = 0, np.inf
