@@ -8,7 +8,8 @@ Sets (each at moves of up to 0.7 and 1.0 rad per joint, 1-4 waypoints, random li
   kind of waypoints (``RetimedPajakConfig``'s path), for the tasks the Pająk law finishes.
 
 Run: ``python examples/bench_smooth_timing.py [--count 20] [--seed 0]``. Prints one line per set
-and scale: median, p90 and worst of T / T_opt and of the planning time [s], the largest exact
+and scale: median, p90 and worst of T / T_opt and of the planning time [s] (wall and this process's CPU: the machine may be shared), of the
+repair's stretch, the largest exact
 peak over each limit and the largest path deviation [rad].
 """
 
@@ -42,22 +43,24 @@ def random_task(rng, scale: float):
             return q, velocity * rng.uniform(0.5, 1.5, 6), acceleration * rng.uniform(0.5, 1.5, 6)
 
 
-def measure(path, velocity, acceleration, grid_points):
-    """(T / T_opt, planning time [s], peaks over the limits (3,), path deviation [rad]) of one path."""
-    start = time.perf_counter()
-    timing = time_path(path, velocity, acceleration, grid_points=grid_points)
-    planning = time.perf_counter() - start
+def measure(path, velocity, acceleration, grid_points, iterations):
+    """(T / T_opt, planning wall time [s], peaks over the limits (3,), path deviation [rad], planning
+    CPU time of this process [s], the repair's stretch) of one path."""
+    start, cpu = time.perf_counter(), time.process_time()
+    timing = time_path(path, velocity, acceleration, grid_points=grid_points, iterations=iterations)
+    planning, cpu = time.perf_counter() - start, time.process_time() - cpu
     optimal = time_optimal_along_path(timing.path, velocity, acceleration)[0]
-    return timing.duration / optimal, planning, timing.peaks.max(axis=1), timing.deviation
+    return timing.duration / optimal, planning, timing.peaks.max(axis=1), timing.deviation, cpu, timing.stretch
 
 
 def summary(name, rows):
     ratio, planning = np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
     peaks, deviation = np.array([r[2] for r in rows]), max(r[3] for r in rows)
+    cpu, stretch = np.array([r[4] for r in rows]), np.array([r[5] for r in rows])
     quantiles = lambda v: f"{np.median(v):.3f} / {np.percentile(v, 90):.3f} / {v.max():.3f}"  # noqa: E731
-    print(f"{name:<22} n={len(rows):<3} T/T_opt {quantiles(ratio)}   planning [s] {quantiles(planning)}   "
-          f"peak/limit v {peaks[:, 0].max():.4f} a {peaks[:, 1].max():.4f} j {peaks[:, 2].max():.4f}   "
-          f"deviation {deviation:.1e} rad")
+    print(f"{name:<18} n={len(rows):<3} T/T_opt {quantiles(ratio)}  planning wall [s] {quantiles(planning)}  "
+          f"CPU [s] {quantiles(cpu)}  stretch {quantiles(stretch)}  peak/limit v {peaks[:, 0].max():.4f} "
+          f"a {peaks[:, 1].max():.4f} j {peaks[:, 2].max():.4f}  deviation {deviation:.1e} rad")
 
 
 def main():
@@ -66,13 +69,14 @@ def main():
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--sets", nargs="+", default=["waypoints", "pajak"])
     parser.add_argument("--grid-points", type=int, default=250)
+    parser.add_argument("--iterations", type=int, default=8)
     args = parser.parse_args()
     time_path(np.linspace(np.zeros(6), np.ones(6), 3), 1.0, 1.0)  # warm-up (imports, first calls)
     for scale in (0.7, 1.0):
         rng = np.random.default_rng([args.seed, int(scale * 10)])
         tasks = [random_task(rng, scale) for _ in range(args.count)]
         if "waypoints" in args.sets:
-            summary(f"waypoints {scale} rad", [measure(waypoint_path(q), v, a, args.grid_points) for q, v, a in tasks])
+            summary(f"waypoints {scale} rad", [measure(waypoint_path(q), v, a, args.grid_points, args.iterations) for q, v, a in tasks])
         if "pajak" in args.sets:
             rows, refused = [], 0
             for q, v, a in tasks:
@@ -83,7 +87,7 @@ def main():
                 except DrakeTrajError:
                     refused += 1  # the Pająk law does not finish this task: no path to re-time
                     continue
-                rows.append(measure(samples, v, a, args.grid_points))
+                rows.append(measure(samples, v, a, args.grid_points, args.iterations))
             summary(f"pajak {scale} rad", rows)
             print(f"{'':<22} ({refused} of {len(tasks)} tasks not finished by the Pająk law)")
 

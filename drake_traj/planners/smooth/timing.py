@@ -46,6 +46,8 @@ PATH_TOLERANCE = 1e-4
 """The largest joint-space deviation [rad] of the timed motion from the given path."""
 LIMIT_MARGIN = 0.99
 """The linear programs aim at this share of each limit; the exact check and the repair do the rest."""
+END_JERK_MARGIN = 0.93
+"""The share of the jerk limit the programs aim at on the first and last 3 nodes."""
 TRUST_REGION = 1.3
 """x may grow by at most this factor from one linear program to the next (where √x is frozen)."""
 _REVERSAL_COSINE = -0.5  # consecutive sample steps turning by more than 120°: a reversal
@@ -320,7 +322,11 @@ class _Program:
         self.accel = sp.vstack(accel, format="csr")
         self.accel_bound = LIMIT_MARGIN * np.concatenate([np.full(N - 2 + len(mid), acceleration[j]) for j in range(n)])
         self.jerk = sp.vstack(jerk_rows, format="csr")
-        self.jerk_bound = LIMIT_MARGIN * np.repeat(jerk, 2 * (N - 2))
+        # the jerk ramps at the ends are where the pieces' jerk exceeds the nodes' most (by up to 8 %
+        # on the seeded sweeps, through the frozen √x): aim lower on the first and last 3 nodes
+        margin = np.full(N - 2, LIMIT_MARGIN)
+        margin[:3] = margin[-3:] = END_JERK_MARGIN
+        self.jerk_bound = np.concatenate([np.tile(margin, 2) * jerk[j] for j in range(n)])
         with np.errstate(divide="ignore"):
             bound = np.min(velocity**2 / np.maximum(d1**2, 1e-300), axis=1)
             mid_bound = np.min(velocity**2 / np.maximum(m1**2, 1e-300), axis=1)
