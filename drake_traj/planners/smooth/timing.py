@@ -361,12 +361,31 @@ class _Program:
         lower = np.concatenate([np.zeros(N), np.full(N, -np.inf)])
         high = np.concatenate([upper, np.full(N, np.inf)])
         lower[[N, 2 * N - 1]] = high[[N, 2 * N - 1]] = 0.0
-        constraint = scipy.optimize.LinearConstraint(scipy.sparse.vstack(rows, format="csr"), np.concatenate(lows),
-                                                     np.concatenate(highs))
-        result = scipy.optimize.milp(cost, constraints=constraint, bounds=scipy.optimize.Bounds(lower, high))
+        if previous is not None:  # the nodes next to the ends weigh nothing in the sum but their time,
+            ends = [1, 2, N - 3, N - 2]  # 3 h / √x, is long: they may fall by the trust region's factor at most
+            lower[ends] = np.minimum(previous[0][ends] / growth, high[ends])
+        # columns scaled to the last iterate (x spans 1e-6 near the ends to 1 mid-path, beyond
+        # HiGHS's absolute tolerances), 1 for the first program
+        scale = np.ones(2 * N) if previous is None else self._scale(*previous)
+        matrix = scipy.sparse.vstack(rows, format="csr") @ scipy.sparse.diags(scale)
+        constraint = scipy.optimize.LinearConstraint(matrix, np.concatenate(lows), np.concatenate(highs))
+        result = scipy.optimize.milp(cost * scale, constraints=constraint,
+                                     bounds=scipy.optimize.Bounds(lower / scale, high / scale))
+        if result.status != 0 and previous is not None and lower[1] > 0:  # without the floor at the ends
+            lower[[1, 2, N - 3, N - 2]] = 0.0
+            result = scipy.optimize.milp(cost * scale, constraints=constraint,
+                                         bounds=scipy.optimize.Bounds(lower / scale, high / scale))
         if result.status != 0:
             raise InfeasibleTimingError(f"the timing's linear program failed: {result.message}", field=("path",))
-        return np.maximum(result.x[:N], 0.0), result.x[N:]
+        z = result.x * scale
+        return np.maximum(z[:N], 0.0), z[N:]
+
+    def _scale(self, x: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """Column scales: x at the last iterate, p at the larger of its last value and x / h."""
+        h = np.diff(self.s)
+        spacing = np.minimum(np.append(h, h[-1]), np.insert(h, 0, h[0]))
+        x_scale = np.maximum(x, 1e-9 * x.max())
+        return np.concatenate([x_scale, np.maximum(np.abs(p), x_scale / spacing)])
 
 
 def _midpoints(s: np.ndarray, x: np.ndarray, p: np.ndarray):
