@@ -126,7 +126,7 @@ def sample_path(samples, max_knots: int = 200, *, name: str = "path") -> tuple[P
     Knots are spaced evenly in arc length plus turning angle (each half of the total), so a
     tight turn gets as many knots as a long straight stretch (a path from Pająk's law turns
     through tens of degrees within 0.1 mrad where it slows down). Repeated samples (closer than
-    1e-9 rad) are dropped. Where the spline strays from a sample by more than a fifth of
+    1e-9 rad) are dropped. Where the spline strays from a sample by more than half of
     :data:`PATH_TOLERANCE`, the knots are doubled (up to 4 × ``max_knots``).
 
     Raises:
@@ -154,12 +154,12 @@ def sample_path(samples, max_knots: int = 200, *, name: str = "path") -> tuple[P
                 PiecewisePolynomial.CubicWithContinuousSecondDerivatives(chord, q[index].T, periodic_end_condition=False))
         at = np.interp(arc, arc[index], chord)  # each sample's parameter, by arc length between knots
         deviation = float(np.abs(path.vector_values(at).T - q).max())
-        if deviation <= 0.2 * PATH_TOLERANCE or knots >= 4 * max_knots or len(index) == len(q):
+        if deviation <= 0.5 * PATH_TOLERANCE or knots >= 4 * max_knots or len(index) == len(q):
             break
         knots *= 2
-    if deviation > 0.2 * PATH_TOLERANCE:
+    if deviation > 0.5 * PATH_TOLERANCE:
         raise InfeasibleTimingError(f"{name}: no spline through {len(index)} of its samples stays within "
-                                    f"{0.2 * PATH_TOLERANCE:g} rad of them ({deviation:.3g} rad): the samples are "
+                                    f"{0.5 * PATH_TOLERANCE:g} rad of them ({deviation:.3g} rad): the samples are "
                                     "too sparse or too noisy for a C2 path", field=(name,))
     return path, deviation
 
