@@ -8,7 +8,7 @@ from pydrake.trajectories import PiecewisePolynomial
 from scipy.spatial import cKDTree
 
 from drake_traj import PajakConfig, RetimedPajakConfig, RuckigConfig, SmoothWaypointsConfig, get_robot, simulate
-from drake_traj.bench import joint_waypoints, paper_task
+from drake_traj.bench import paper_task
 from drake_traj.errors import DrakeTrajError
 from drake_traj.planners import make_planner
 from drake_traj.planners.baselines.toppra import time_optimal_along_path
@@ -60,8 +60,8 @@ def test_limits_hold_at_every_millisecond_and_at_the_exact_peaks(timed):
         peaks = exact_peaks(breaks, coefficients)
         assert np.all(peaks <= limits * (1 + 1e-9)), peaks / limits
         assert np.all(sampled <= peaks * (1 + 1e-9))  # no sample above the exact peak
-        assert np.all(peaks >= 0.9 * sampled)
-        assert np.all(peaks.max(axis=1) / limits.max(axis=1) > 0.0)
+        # and the 1 ms samples come close to it (jerk moves fastest between samples: 1.5 % of its limit)
+        assert np.all(peaks <= sampled + np.array([[1e-3], [1e-3], [2e-2]]) * limits)
         # some limit is reached within 2 %: the motion is not just slow
         assert (peaks / limits).max() > 0.98
 

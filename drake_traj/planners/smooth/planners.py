@@ -14,7 +14,7 @@ from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.planners.baselines.ruckig import default_jerk_limit
 from drake_traj.planners.pajak import PajakConfig, PajakPlanner
 from drake_traj.planners.smooth.timing import SmoothTiming, time_path
-from drake_traj.robots import UR10E, Robot
+from drake_traj.robots import Robot
 from drake_traj.validation import instance_of, limit_or_default, positive_vector, whole_number
 
 __all__ = ["RetimedPajakConfig", "SmoothPlanner", "SmoothWaypointsConfig", "make_retimed_pajak",

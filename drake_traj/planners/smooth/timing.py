@@ -292,7 +292,6 @@ class _Program:
         offset = 1e-9 * (s[-1] - s[0])
         after = _path_derivatives(path, np.minimum(s + offset, s[-1]))[2]
         before = _path_derivatives(path, np.maximum(s - offset, s[0]))[2]
-        self.d1, self.d2 = d1, d2
         sp = scipy.sparse
         X = sp.hstack([sp.identity(N), sp.csr_matrix((N, N))], format="csr")
         P = sp.hstack([sp.csr_matrix((N, N)), sp.identity(N)], format="csr")
