@@ -12,14 +12,13 @@ Along the path (' = d/ds):
 
 - q̇ = q' ṡ, so |q̇_j| <= v_j is the bound x <= v_j² / q'_j²;
 - q̈ = q' x' / 2 + q'' x (linear in x);
-- q⃛ = √x (q''' x + 1.5 q'' x' + 0.5 q' x'') (Palleschi et al. 2019, eq. 9), linear in x once
-  √x is frozen at the previous iterate: the sequential LP.
+- q⃛ = √x (q''' x + 1.5 q'' x' + 0.5 q' x''), linear in x once √x is frozen at the previous
+  iterate: the sequential LP (Palleschi et al. 2019's linearisation).
 
-The derivatives x', x'' at a grid node are those of the quadratic through the node and its two
-neighbours. At the ends the motion starts (and stops) with constant path jerk, s = j t³ / 6, so
-x = (9 j² / 4)^(1/3) ... ∝ s^(4/3): at the node next to an end x' = 4 x / (3 h) and
-x'' = 4 x / (9 h²) (h its distance to the end), q̈(0) = 0 and the time of the end interval is
-3 h / √x. Between interior nodes x is linear in s (Δt = 2 h / (√x_i + √x_{i+1})).
+Our discretisation: x and x' at every node, x quadratic in s between nodes (so s̈ = x' / 2 is
+continuous). At the ends the motion starts (and stops) with a constant path jerk, s = j t³ / 6,
+so x ∝ distance^(4/3): at the node next to an end x' = ±4 x / (3 h) and x'' = 4 x / (9 h²) (h its
+distance to the end), q̈ = 0 at the end and the end interval lasts 3 h / √x.
 """
 
 from __future__ import annotations
@@ -71,9 +70,10 @@ class SmoothTiming:
         path: the geometric path q(s) that was timed.
         stretch: the factor (>= 1) the repair stretched the time by so every limit holds (1: none).
         peaks: max |q̇|, |q̈|, |q⃛| over the limit per joint, exact ((3, n)).
-        deviation: a bound [rad] of the largest joint deviation from the given path: the spline's
-            from the samples (0 for a Trajectory) plus the pieces' from the spline (against q(s(t))
-            with s(t) the same Hermite interpolation of the path speed, 4 points per piece).
+        deviation: the largest joint deviation [rad] from the given path, as checked: the
+            spline's from every sample (0 for a Trajectory) plus the pieces' from the spline at 4
+            points inside every piece (against q(s(t)), s(t) the same Hermite interpolation of
+            the path speed, which bounds the distance to the path at those points).
         iterations: linear programs solved.
     """
 
