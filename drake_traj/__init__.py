@@ -13,7 +13,7 @@ Planner configs (``PajakConfig``, ``QuinticConfig``, ...) build planners with
 from drake_traj.station import add_station, build_station, make_station, run_station, simulate
 from drake_traj.errors import Cause, DrakeTrajError, Failure, PlanningError, SingularConfigurationError
 from drake_traj.planners import (BorygaConfig, LiConfig, MovejConfig, PajakConfig, QuinticConfig,
-                                 RuckigConfig, ToppraConfig)
+                                 RetimedPajakConfig, RuckigConfig, SmoothWaypointsConfig, ToppraConfig)
 from drake_traj.result import Metrics, SimulationResult
 from drake_traj.robots import Robot, get_robot
 from drake_traj.scenario import ControllerGains, Scenario, SpeedOverride, load_scenario, make_planner, preflight
@@ -23,6 +23,7 @@ from drake_traj.version import __version__
 __all__ = [
     "add_station", "BorygaConfig", "build_station", "Cause", "ControllerGains", "DrakeTrajError", "Failure",
     "get_robot", "LiConfig", "load_scenario", "make_planner", "make_station", "Metrics", "MovejConfig",
-    "PajakConfig", "PlanningError", "preflight", "QuinticConfig", "Robot", "RuckigConfig", "run_station", "Scenario",
-    "simulate", "SimulationResult", "SingularConfigurationError", "SpeedOverride", "ToppraConfig",
+    "PajakConfig", "PlanningError", "preflight", "QuinticConfig", "RetimedPajakConfig", "Robot", "RuckigConfig",
+    "run_station", "Scenario", "simulate", "SimulationResult", "SingularConfigurationError", "SmoothWaypointsConfig",
+    "SpeedOverride", "ToppraConfig",
 ]

@@ -8,6 +8,9 @@ through the same PD-controlled UR10e, with the UR joint-move limits (1.05 rad/s,
 - ``movej_blend``: UR-style joint moves with a 0.05 m blend radius;
 - ``quintic_stop``: synchronised quintic moves (Benotsmane et al.) through the IK of the waypoints;
 - ``ruckig_stop``: Ruckig's jerk-limited moves through the same joint waypoints;
+- ``smooth_waypoints``: the smooth path through the same joint waypoints, timed jerk-limited and
+  near time-optimal without stopping (docs/smooth_timing.md);
+- ``pajak_retimed``: the joint path of ``pajak_blend``'s preflight, timed the same way;
 - ``toppra``: Drake's Toppra, time-optimal along the geometric path of ``pajak_blend``.
 
 Columns: T; T over Toppra's time-optimal T on the planner's own path; max |qd| and |qdd| over
@@ -63,7 +66,9 @@ from drake_traj.planners import (
     MovejConfig,
     PajakConfig,
     QuinticConfig,
+    RetimedPajakConfig,
     RuckigConfig,
+    SmoothWaypointsConfig,
     ToppraConfig,
     make_planner,
 )
@@ -171,12 +176,22 @@ def ruckig_stop_config(poses, joints):
     return RuckigConfig(goals=joints[1:].tolist())
 
 
+def smooth_waypoints_config(poses, joints):
+    return SmoothWaypointsConfig(goals=joints[1:].tolist())
+
+
+def pajak_retimed_config(poses, joints):
+    return RetimedPajakConfig(pajak=PajakConfig(waypoints=poses, blend_waypoints=True))
+
+
 CONFIG_BUILDERS = {
     "pajak_blend": pajak_blend_config,
     "pajak_stop": pajak_stop_config,
     "movej_blend": movej_blend_config,
     "quintic_stop": quintic_stop_config,
     "ruckig_stop": ruckig_stop_config,
+    "smooth_waypoints": smooth_waypoints_config,
+    "pajak_retimed": pajak_retimed_config,
 }
 PLANNERS = (*CONFIG_BUILDERS, "toppra")
 

@@ -4,7 +4,8 @@ slows it, keeps its limits and its q̈ continuity, and it still reaches its goal
 import numpy as np
 import pytest
 
-from drake_traj import BorygaConfig, LiConfig, MovejConfig, QuinticConfig, RuckigConfig, ToppraConfig, get_robot, simulate
+from drake_traj import (BorygaConfig, LiConfig, MovejConfig, PajakConfig, QuinticConfig, RetimedPajakConfig, RuckigConfig,
+                        SmoothWaypointsConfig, ToppraConfig, get_robot, simulate)
 from drake_traj.bench import joint_waypoints, paper_task
 from drake_traj.planners import make_planner
 from drake_traj.scenario import SpeedOverride
@@ -15,6 +16,8 @@ CASES = {
     "quintic": (QuinticConfig(goals=JOINTS[1:3].tolist()), True),
     "ruckig": (RuckigConfig(goals=JOINTS[1:3].tolist()), True),
     "movej": (MovejConfig(goals=JOINTS[1:3].tolist(), blend_radius=0.05), False),  # its blends jump by design
+    "smooth_waypoints": (SmoothWaypointsConfig(goals=JOINTS[1:3].tolist()), True),
+    "pajak_retimed": (RetimedPajakConfig(pajak=PajakConfig(waypoints=paper_task()[1][:2])), True),
     "toppra": (ToppraConfig(path=np.linspace(JOINTS[0], JOINTS[1], 50)[1:].tolist(), grid_points=1000), False),
     "boryga": (BorygaConfig(velocity_limit=[1.05] * 6, acceleration_limit=[1.40] * 6), False),  # v²/R jumps at the arc
     "li": (LiConfig(points=(np.array([[0.0, 0.0, 0.0], [0.04, 0.0, 0.0], [0.04, 0.03, 0.0]])
@@ -35,7 +38,8 @@ def test_override_to_half_speed_mid_motion(name):
     slowed = simulate(planner, settle_time=0.1, speed_override=SpeedOverride([step], [0.5]))
     assert free.succeeded and slowed.succeeded, slowed.failure
     # Measured T [s] without -> with: boryga 2.691 -> 4.311 (c to 0.151, half its cap), li 2.594 -> 4.116,
-    # movej 2.416 -> 3.749, quintic 3.307 -> 5.309, ruckig 2.962 -> 4.428, toppra 1.623 -> 2.465.
+    # movej 2.416 -> 3.749, quintic 3.307 -> 5.309, ruckig 2.962 -> 4.428, toppra 1.623 -> 2.465,
+    # smooth_waypoints 2.502 -> 3.955, pajak_retimed 2.677 -> 4.225.
     # c goes towards half the planner's speed cap as fast as the acceleration limits allow (a
     # time-optimal law can slow down only where no joint is braking at its limit), and stays there.
     goal = 0.5 * getattr(planner, "speed_cap", 1.0)

@@ -18,12 +18,14 @@ from drake_traj.planners.baselines.toppra import ToppraConfig
 from drake_traj.planners.li import LiConfig
 from drake_traj.planners.pajak import PajakConfig
 from drake_traj.planners.quintic import QuinticConfig
+from drake_traj.planners.smooth import planners as smooth
+from drake_traj.planners.smooth.planners import RetimedPajakConfig, SmoothWaypointsConfig
 from drake_traj.robots.base import Robot
 from drake_traj.validation import finite_array, instance_of
 
 __all__ = [
     "BorygaConfig", "LiConfig", "MovejConfig", "PLANNER_CONFIGS", "PajakConfig", "PlannerConfig", "PlannerSystem",
-    "QuinticConfig", "RuckigConfig", "ToppraConfig", "make_planner",
+    "QuinticConfig", "RetimedPajakConfig", "RuckigConfig", "SmoothWaypointsConfig", "ToppraConfig", "make_planner",
 ]
 
 # Each config type and the ``make(config, robot, q_initial)`` that builds its planner.
@@ -35,9 +37,12 @@ _MAKERS = {
     MovejConfig: movej.make,
     RuckigConfig: ruckig.make,
     ToppraConfig: toppra.make,
+    SmoothWaypointsConfig: smooth.make_smooth_waypoints,
+    RetimedPajakConfig: smooth.make_retimed_pajak,
 }
 PLANNER_CONFIGS = tuple(_MAKERS)
-PlannerConfig = Union[QuinticConfig, PajakConfig, BorygaConfig, LiConfig, MovejConfig, RuckigConfig, ToppraConfig]
+PlannerConfig = Union[QuinticConfig, PajakConfig, BorygaConfig, LiConfig, MovejConfig, RuckigConfig, ToppraConfig,
+                      SmoothWaypointsConfig, RetimedPajakConfig]
 
 
 def make_planner(config: PlannerConfig, robot: Robot, q_initial) -> PlannerSystem:

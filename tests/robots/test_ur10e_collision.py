@@ -267,7 +267,8 @@ def start_configurations():
 
 def test_start_configurations_have_no_self_contact(arm):
     starts = start_configurations()
-    assert len(starts) == 8  # home + boryga_loop_ur10e, fixture_cell, li_closed_path_ur10e, pajak_sim1..3, quintic_ptp
+    assert len(starts) == 10  # home + boryga_loop_ur10e, fixture_cell, li_closed_path_ur10e, pajak_sim1..3,
+    # pajak_retimed, quintic_ptp, smooth_waypoints
     for name, q in starts.items():
         pairs = distances(arm, q)
         closest = self_pairs(pairs)[0]

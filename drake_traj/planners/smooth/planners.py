@@ -1,0 +1,164 @@
+"""The smooth timing (:func:`~drake_traj.planners.smooth.timing.time_path`) as planners: through
+joint waypoints without stopping (:class:`SmoothWaypointsConfig`), and the joint path of Pająk
+2024's preflight re-timed (:class:`RetimedPajakConfig`). Both are time-law planners (speed
+override, station, preflight and cell checks as for every time law)."""
+
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.trajectories import PiecewisePolynomial
+
+from drake_traj.errors import Cause, DrakeTrajError, joint_label
+from drake_traj.planners.base import TimeLawPlanner, start_and_goals
+from drake_traj.planners.baselines.ruckig import default_jerk_limit
+from drake_traj.planners.pajak import PajakConfig, PajakPlanner
+from drake_traj.planners.smooth.timing import SmoothTiming, time_path
+from drake_traj.robots import Robot
+from drake_traj.validation import instance_of, limit_or_default, positive_vector, whole_number
+
+__all__ = ["RetimedPajakConfig", "SmoothPlanner", "SmoothWaypointsConfig", "make_retimed_pajak",
+           "make_smooth_waypoints", "waypoint_path"]
+
+
+class SmoothPlanner(TimeLawPlanner):
+    """A :class:`SmoothTiming` run as a time law.
+
+    Args:
+        timing: the timed motion.
+        velocity_limit, acceleration_limit, jerk_limit: the limits it was timed under, per joint.
+        tool_waypoints: tool positions [m] the task passes through (base frame), (m, 3), for plots.
+        speed_cap, update_period: as :class:`TimeLawPlanner`.
+    """
+
+    def __init__(self, timing: SmoothTiming, velocity_limit, acceleration_limit, jerk_limit, *,
+                 tool_waypoints=None, speed_cap: float = 1.0, update_period: float = 0.001):
+        instance_of(timing, SmoothTiming, "timing")
+        n = len(timing.law.q_start)
+        super().__init__(timing.law, positive_vector(velocity_limit, "velocity_limit", n),
+                         positive_vector(acceleration_limit, "acceleration_limit", n), speed_cap=speed_cap,
+                         update_period=update_period)
+        self.timing = timing
+        self.jerk_limit = positive_vector(jerk_limit, "jerk_limit", n)
+        self._tool_waypoints = np.zeros((0, 3)) if tool_waypoints is None else np.asarray(tool_waypoints, float)
+
+    def task_waypoints(self) -> np.ndarray:
+        return self._tool_waypoints.copy()
+
+
+def waypoint_path(q_waypoints) -> PiecewisePolynomial:
+    """The C2 path through joint waypoints (m + 1, n) [rad]: the not-a-knot cubic spline with the
+    centripetal parameter (s grows by the square root of each chord's length [rad], which bulges
+    less past a waypoint where joints reverse than the chord length: 2 % shorter motions on
+    seeded tasks); the straight segment for one move. Repeated waypoints are dropped."""
+    q = np.asarray(q_waypoints, dtype=float)
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(q, axis=0), axis=1) > 1e-9])
+    q = q[keep]
+    if len(q) < 2:
+        raise DrakeTrajError("goals: every goal equals the start: there is no path to time", field=("goals",))
+    chord = np.concatenate([[0.0], np.cumsum(np.sqrt(np.linalg.norm(np.diff(q, axis=0), axis=1)))])
+    if len(q) == 2:
+        return PiecewisePolynomial.FirstOrderHold(chord, q.T)
+    return PiecewisePolynomial.CubicWithContinuousSecondDerivatives(chord, q.T, periodic_end_condition=False)
+
+
+def _check_joint_range(path, robot: Robot, name: str) -> None:
+    """A JOINT_RANGE error naming the joint where the path leaves the robot's position range."""
+    s = np.linspace(path.start_time(), path.end_time(), 1001)
+    q = path.vector_values(s).T
+    low, high = robot.lower_limits, robot.upper_limits
+    outside = (q < low) | (q > high)
+    if np.any(outside):
+        k, j = np.argwhere(outside)[0]
+        raise DrakeTrajError(
+            f"{name}: the smooth path through them leaves the range of {joint_label(j)} ([{low[j]:.4g}, {high[j]:.4g}] "
+            f"rad) with q = {q[k, j]:.4g} rad at s = {s[k]:.4g} rad of {s[-1]:.4g}: move the waypoints inwards",
+            field=(name,), cause=Cause.JOINT_RANGE)
+
+
+def _timed(path, name: str, velocity, acceleration, jerk, grid_points: int) -> SmoothTiming:
+    try:
+        return time_path(path, velocity, acceleration, jerk, grid_points=grid_points)
+    except DrakeTrajError as error:
+        if error.field[:1] == ("path",):
+            raise error.relocated((name, *error.field[1:]), f"{name}: {error}") from None
+        raise
+
+
+@dataclass
+class SmoothWaypointsConfig:
+    """Through joint waypoints without stopping, jerk-limited and near time-optimal: the
+    scenario's ``planner: !SmoothWaypointsConfig`` entry.
+
+    Attributes:
+        goals: joint waypoints after the start [rad], one row of n per waypoint.
+        velocity_limit, acceleration_limit: per joint; empty: the robot's joint-move limits.
+        jerk_limit: per joint [rad/s³]; empty: 10 /s × the acceleration limit.
+        grid_points: nodes of the timing's linear programs.
+    """
+
+    goals: list[list[float]] = field(default_factory=list)
+    velocity_limit: list[float] = field(default_factory=list)
+    acceleration_limit: list[float] = field(default_factory=list)
+    jerk_limit: list[float] = field(default_factory=list)
+    grid_points: int = 200
+
+
+def _limits(config, robot: Robot, velocity=None, acceleration=None):
+    n = robot.num_joints
+    default_velocity, default_acceleration = robot.joint_move_limits
+    velocity = limit_or_default(config.velocity_limit if velocity is None else velocity, default_velocity,
+                                "velocity_limit", n)
+    acceleration = limit_or_default(config.acceleration_limit if acceleration is None else acceleration,
+                                    default_acceleration, "acceleration_limit", n)
+    jerk = limit_or_default(config.jerk_limit, default_jerk_limit(acceleration), "jerk_limit", n)
+    return velocity, acceleration, jerk
+
+
+def make_smooth_waypoints(config: SmoothWaypointsConfig, robot: Robot, q_initial) -> SmoothPlanner:
+    """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]."""
+    q = start_and_goals(q_initial, config.goals, robot.num_joints)
+    velocity, acceleration, jerk = _limits(config, robot)
+    path = waypoint_path(q)
+    _check_joint_range(path, robot, "goals")
+    timing = _timed(path, "goals", velocity, acceleration, jerk,
+                    whole_number(config.grid_points, "grid_points", minimum=20))
+    return SmoothPlanner(timing, velocity, acceleration, jerk, tool_waypoints=robot.tool_position(q[1:]))
+
+
+@dataclass
+class RetimedPajakConfig:
+    """Pająk 2024's task-space path, re-timed: the joint path of the Pająk planner's preflight (its
+    ``plan()``), timed jerk-limited and near time-optimal under its own velocity and acceleration
+    limits: the scenario's ``planner: !RetimedPajakConfig`` entry.
+
+    Attributes:
+        pajak: the Pająk task and settings that make the path (its limits are the timing's).
+        jerk_limit: per joint [rad/s³]; empty: 10 /s × the acceleration limit.
+        grid_points: nodes of the timing's linear programs.
+    """
+
+    pajak: PajakConfig = field(default_factory=PajakConfig)
+    jerk_limit: list[float] = field(default_factory=list)
+    grid_points: int = 250
+
+
+def pajak_joint_path(config: PajakConfig, robot: Robot, q_initial) -> np.ndarray:
+    """The joint samples [rad] (N, n) of the Pająk planner's planned motion (its preflight, one
+    sample per update period up to the finish), the path the re-timed planner times."""
+    plan = PajakPlanner(config, q_initial, robot=robot).plan()
+    return plan.vector_values(plan.get_segment_times()).T
+
+
+def make_retimed_pajak(config: RetimedPajakConfig, robot: Robot, q_initial) -> SmoothPlanner:
+    """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]: raises what the Pająk
+    preflight raises (an unreachable waypoint, a stall, ...) and what the timing raises."""
+    instance_of(config.pajak, PajakConfig, "pajak")
+    samples = pajak_joint_path(config.pajak, robot, q_initial)
+    n = robot.num_joints
+    velocity, acceleration, jerk = _limits(config, robot, np.broadcast_to(config.pajak.velocity_limit, (n,)),
+                                           np.broadcast_to(config.pajak.acceleration_limit, (n,)))
+    timing = _timed(samples, "pajak", velocity, acceleration, jerk,
+                    whole_number(config.grid_points, "grid_points", minimum=20))
+    return SmoothPlanner(timing, velocity, acceleration, jerk,
+                         tool_waypoints=np.asarray(config.pajak.waypoints, dtype=float)[:, :3])

@@ -1,0 +1,541 @@
+"""Smooth, jerk-limited, near-time-optimal timing of a joint path (docs/smooth_timing.md).
+
+Given a joint path q(s) and per-joint limits on |q̇|, |q̈| and |q⃛|, :func:`time_path` finds a
+path speed profile x(s) = ṡ² by a sequence of linear programs (Palleschi et al. 2019, RA-L,
+"Time-optimal path tracking for jerk controlled robots"; the velocity and acceleration constraints
+are the TOPP-RA ones of Pham & Pham 2018, linear in x) and returns the motion as quintic Hermite
+pieces in time, C2 (q̈ continuous), at rest at both ends, with every limit checked at the exact
+peaks of every piece. Joint positions in rad, s the path parameter (joint-space arc length for
+a path made from samples), t in s.
+
+Along the path (' = d/ds):
+
+- q̇ = q' ṡ, so |q̇_j| <= v_j is the bound x <= v_j² / q'_j²;
+- q̈ = q' x' / 2 + q'' x (linear in x);
+- q⃛ = √x (q''' x + 1.5 q'' x' + 0.5 q' x''), linear in x once √x is frozen at the previous
+  iterate: the sequential LP (Palleschi et al. 2019's linearisation).
+
+Our discretisation: x and x' at every node, x quadratic in s between nodes (so s̈ = x' / 2 is
+continuous). At the ends the motion starts (and stops) with a constant path jerk, s = j t³ / 6,
+so x ∝ distance^(4/3): at the node next to an end x' = ±4 x / (3 h) and x'' = 4 x / (9 h²) (h its
+distance to the end), q̈ = 0 at the end and the end interval lasts 3 h / √x.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import comb
+
+import numpy as np
+import scipy.optimize
+import scipy.sparse
+from pydrake.trajectories import PiecewisePolynomial, Trajectory
+
+from drake_traj.errors import Cause, DrakeTrajError, joint_label
+from drake_traj.planners.base import piecewise_trajectory
+from drake_traj.planners.baselines.ruckig import default_jerk_limit
+from drake_traj.planners.baselines.toppra import time_optimal_along_path
+from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coefficients
+from drake_traj.planners.laws.polynomials import rate_peaks
+from drake_traj.validation import positive_scalar, positive_vector, real_array, require_finite
+
+__all__ = ["InfeasibleTimingError", "SmoothTiming", "check_path", "exact_peaks", "time_path"]
+
+PATH_TOLERANCE = 1e-4
+"""The largest joint-space deviation [rad] of the timed motion from the given path."""
+LIMIT_MARGIN = 0.99
+"""The linear programs aim at this share of each limit; the exact check and the repair do the rest."""
+END_JERK_MARGIN = 0.93
+"""The share of the jerk limit the programs aim at on the first and last 3 nodes."""
+TRUST_REGION = 1.3
+"""x may grow by at most this factor from one linear program to the next (where √x is frozen)."""
+_REVERSAL_COSINE = -0.5  # consecutive sample steps turning by more than 120°: a reversal
+
+
+class InfeasibleTimingError(DrakeTrajError):
+    """The path cannot be timed under the given limits (a cusp, a corner, limits too small)."""
+
+    default_cause = Cause.INFEASIBLE
+
+
+@dataclass(frozen=True)
+class SmoothTiming:
+    """The timed motion.
+
+    Attributes:
+        law: the motion as a time law (:class:`HermiteLaw`, quintic pieces between ``knots``)
+            for a :class:`~drake_traj.planners.base.TimeLawPlanner`.
+        trajectory: the same motion as Drake's PiecewisePolynomial q(t) [rad], t in [0, duration].
+        duration: T [s].
+        path: the geometric path q(s) that was timed.
+        stretch: the factor (>= 1) the repair stretched the time by so every limit holds (1: none).
+        peaks: max |q̇|, |q̈|, |q⃛| over the limit per joint, exact ((3, n)).
+        deviation: the largest joint deviation [rad] from the given path, as checked: the
+            spline's from every sample (0 for a Trajectory) plus the pieces' from the spline at 4
+            points inside every piece (against q(s(t)), s(t) the same Hermite interpolation of
+            the path speed, which bounds the distance to the path at those points).
+        iterations: linear programs solved.
+    """
+
+    law: HermiteLaw
+    trajectory: PiecewisePolynomial
+    duration: float
+    path: Trajectory
+    stretch: float
+    peaks: np.ndarray
+    deviation: float
+    iterations: int
+
+
+def check_path(path, name: str = "path") -> tuple[Trajectory, float]:
+    """``path`` as a Drake Trajectory q(s) and its largest deviation from what was given [rad]:
+    a Trajectory as it is (0), joint samples (N, n) as the C2 cubic spline through knots picked
+    from them (:func:`sample_path`).
+
+    Raises:
+        InfeasibleTimingError: samples that turn back (two consecutive steps more than 120°
+            apart: a cusp or a joint reversal at a corner), a Trajectory whose q'' jumps at a
+            break (a corner: q̈ would jump there) or whose q' vanishes (a cusp).
+        DrakeTrajError: wrong shapes or non-finite samples.
+    """
+    if isinstance(path, Trajectory):
+        if path.cols() != 1 or path.rows() < 1:
+            raise DrakeTrajError(f"{name} must be a trajectory of one column (n x 1), got {path.rows()} x {path.cols()}",
+                                 field=(name,))
+        if not path.end_time() > path.start_time():
+            raise DrakeTrajError(f"{name} must have a positive length in s, got [{path.start_time()}, {path.end_time()}]",
+                                 field=(name,))
+        _check_corners(path, name)
+        fit = 0.0
+    else:
+        samples = real_array(path, name, "rad")
+        if samples.ndim != 2 or samples.shape[0] < 2 or samples.shape[1] < 1:
+            raise DrakeTrajError(f"{name} must be joint samples of shape (N, n) with N >= 2, got shape {samples.shape}",
+                                 field=(name,))
+        require_finite(samples, name, "rad")
+        _check_reversals(samples, name)
+        path, fit = sample_path(samples, name=name)
+    _check_cusps(path, name)
+    return path, fit
+
+
+def sample_path(samples, max_knots: int = 200, *, name: str = "path") -> tuple[PiecewisePolynomial, float]:
+    """The C2 cubic spline q(s) through knots picked from joint samples (N, n) [rad], s the
+    arc length through the knots [rad], and its largest deviation from the samples [rad].
+
+    Knots are spaced evenly in arc length plus turning angle (each half of the total), so a
+    tight turn gets as many knots as a long straight stretch (a path from Pająk's law turns
+    through tens of degrees within 0.1 mrad where it slows down). Repeated samples (closer than
+    1e-9 rad) are dropped. Where the spline strays from a sample by more than half of
+    :data:`PATH_TOLERANCE`, the knots are doubled (up to 4 × ``max_knots``).
+
+    Raises:
+        InfeasibleTimingError: fewer than two distinct samples, or a spline that still strays.
+    """
+    q = np.asarray(samples, dtype=float)
+    step = np.linalg.norm(np.diff(q, axis=0), axis=1)
+    q = q[np.concatenate([[True], step > 1e-9])]
+    if len(q) < 2:
+        raise InfeasibleTimingError(f"{name} must hold at least 2 distinct configurations", field=(name,))
+    steps = np.diff(q, axis=0)
+    length = np.linalg.norm(steps, axis=1)
+    arc = np.concatenate([[0.0], np.cumsum(length)])
+    if len(q) == 2:
+        return PiecewisePolynomial.FirstOrderHold(arc, q.T), 0.0
+    unit = steps / length[:, None]
+    turn = np.arccos(np.clip(np.sum(unit[1:] * unit[:-1], axis=1), -1.0, 1.0))
+    measure = arc + np.concatenate([[0.0], np.cumsum(turn), [turn.sum()]]) * (arc[-1] / max(turn.sum(), 1e-12))
+    knots = max_knots
+    while True:
+        index = np.unique(np.concatenate([[0, len(q) - 1],
+                                          np.searchsorted(measure, np.linspace(0, measure[-1], knots)).clip(0, len(q) - 1)]))
+        chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(q[index], axis=0), axis=1))])
+        path = (PiecewisePolynomial.FirstOrderHold(chord, q[index].T) if len(index) == 2 else
+                PiecewisePolynomial.CubicWithContinuousSecondDerivatives(chord, q[index].T, periodic_end_condition=False))
+        at = np.interp(arc, arc[index], chord)  # each sample's parameter, by arc length between knots
+        deviation = float(np.abs(path.vector_values(at).T - q).max())
+        if deviation <= 0.5 * PATH_TOLERANCE or knots >= 4 * max_knots or len(index) == len(q):
+            break
+        knots *= 2
+    if deviation > 0.5 * PATH_TOLERANCE:
+        raise InfeasibleTimingError(f"{name}: no spline through {len(index)} of its samples stays within "
+                                    f"{0.5 * PATH_TOLERANCE:g} rad of them ({deviation:.3g} rad): the samples are "
+                                    "too sparse or too noisy for a C2 path", field=(name,))
+    return path, deviation
+
+
+def _check_reversals(samples: np.ndarray, name: str) -> None:
+    steps = np.diff(samples, axis=0)
+    steps = steps[np.linalg.norm(steps, axis=1) > 1e-9]
+    if len(steps) < 2:
+        return
+    unit = steps / np.linalg.norm(steps, axis=1)[:, None]
+    cosine = np.sum(unit[1:] * unit[:-1], axis=1)
+    if np.any(cosine < _REVERSAL_COSINE):
+        k = int(np.argmax(cosine < _REVERSAL_COSINE)) + 1
+        angle = np.degrees(np.arccos(np.clip(cosine[k - 1], -1, 1)))
+        raise InfeasibleTimingError(
+            f"{name} turns back by {angle:.0f}° at its distinct sample {k}: a cusp or a joint reversal at a corner, "
+            "which no motion with continuous q̈ passes without stopping; split the path there and time each part",
+            field=(name, k))
+
+
+def _check_corners(path: Trajectory, name: str) -> None:
+    """A corner error where q' or q'' jumps at a break of ``path`` (relative to their size)."""
+    breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
+    if not len(breaks):
+        return
+    delta = 1e-9 * (path.end_time() - path.start_time())
+    s_all = np.linspace(path.start_time(), path.end_time(), 50)
+    for order, symbol in ((1, "q'"), (2, "q''")):
+        scale = max(1.0, max(np.abs(path.EvalDerivative(s, order)).max() for s in s_all))
+        for s in breaks:
+            left, right = path.EvalDerivative(s - delta, order).ravel(), path.EvalDerivative(s + delta, order).ravel()
+            jump = np.abs(right - left).max()
+            if jump > 1e-6 * scale:
+                turn = np.dot(path.EvalDerivative(s - delta, 1).ravel(), path.EvalDerivative(s + delta, 1).ravel())
+                kind = "turns back" if turn < 0 else "is not C2"
+                raise InfeasibleTimingError(
+                    f"{name} {kind} at s = {s:.6g}: {symbol} jumps by {jump:.3g} there (a corner), so q̈ would jump "
+                    "unless the motion stops there; give a C2 path (e.g. PiecewisePolynomial."
+                    "CubicWithContinuousSecondDerivatives) or time the parts on either side separately", field=(name,))
+
+
+def _check_cusps(path: Trajectory, name: str) -> None:
+    s = np.linspace(path.start_time(), path.end_time(), 2001)
+    speed = np.array([np.linalg.norm(path.EvalDerivative(v, 1)) for v in s])
+    typical = np.median(speed)
+    if not typical > 0:
+        raise InfeasibleTimingError(f"{name} does not move: |q'(s)| is 0 along it", field=(name,))
+    if speed.min() < 1e-3 * typical:
+        k = int(np.argmin(speed))
+        raise InfeasibleTimingError(
+            f"{name} has a cusp at s = {s[k]:.6g}: |q'(s)| = {speed[k]:.3g} there, against {typical:.3g} typical "
+            "(the path stops and turns, where the timing would need an infinite path acceleration); split the path "
+            "there and time each part", field=(name,))
+
+
+def _limits(path, velocity_limit, acceleration_limit, jerk_limit):
+    n = path.rows()
+    velocity = positive_vector(velocity_limit, "velocity_limit", n)
+    acceleration = positive_vector(acceleration_limit, "acceleration_limit", n)
+    jerk = default_jerk_limit(acceleration) if jerk_limit is None else positive_vector(jerk_limit, "jerk_limit", n)
+    return velocity, acceleration, jerk
+
+
+def _grid(path, velocity, acceleration, jerk, points: int) -> np.ndarray:
+    """Grid nodes s: evenly spaced in the time of the bang-bang optimum (Drake's Toppra), so
+    the nodes crowd where the path is slow and near the ends (s ∝ t² there), plus the path's
+    breaks. Where Toppra finds no parameterisation (its reachability analysis fails on some
+    paths with tight turns), the bang-bang profile of our own first linear program on nodes
+    evenly spaced in s takes its place."""
+    breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
+    points = max(points - len(breaks), points // 2)
+    try:
+        optimal, trajectory = time_optimal_along_path(path, velocity, acceleration)
+        s_of_t = trajectory.time_scaling()
+        s = np.array([s_of_t.value(t)[0, 0] for t in np.linspace(0.0, optimal, points)])
+    except ValueError:
+        even = np.unique(np.concatenate([np.linspace(path.start_time(), path.end_time(), points), breaks]))
+        x, p = _Program(path, even, velocity, acceleration, jerk).solve(None, np.inf)
+        times = _node_times(even, x, p)
+        s = np.interp(np.linspace(0.0, times[-1], points), times, even)
+    s = np.maximum.accumulate(np.clip(s, path.start_time(), path.end_time()))
+    s[0], s[-1] = path.start_time(), path.end_time()
+    # the path's own breaks are nodes (q''' may jump there); grid nodes too close to one are dropped
+    if len(breaks):
+        spacing = np.interp(breaks, s[1:], np.diff(s))
+        near = (np.abs(s[:, None] - breaks[None, :]) < 0.3 * spacing[None, :]).any(axis=1)
+        near[[0, -1]] = False
+        s = np.sort(np.concatenate([s[~near], breaks]))
+    keep = np.concatenate([[True], np.diff(s) > 1e-9 * (s[-1] - s[0])])
+    s = s[keep]
+    s[-1] = path.end_time()
+    return s
+
+
+def _path_derivatives(path, s):
+    """First, second and third derivatives of q(s) at ``s``, each (N, n)."""
+    return [np.array([path.EvalDerivative(v, k).ravel() for v in s]) for k in (1, 2, 3)]
+
+
+_GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(8)
+
+
+def _node_times(s: np.ndarray, x: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """t at the nodes [s]: on the end intervals 3 h / √x (constant path jerk, x ∝ distance^(4/3));
+    between interior nodes the integral of ds / √x with x the quadratic of (x, x') at both ends
+    (8-point Gauss-Legendre)."""
+    h = np.diff(s)
+    u = 0.5 * (1 + _GAUSS_NODES)[None, :] * h[:, None]  # (N-1, 8)
+    curvature = (p[1:] - p[:-1]) / h
+    inside = x[:-1, None] + p[:-1, None] * u + 0.5 * curvature[:, None] * u**2
+    dt = 0.5 * h * (_GAUSS_WEIGHTS / np.sqrt(np.maximum(inside, 1e-300))).sum(axis=1)
+    dt[0] = 3 * h[0] / np.sqrt(x[1])
+    dt[-1] = 3 * h[-1] / np.sqrt(x[-2])
+    return np.concatenate([[0.0], np.cumsum(dt)])
+
+
+class _Program:
+    """The linear program of one iteration, in z = [x (N), p (N)], x = ṡ² and p = x' = 2 s̈ at the
+    nodes, x quadratic in s between interior nodes (so s̈ is continuous): maximise the sum of x
+    weighted by the grid spacing subject to the velocity bound, the acceleration at the nodes and
+    between them, and the jerk at both ends of every interval with √x frozen at the previous
+    iterate (the linearisation of Palleschi et al. 2019)."""
+
+    def __init__(self, path, s, velocity, acceleration, jerk):
+        N, n = len(s), path.rows()
+        h = np.diff(s)
+        self.s, self.num_nodes, self.num_joints = s, N, n
+        d1, d2, _ = _path_derivatives(path, s)
+        # q''' on each side of the nodes (it jumps at the breaks of a cubic spline)
+        offset = 1e-9 * (s[-1] - s[0])
+        after = _path_derivatives(path, np.minimum(s + offset, s[-1]))[2]
+        before = _path_derivatives(path, np.maximum(s - offset, s[0]))[2]
+        sp = scipy.sparse
+        X = sp.hstack([sp.identity(N), sp.csr_matrix((N, N))], format="csr")
+        P = sp.hstack([sp.csr_matrix((N, N)), sp.identity(N)], format="csr")
+        inner = slice(1, N - 1)
+        # x'' on every interval: (p_{i+1} - p_i) / h inside, 4 x / (9 h²) at the node next to an end
+        curvature = sp.diags(1 / h) @ (P[1:] - P[:-1])
+        curvature = sp.vstack([X[1] * (4 / (9 * h[0] ** 2)), curvature[1:-1], X[N - 2] * (4 / (9 * h[-1] ** 2))],
+                              format="csr")
+        # continuity of x (interior intervals) and the end laws p = ±4 x / (3 h)
+        continuity = (X[2:N - 1] - X[1:N - 2]) - sp.diags(0.5 * h[1:-1]) @ (P[1:N - 2] + P[2:N - 1])
+        self.equality = sp.vstack([continuity, P[1] - X[1] * (4 / (3 * h[0])), P[N - 2] + X[N - 2] * (4 / (3 * h[-1]))],
+                                  format="csr")
+        mid = 0.5 * (s[1:-2] + s[2:-1])  # interior intervals 1..N-3
+        m1, m2 = _path_derivatives(path, mid)[:2]
+        hm = h[1:-1]
+        x_mid = X[1:N - 2] + sp.diags(hm / 8) @ (3 * P[1:N - 2] + P[2:N - 1])
+        p_mid = 0.5 * (P[1:N - 2] + P[2:N - 1])
+        accel, jerk_rows = [], []
+        for j in range(n):
+            accel.append(sp.diags(d2[inner, j]) @ X[inner] + sp.diags(0.5 * d1[inner, j]) @ P[inner])
+            accel.append(sp.diags(m2[:, j]) @ x_mid + sp.diags(0.5 * m1[:, j]) @ p_mid)
+            node = sp.diags(1.5 * d2[inner, j]) @ P[inner]
+            q1 = sp.diags(0.5 * d1[inner, j])
+            # node i on interval i (its left end), then on interval i - 1 (its right end)
+            jerk_rows.append(node + q1 @ curvature[1:] + sp.diags(after[inner, j]) @ X[inner])
+            jerk_rows.append(node + q1 @ curvature[:-1] + sp.diags(before[inner, j]) @ X[inner])
+        self.accel = sp.vstack(accel, format="csr")
+        self.accel_bound = LIMIT_MARGIN * np.concatenate([np.full(N - 2 + len(mid), acceleration[j]) for j in range(n)])
+        self.jerk = sp.vstack(jerk_rows, format="csr")
+        # the jerk ramps at the ends are where the pieces' jerk exceeds the nodes' most (by up to 8 %
+        # on the seeded sweeps, through the frozen √x): aim lower on the first and last 3 nodes
+        margin = np.full(N - 2, LIMIT_MARGIN)
+        margin[:3] = margin[-3:] = END_JERK_MARGIN
+        self.jerk_bound = np.concatenate([np.tile(margin, 2) * jerk[j] for j in range(n)])
+        with np.errstate(divide="ignore"):
+            bound = np.min(velocity**2 / np.maximum(d1**2, 1e-300), axis=1)
+            mid_bound = np.min(velocity**2 / np.maximum(m1**2, 1e-300), axis=1)
+        self.velocity_bound = LIMIT_MARGIN**2 * bound
+        self.velocity_bound[[0, -1]] = 0.0
+        # x_mid <= the velocity bound, and x_mid >= (x_i + x_{i+1}) / 4, which keeps the quadratic
+        # x >= x_i (1 - w)² + x_{i+1} w² > 0 across the interval (w in [0, 1]): a finite time
+        self.mid = sp.vstack([x_mid, x_mid - 0.25 * (X[1:N - 2] + X[2:N - 1])], format="csr")
+        self.mid_low = np.concatenate([np.full(len(mid), -np.inf), np.zeros(len(mid))])
+        self.mid_bound = np.concatenate([LIMIT_MARGIN**2 * mid_bound, np.full(len(mid), np.inf)])
+        w = np.zeros(N)
+        w[:-1] += 0.5 * h
+        w[1:] += 0.5 * h
+        self.weights = w
+
+    def solve(self, previous, growth: float) -> tuple[np.ndarray, np.ndarray]:
+        """(x, p) of the LP; without ``previous`` (x, p) the jerk is left out (a bang-bang profile
+        with continuous s̈); with it, x grows by at most the factor ``growth`` (the trust region)."""
+        N = self.num_nodes
+        upper = self.velocity_bound.copy()
+        rows = [self.accel, self.mid, self.equality]
+        lows = [-self.accel_bound, self.mid_low, np.zeros(self.equality.shape[0])]
+        highs = [self.accel_bound, self.mid_bound, np.zeros(self.equality.shape[0])]
+        cost = np.concatenate([-self.weights, np.zeros(N)])
+        if previous is not None:
+            x_previous = previous[0]
+            root = np.sqrt(np.maximum(x_previous[1:-1], 0.0))
+            rows.append(scipy.sparse.diags(np.tile(root, 2 * self.num_joints)) @ self.jerk)
+            lows.append(-self.jerk_bound)
+            highs.append(self.jerk_bound)
+            upper = np.minimum(upper, growth * x_previous)
+        lower = np.concatenate([np.zeros(N), np.full(N, -np.inf)])
+        high = np.concatenate([upper, np.full(N, np.inf)])
+        lower[[N, 2 * N - 1]] = high[[N, 2 * N - 1]] = 0.0
+        if previous is not None:  # the nodes next to the ends weigh nothing in the sum but their time,
+            ends = [1, 2, N - 3, N - 2]  # 3 h / √x, is long: they may fall by the trust region's factor at most
+            lower[ends] = np.minimum(previous[0][ends] / growth, high[ends])
+        # columns scaled to the last iterate (x spans 1e-6 near the ends to 1 mid-path, beyond
+        # HiGHS's absolute tolerances), 1 for the first program
+        scale = np.ones(2 * N) if previous is None else self._scale(*previous)
+        matrix = scipy.sparse.vstack(rows, format="csr") @ scipy.sparse.diags(scale)
+        constraint = scipy.optimize.LinearConstraint(matrix, np.concatenate(lows), np.concatenate(highs))
+        result = scipy.optimize.milp(cost * scale, constraints=constraint,
+                                     bounds=scipy.optimize.Bounds(lower / scale, high / scale))
+        if result.status != 0 and previous is not None and lower[1] > 0:  # without the floor at the ends
+            lower[[1, 2, N - 3, N - 2]] = 0.0
+            result = scipy.optimize.milp(cost * scale, constraints=constraint,
+                                         bounds=scipy.optimize.Bounds(lower / scale, high / scale))
+        if result.status != 0:
+            raise InfeasibleTimingError(f"the timing's linear program failed: {result.message}", field=("path",))
+        z = result.x * scale
+        return np.maximum(z[:N], 0.0), z[N:]
+
+    def _scale(self, x: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """Column scales: x at the last iterate, p at the larger of its last value and x / h."""
+        h = np.diff(self.s)
+        spacing = np.minimum(np.append(h, h[-1]), np.insert(h, 0, h[0]))
+        x_scale = np.maximum(x, 1e-9 * x.max())
+        return np.concatenate([x_scale, np.maximum(np.abs(p), x_scale / spacing)])
+
+
+def _midpoints(s: np.ndarray, x: np.ndarray, p: np.ndarray):
+    """(s, x, p, time from the interval's start [s]) at the middle (in s) of every interval: x
+    quadratic inside, x ∝ distance^(4/3) on the end intervals."""
+    h = np.diff(s)
+    half = 0.5 * h
+    curvature = (p[1:] - p[:-1]) / h
+    x_mid = x[:-1] + p[:-1] * half + 0.5 * curvature * half**2
+    p_mid = p[:-1] + curvature * half
+    u = 0.5 * (1 + _GAUSS_NODES)[None, :] * half[:, None]
+    inside = x[:-1, None] + p[:-1, None] * u + 0.5 * curvature[:, None] * u**2
+    dt = 0.5 * half * (_GAUSS_WEIGHTS / np.sqrt(np.maximum(inside, 1e-300))).sum(axis=1)
+    x_mid[0], x_mid[-1] = x[1] * 2 ** (-4 / 3), x[-2] * 2 ** (-4 / 3)
+    p_mid[0], p_mid[-1] = 8 * x_mid[0] / (3 * h[0]), -8 * x_mid[-1] / (3 * h[-1])
+    dt[0] = 3 * h[0] * 2 ** (-1 / 3) / np.sqrt(x[1])
+    dt[-1] = 3 * h[-1] * (1 - 2 ** (-1 / 3)) / np.sqrt(x[-2])
+    return s[:-1] + half, x_mid, p_mid, dt
+
+
+def _samples(path, program: _Program, x: np.ndarray, p: np.ndarray):
+    """(t, [q, q̇, q̈] (K, 3, n), [s, ṡ, s̈] (K, 3)) at the nodes and the middle of every interval
+    (the knots of the pieces), at rest at both ends."""
+    nodes = _node_times(program.s, x, p)
+    s_mid, x_mid, p_mid, dt_mid = _midpoints(program.s, x, p)
+    order = np.argsort(np.concatenate([program.s, s_mid]), kind="stable")
+    s = np.concatenate([program.s, s_mid])[order]
+    x = np.concatenate([x, x_mid])[order]
+    p = np.concatenate([p, p_mid])[order]
+    t = np.concatenate([nodes, nodes[:-1] + dt_mid])[order]
+    d1, d2 = _path_derivatives(path, s)[:2]
+    rate = np.sqrt(np.maximum(x, 0.0))
+    q = np.array([path.value(v).ravel() for v in s])
+    qd = d1 * rate[:, None]
+    qdd = d1 * (0.5 * p)[:, None] + d2 * x[:, None]
+    return t, np.stack([q, qd, qdd], axis=1), np.stack([s, rate, 0.5 * p], axis=1)
+
+
+def exact_peaks(knots, coefficients) -> np.ndarray:
+    """max |q̇|, |q̈|, |q⃛| per joint over piecewise quintics (monomial ``coefficients`` (K, 6, n)
+    in t - knots[k]), exact to round-off: (3, n)."""
+    knots = np.asarray(knots, dtype=float)
+    half = 0.5 * np.diff(knots)[:, None]
+    c = np.moveaxis(np.asarray(coefficients, dtype=float), 1, 0)  # (6, K, n)
+    # q in sigma in [-1, 1], t - knot = half (1 + sigma): binomial expansion
+    position = np.stack([sum(comb(j, k) * c[j] * half**j for j in range(k, 6)) for k in range(6)])
+    velocity = np.stack([(k + 1) * position[k + 1] / half for k in range(5)])
+    acceleration = np.stack([(k + 1) * velocity[k + 1] / half for k in range(4)])
+    jerk = np.stack([(k + 1) * acceleration[k + 1] / half for k in range(3)])  # quadratic
+    v_peak, _, a_peak, _ = rate_peaks(velocity, acceleration)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = np.where(jerk[2] != 0, -jerk[1] / (2 * jerk[2]), np.nan)
+    vertex = np.where(np.abs(vertex) <= 1, vertex, np.nan)
+    candidates = [np.abs(jerk[0] - jerk[1] + jerk[2]), np.abs(jerk[0] + jerk[1] + jerk[2]),
+                  np.nan_to_num(np.abs(jerk[0] + jerk[1] * vertex + jerk[2] * vertex**2), nan=0.0)]
+    j_peak = np.max(candidates, axis=0)
+    return np.stack([v_peak.max(axis=0), a_peak.max(axis=0), j_peak.max(axis=0)])
+
+
+def _deviation(path, knots, joint_coefficients, path_samples) -> float:
+    """Upper bound [rad] of the distance of the pieces from the path: at 4 points inside every
+    piece, |q_piece(t) - q(s_piece(t))|, s_piece the quintic Hermite of (s, ṡ, s̈)."""
+    s_coefficients = quintic_hermite_coefficients(knots, path_samples[:, :, None], path_samples[:, :, None])
+    worst = 0.0
+    fractions = np.array([0.2, 0.4, 0.6, 0.8])
+    h = np.diff(knots)
+    for k in range(len(h)):
+        tau = fractions * h[k]
+        powers = tau[:, None] ** np.arange(6)
+        q = powers @ joint_coefficients[k]
+        s = np.clip(powers @ s_coefficients[k, :, 0], path.start_time(), path.end_time())
+        on_path = np.array([path.value(v).ravel() for v in s])
+        worst = max(worst, float(np.abs(q - on_path).max()))
+    return worst
+
+
+def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 250,
+              iterations: int = 8, max_duration: float = 600.0) -> SmoothTiming:
+    """Time ``path`` from rest to rest under per-joint velocity, acceleration and jerk limits.
+
+    Args:
+        path: a Drake Trajectory q(s) (n x 1, C2: q'' may not jump at a break) or joint samples
+            (N, n) [rad] in path order (:func:`check_path`).
+        velocity_limit, acceleration_limit: per joint [rad/s, rad/s²], > 0 (scalar or (n,)).
+        jerk_limit: per joint [rad/s³], > 0; None: 10 /s × the acceleration limit.
+        grid_points: nodes of the linear programs (more: closer to the optimum, slower).
+        iterations: the most linear programs with the jerk (they stop once T shortens by < 0.2 %).
+        max_duration: the longest motion accepted [s]: limits so small that the motion would
+            last longer are refused.
+
+    Returns:
+        :class:`SmoothTiming`: the law, the Drake trajectory and what was checked.
+
+    Raises:
+        InfeasibleTimingError: a cusp or a corner (:func:`check_path`), limits too small for the
+            path (a motion longer than ``max_duration``), a linear program that fails, or a
+            motion that leaves the path by more than :data:`PATH_TOLERANCE`.
+        DrakeTrajError: malformed limits (naming the limit and the joint) or path.
+    """
+    path, fit = check_path(path)
+    velocity, acceleration, jerk = _limits(path, velocity_limit, acceleration_limit, jerk_limit)
+    max_duration = positive_scalar(max_duration, "max_duration", "s")
+    s_all = np.linspace(path.start_time(), path.end_time(), 2001)
+    travel = np.trapezoid(np.abs(path.MakeDerivative(1).vector_values(s_all)), s_all, axis=1)  # per joint [rad]
+    if not np.max(travel / velocity) <= max_duration:  # the velocity limit alone takes longer
+        j = int(np.argmax(travel / velocity))
+        raise InfeasibleTimingError(
+            f"the limits are too small for the path: {joint_label(j)} travels {travel[j]:.4g} rad at most "
+            f"{velocity[j]:.4g} rad/s (velocity_limit), longer than max_duration {max_duration:g} s", field=("path",))
+    s = _grid(path, velocity, acceleration, jerk, grid_points)
+    program = _Program(path, s, velocity, acceleration, jerk)
+    x, p = program.solve(None, np.inf)
+    done, duration = 0, np.inf
+    for done in range(1, iterations + 1):
+        candidate = program.solve((x, p), TRUST_REGION)
+        if not np.all(candidate[0][1:-1] > 0):  # a degenerate iterate: keep the last good one
+            break
+        x, p = candidate
+        shorter = 1 - (updated := _node_times(s, x, p)[-1]) / duration
+        duration = updated
+        if done >= 4 and abs(shorter) < 2e-3:
+            break
+    if not np.all(x[1:-1] > 0):
+        k = int(np.argmin(x[1:-1])) + 1
+        raise InfeasibleTimingError(
+            f"the limits are too small for the path: the path speed falls to 0 at s = {s[k]:.6g} (velocity_limit, "
+            "acceleration_limit or jerk_limit)", field=("path",))
+    t, joint_samples, path_samples = _samples(path, program, x, p)
+    if not t[-1] <= max_duration:
+        raise InfeasibleTimingError(
+            f"the limits are too small for the path: the motion would last {t[-1]:.4g} s > max_duration "
+            f"{max_duration:g} s (velocity_limit, acceleration_limit or jerk_limit)", field=("path",))
+    coefficients = quintic_hermite_coefficients(t, joint_samples, joint_samples)
+    limits = np.stack([velocity, acceleration, jerk])
+    ratio = exact_peaks(t, coefficients) / limits
+    # the repair: stretch time by k, which scales q̇, q̈, q⃛ by 1/k, 1/k², 1/k³
+    stretch = max(1.0, *(ratio.max(axis=1) ** (1.0 / np.arange(1, 4)) * (1 + 1e-6)))
+    if stretch > 1.0:
+        t = t * stretch
+        joint_samples = joint_samples / stretch ** np.arange(3)[None, :, None]
+        path_samples = path_samples / stretch ** np.arange(3)[None, :]
+        coefficients = quintic_hermite_coefficients(t, joint_samples, joint_samples)
+        ratio = exact_peaks(t, coefficients) / limits
+    if not np.all(ratio <= 1.0):
+        k, j = np.unravel_index(np.argmax(ratio), ratio.shape)
+        raise InfeasibleTimingError(f"the timed motion exceeds the {('velocity', 'acceleration', 'jerk')[k]} limit of "
+                                    f"{joint_label(j)} by a factor {ratio[k, j]:.6g} after the repair", field=("path",))
+    deviation = fit + _deviation(path, t, coefficients, path_samples)
+    if deviation > PATH_TOLERANCE:
+        raise InfeasibleTimingError(
+            f"the timed motion leaves the path by {deviation:.3g} rad > {PATH_TOLERANCE:g} rad (grid_points "
+            f"{grid_points} too few for this path's curvature: give more)", field=("path",))
+    law = HermiteLaw(t, joint_samples, joint_samples)
+    return SmoothTiming(law, piecewise_trajectory(t, coefficients), float(t[-1]), path, stretch, ratio, deviation, done)

@@ -1,0 +1,96 @@
+"""The smooth timing (issue 22, docs/smooth_timing.md) against the bang-bang optimum on the same
+path (Drake's Toppra), on seeded random tasks: T / T_opt, planning time, limits and path deviation.
+
+Sets (each at moves of up to 0.7 and 1.0 rad per joint, 1-4 waypoints, random limits):
+
+- ``waypoints``: the smooth path through the joint waypoints (``SmoothWaypointsConfig``'s path);
+- ``pajak``: the joint path of the Pająk 2024 preflight through the flange poses of the same
+  kind of waypoints (``RetimedPajakConfig``'s path), for the tasks the Pająk law finishes.
+
+Run: ``python examples/bench_smooth_timing.py [--count 20] [--seed 0]``. Prints one line per set
+and scale: median, p90 and worst of T / T_opt and of the planning time [s] (wall and this process's CPU: the machine may be shared), of the
+repair's stretch, the largest exact
+peak over each limit and the largest path deviation [rad].
+"""
+
+import argparse
+import time
+
+import numpy as np
+
+from drake_traj import PajakConfig, get_robot
+from drake_traj.errors import DrakeTrajError
+from drake_traj.planners.baselines.toppra import time_optimal_along_path
+from drake_traj.planners.pajak import paper_initial_configuration
+from drake_traj.planners.smooth.planners import pajak_joint_path, waypoint_path
+from drake_traj.planners.smooth.timing import time_path
+from drake_traj.robots import ur10e
+
+ROBOT = get_robot("ur10e")
+
+
+def random_task(rng, scale: float):
+    """(joint waypoints (m + 1, 6) from the Pająk start, velocity, acceleration limits): 1-4
+    waypoints, each up to ``scale`` rad per joint from the previous one, away from singularities
+    and inside the joint ranges; limits uniform in [0.5, 1.5] × the UR joint-move limits."""
+    velocity, acceleration = ROBOT.joint_move_limits
+    while True:
+        q = [paper_initial_configuration()]
+        for _ in range(rng.integers(1, 5)):
+            q.append(q[-1] + rng.uniform(-scale, scale, 6))
+        q = np.array(q)
+        if all(ur10e.singularity_measure(c) > 0.15 for c in q[1:]) and np.all((q >= ROBOT.lower_limits) & (q <= ROBOT.upper_limits)):
+            return q, velocity * rng.uniform(0.5, 1.5, 6), acceleration * rng.uniform(0.5, 1.5, 6)
+
+
+def measure(path, velocity, acceleration, grid_points, iterations):
+    """(T / T_opt, planning wall time [s], peaks over the limits (3,), path deviation [rad], planning
+    CPU time of this process [s], the repair's stretch) of one path."""
+    start, cpu = time.perf_counter(), time.process_time()
+    timing = time_path(path, velocity, acceleration, grid_points=grid_points, iterations=iterations)
+    planning, cpu = time.perf_counter() - start, time.process_time() - cpu
+    optimal = time_optimal_along_path(timing.path, velocity, acceleration)[0]
+    return timing.duration / optimal, planning, timing.peaks.max(axis=1), timing.deviation, cpu, timing.stretch
+
+
+def summary(name, rows):
+    ratio, planning = np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
+    peaks, deviation = np.array([r[2] for r in rows]), max(r[3] for r in rows)
+    cpu, stretch = np.array([r[4] for r in rows]), np.array([r[5] for r in rows])
+    quantiles = lambda v: f"{np.median(v):.3f} / {np.percentile(v, 90):.3f} / {v.max():.3f}"  # noqa: E731
+    print(f"{name:<18} n={len(rows):<3} T/T_opt {quantiles(ratio)}  planning wall [s] {quantiles(planning)}  "
+          f"CPU [s] {quantiles(cpu)}  stretch {quantiles(stretch)}  peak/limit v {peaks[:, 0].max():.4f} "
+          f"a {peaks[:, 1].max():.4f} j {peaks[:, 2].max():.4f}  deviation {deviation:.1e} rad")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--count", type=int, default=20)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--sets", nargs="+", default=["waypoints", "pajak"])
+    parser.add_argument("--grid-points", type=int, default=250)
+    parser.add_argument("--iterations", type=int, default=8)
+    args = parser.parse_args()
+    time_path(np.linspace(np.zeros(6), np.ones(6), 3), 1.0, 1.0)  # warm-up (imports, first calls)
+    for scale in (0.7, 1.0):
+        rng = np.random.default_rng([args.seed, int(scale * 10)])
+        tasks = [random_task(rng, scale) for _ in range(args.count)]
+        if "waypoints" in args.sets:
+            summary(f"waypoints {scale} rad", [measure(waypoint_path(q), v, a, args.grid_points, args.iterations) for q, v, a in tasks])
+        if "pajak" in args.sets:
+            rows, refused = [], 0
+            for q, v, a in tasks:
+                poses = np.array([ur10e.task_pose(c) for c in q[1:]])
+                config = PajakConfig(waypoints=poses, velocity_limit=v, acceleration_limit=a)
+                try:
+                    samples = pajak_joint_path(config, ROBOT, q[0])
+                except DrakeTrajError:
+                    refused += 1  # the Pająk law does not finish this task: no path to re-time
+                    continue
+                rows.append(measure(samples, v, a, args.grid_points, args.iterations))
+            summary(f"pajak {scale} rad", rows)
+            print(f"{'':<22} ({refused} of {len(tasks)} tasks not finished by the Pająk law)")
+
+
+if __name__ == "__main__":
+    main()
