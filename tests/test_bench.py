@@ -143,3 +143,56 @@ def test_the_plot_has_the_task_count_in_its_title_and_a_legend_on_each_panel(row
     # a box over fewer runs than tasks (a failed run has no value) says how many
     labels = [label.get_text() for label in bench.bench_figure(cluster_rows).axes[0].get_xticklabels()]
     assert labels == ["pajak_blend", "quintic_stop", "toppra", "broken\n(0 of 2)"]
+
+
+def independent_optimal_time(path, velocity: float, acceleration: float, points: int = 3000) -> float:
+    """Time-optimal duration along ``path`` (a Drake trajectory q(s)) from rest to rest under
+    |q̇_j| <= velocity, |q̈_j| <= acceleration, by the classic numerical integration on x = ṡ²
+    (forward at the largest s̈, backward at the smallest, under the maximum-velocity curve found
+    by bisection): our own computation, not Drake's Toppra."""
+    s = np.linspace(path.start_time(), path.end_time(), points)
+    step = s[1] - s[0]
+    first = np.array([path.EvalDerivative(x, 1).ravel() for x in s])
+    second = np.array([path.EvalDerivative(x, 2).ravel() for x in s])
+    moving = np.abs(first) > 1e-12
+
+    def accelerations(x, at=slice(None)):
+        """(lowest, highest) s̈ at the grid points ``at`` for ṡ² = x (q̈ = q' s̈ + q'' x)."""
+        slope, bias, free = first[at], second[at] * np.asarray(x)[..., None], moving[at]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            upper = np.where(free, (np.sign(slope) * acceleration - bias) / slope, np.inf)
+            lower = np.where(free, (-np.sign(slope) * acceleration - bias) / slope, -np.inf)
+        blocked = np.any(~free & (np.abs(bias) > acceleration), axis=-1)
+        return np.where(blocked, np.inf, lower.max(axis=-1)), np.where(blocked, -np.inf, upper.min(axis=-1))
+
+    with np.errstate(divide="ignore"):
+        ceiling = np.min(np.where(moving, (velocity / np.abs(first)) ** 2, np.inf), axis=1)
+    low, high = np.zeros(points), ceiling.copy()
+    for _ in range(60):  # the largest x with an admissible s̈ (the feasible x form an interval from 0)
+        middle = 0.5 * (low + high)
+        lowest, highest = accelerations(middle)
+        feasible = lowest <= highest
+        low, high = np.where(feasible, middle, low), np.where(feasible, high, middle)
+    ceiling = low
+    x = np.zeros(points)
+    for k in range(points - 1):  # accelerate
+        x[k + 1] = min(ceiling[k + 1], x[k] + 2 * step * max(accelerations(x[k], k)[1], 0.0))
+    x[-1] = 0.0
+    for k in range(points - 1, 0, -1):  # decelerate
+        x[k - 1] = min(x[k - 1], x[k] - 2 * step * min(accelerations(x[k], k)[0], 0.0))
+    rates = np.sqrt(np.maximum(x, 0.0))
+    return float(np.sum(2 * step / (rates[1:] + rates[:-1])))
+
+
+def test_the_optimal_and_jerk_columns_against_our_own_computation():
+    # pajak_blend on the paper task: T_over_optimal is T over the time-optimal T along its own
+    # path (Toppra in the bench; here our own integration on ṡ², same spline of the path), and
+    # max_jerk the largest rate of change of the reference q̈ (here third differences of q)
+    task = bench.tasks(count=0, repeats=1)[0]
+    output = bench.run_planner(task, "pajak_blend", bench.CONFIG_BUILDERS["pajak_blend"], keep_path=True)
+    row, path = output["row"], output["path"]
+    optimal = independent_optimal_time(bench.geometric_path_from_samples(path), bench.VELOCITY, bench.ACCELERATION)
+    assert row["T_over_optimal"] == pytest.approx(row["T_s"] / optimal, rel=0.01)
+    assert row["optimal_failure"] == ""
+    jerk = np.abs(np.diff(path, 3, axis=0)).max() / 1e-3**3
+    assert row["max_jerk"] == pytest.approx(jerk, rel=0.01)
