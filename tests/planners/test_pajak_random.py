@@ -12,6 +12,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from drake_traj.bench import pajak_walk_tasks
 from drake_traj.planners import pajak as P
 from drake_traj.planners.pajak.kernel import Discrete
 from drake_traj.robots import ur10e as robot
@@ -22,27 +23,10 @@ TOL = 1e-9  # floating-point slack on "limit held"
 
 
 def random_tasks(count: int = 200, seed: int = 9) -> list[P.PajakConfig]:
-    """``count`` valid tasks (tasks validate() refuses are drawn again), seeded. The law is
-    integrated alone here, without the arm's body or a cell: the set is not filtered for
-    collisions, so that the measured set (README "Beyond the paper's task") stays the same."""
-    rng = np.random.default_rng(seed)
-    tasks = []
-    while len(tasks) < count:
-        configurations = [Q0]
-        for _ in range(int(rng.integers(1, 5))):
-            configurations.append(configurations[-1] + rng.uniform(-0.7, 0.7, 6))
-        if rng.integers(0, 2):
-            velocity, acceleration = rng.uniform(0.5, 2.0, 6), rng.uniform(0.7, 3.0, 6)
-        else:
-            velocity, acceleration = np.full(6, rng.uniform(0.5, 2.0)), np.full(6, rng.uniform(0.7, 3.0))
-        task = P.PajakConfig(waypoints=np.array([robot.task_pose(q) for q in configurations[1:]]),
-                             velocity_limit=velocity, acceleration_limit=acceleration)
-        try:
-            task.validate()
-        except ValueError:  # e.g. two waypoints closer than the neighbourhood
-            continue
-        tasks.append(task)
-    return tasks
+    """``count`` valid tasks of moves of up to 0.7 rad per joint, seeded (bench.pajak_walk_tasks).
+    The law is integrated alone here, without the arm's body or a cell: the set is not filtered
+    for collisions, so that the measured set (README "Beyond the paper's task") stays the same."""
+    return pajak_walk_tasks(count, seed, step=0.7)
 
 
 def largest_step(qdd: np.ndarray) -> float:
