@@ -53,7 +53,7 @@ def test_qdd_continuous_on_moves_of_1_rad(index):
 def test_the_wrapped_orientation_error_made_qdd_jump():
     # task 106 passes near the Euler angles' gimbal lock (cos φ_Y = 0.003), where φ_Z turns fast
     # and its error passes π: wrapped to (-π, π] (the paper's reading), e jumps by 2π and q̈ by
-    # 1.44 rad/s² within 1 ms and within 0.5 ms alike (measured); on its branch (improvement 5)
+    # 1.44 rad/s² within 1 ms and within 0.5 ms alike (measured); on its branch (improvement 6)
     # e is continuous (0.063 rad/s² in 1 ms)
     task = TASKS[106]
     _, ours = finished_run(task)

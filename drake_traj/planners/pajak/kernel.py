@@ -92,7 +92,7 @@ Discrete = _layout("Discrete", [
     ("BRAKE", 1), ("BRAKE_SLOPE", 1),  # fallback braking weight at the last update and its slope [1/s]
     ("SATURATED", 1),  # updates at which the limits overruled the law (improvement 2)
     ("APPROACH", 1),  # approach rate of improvement 4 at the last update (0 where unused) [1/s]
-    ("BRANCH", 1),  # 1 once ERROR and FINAL_ERROR hold the last update's orientation errors (improvement 5)
+    ("BRANCH", 1),  # 1 once ERROR and FINAL_ERROR hold the last update's orientation errors (improvement 6)
     ("ERROR", 3), ("FINAL_ERROR", 3),  # orientation part of e (eq. 6/19) and of the error to p_w there [rad]
     ("HELD_BY", 1), ("HELD_BY_VELOCITY", 1),  # Evaluation.HOLDING(_VELOCITY) when the limits last set c (the anchor)
 ])
@@ -108,7 +108,7 @@ Evaluation = _layout("Evaluation", [
     ("POSITION_ERROR", 1), ("ORIENTATION_ERROR", 1),  # to the active waypoint (update_kernel) [m, rad]
     ("REMAINING", 1),  # remaining path to p_w (update_kernel) [m]
     ("APPROACH", 1),  # approach rate the damping of improvement 4 is sized for (0 where unused) [1/s]
-    ("ERROR", 3), ("FINAL_ERROR", 3),  # orientation part of e and of the error to p_w (improvement 5) [rad]
+    ("ERROR", 3), ("FINAL_ERROR", 3),  # orientation part of e and of the error to p_w (improvement 6) [rad]
     ("HOLDING", 1),  # the joint whose limit bounds c lowest (limits.holding_joint; -1: none below 1)
     ("HOLDING_VELOCITY", 1),  # 1 where that bound is its velocity limit's viability bound, 0 its acceleration limit
 ])
@@ -480,7 +480,7 @@ def _evaluate_kernel(dependencies):
         error_rate = np.empty(6)
         final = np.empty(6)  # the error to p_w (improvement 4's approach rate)
         goal = i if p[Parameter.BLEND_WAYPOINTS] == 0.0 else last
-        # improvement 5: each orientation component on the branch (a multiple of 2π) nearest to its
+        # improvement 6: each orientation component on the branch (a multiple of 2π) nearest to its
         # value at the last update, so that it is continuous where it passes ±π (wrapped to the
         # shortest branch it jumps by 2π there, and q̈ with it: by up to 3.8 rad/s² in 1 ms on
         # moves of 1 rad per joint, where φ_X and φ_Z turn fast near the Euler angles' gimbal lock)

@@ -54,7 +54,7 @@ class PajakConfig:
         damped_inverse: improvement 3, damped least squares near a singular J.
         preserve_damping: improvement 4, no error component changes sign (overshoot) near the
             final goal, whatever c.
-        continuous_orientation: improvement 5, each orientation component of the error on the
+        continuous_orientation: improvement 6, each orientation component of the error on the
             branch (a multiple of 2π) nearest its value at the last update, so e is continuous
             where a component passes ±π (literal: wrapped to (-π, π], a jump of 2π there).
         scaling_rate: rate of eq. 18 [1/s] (1 in the paper).
