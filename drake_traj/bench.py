@@ -604,25 +604,29 @@ def medians(rows) -> list[dict]:
 
 
 def bench_figure(rows):
-    """The plot of ``bench.png``: per planner, boxes of T over the time-optimal T and of the peak
-    q̈ over the limit across the tasks of ``rows``, the task count in the title."""
+    """The plot of ``bench.png``: per planner, boxes of T over the time-optimal T, of the peak q̈
+    over the limit and of the largest jerk across the tasks of ``rows``, the task count in the
+    title."""
     from matplotlib.figure import Figure
 
     names = _planner_names(rows)
     tasks = list(dict.fromkeys(row["task"] for row in rows))
     seeded = sum(task != "paper" for task in tasks)
-    figure = Figure(figsize=(9, 4.6), layout="constrained")
-    duration_ax, acceleration_ax = figure.subplots(1, 2)
-    for ax, column, label, bound in ((duration_ax, "T_over_optimal", "T / time-optimal T on the same path",
-                                      "1: time-optimal"),
-                                     (acceleration_ax, "max_qdd_over_limit", "max |qdd| / limit", "1: the limit")):
+    figure = Figure(figsize=(13, 4.6), layout="constrained")
+    duration_ax, acceleration_ax, jerk_ax = figure.subplots(1, 3)
+    jerk_ax.set_yscale("log")  # 10-30 rad/s^3 for the smooth planners, thousands for the bang-bang ones
+    for ax, column, label, bound, level in (
+            (duration_ax, "T_over_optimal", "T / time-optimal T on the same path", "1: time-optimal", 1.0),
+            (acceleration_ax, "max_qdd_over_limit", "max |qdd| / limit", "1: the limit", 1.0),
+            (jerk_ax, "max_jerk", "max |jerk| of the reference [rad/s^3]", "JUMP per 1 ms: continuous qdd",
+             JUMP / 1e-3)):
         data = [[row[column] for row in rows if row["planner"] == name and np.isfinite(row[column])]
                 for name in names]
         # a planner whose runs did not all give a value (failed runs) says over how many the box is
         ticks = [name if len(values) == len(tasks) else f"{name}\n({len(values)} of {len(tasks)})"
                  for name, values in zip(names, data)]
         boxes = ax.boxplot(data, tick_labels=ticks)
-        line = ax.axhline(1.0, color="grey", linestyle="--")
+        line = ax.axhline(level, color="grey", linestyle="--")
         ax.legend([boxes["medians"][0], line], ["median over the tasks (box: quartiles)", bound], fontsize="small")
         ax.set_ylabel(label)
         ax.tick_params(axis="x", rotation=45)

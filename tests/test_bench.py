@@ -2,6 +2,7 @@
 a failing run is a row, and bad arguments stop it before any run (not a timing test)."""
 
 import csv
+import logging
 import math
 
 import dask
@@ -196,3 +197,27 @@ def test_the_optimal_and_jerk_columns_against_our_own_computation():
     assert row["optimal_failure"] == ""
     jerk = np.abs(np.diff(path, 3, axis=0)).max() / 1e-3**3
     assert row["max_jerk"] == pytest.approx(jerk, rel=0.01)
+
+
+def test_a_path_toppra_cannot_parameterise_gives_its_reason_not_a_log_line(capfd):
+    # task 69 of the Pająk sweep's 0.7 rad set: Drake's Toppra fails on the law's own path (it
+    # logs "Toppra failed to find the maximum path acceleration at knot ..." through spdlog)
+    task = bench.pajak_walk_tasks(70, seed=9, step=0.7)[69]
+    result = bench.pajak.integrate(bench.pajak.PajakLaw(task), bench.pajak.paper_initial_configuration())
+    end = result["finish_index"] + 1
+    drake_log = logging.getLogger("drake")
+    handlers, propagate = list(drake_log.handlers), drake_log.propagate
+    optimal, reason = bench.optimal_duration(result["q"][:end], result["qd"][:end], task.velocity_limit,
+                                             task.acceleration_limit)
+    assert math.isnan(optimal)
+    assert reason.startswith("no T_opt: move 1 of 1: Toppra found no feasible time parameterisation")
+    assert "Toppra failed to find the maximum path acceleration at knot" in reason
+    printed = capfd.readouterr()
+    assert "Toppra failed" not in printed.err + printed.out
+    assert drake_log.handlers == handlers and drake_log.propagate == propagate  # the logger as it was
+
+
+def test_every_missing_optimum_has_its_reason(rows):
+    for row in rows:
+        if row["succeeded"]:
+            assert (row["optimal_failure"] == "") == bool(np.isfinite(row["T_over_optimal"])), row
