@@ -78,6 +78,7 @@ VELOCITY, ACCELERATION = robot.DEFAULT_JOINT_MOVE_VELOCITY, robot.DEFAULT_JOINT_
 BLEND_RADIUS = 0.05  # [m], the paper's experiment 1
 JUMP = 0.07  # [rad/s^2] between 1 ms samples: a jerk of 70 rad/s^3, above every continuous planner here
 TOPPRA_GRID_POINTS = 2000
+STOP_SPEED = 1e-3  # [rad/s]: a local minimum of the joint speed below this is a stop (optimal_duration)
 SETTLE_TIME, MAX_DURATION = 0.2, 30.0  # [s] of every run
 REFERENCE = "pajak_blend"  # the planner whose path Toppra parameterises
 COLUMNS = (
@@ -276,12 +277,19 @@ def optimal_duration(q, qd, velocity_limit=VELOCITY, acceleration_limit=ACCELERA
     or per joint); reason is "" or why there is no T_opt (then T_opt is NaN).
 
     A planner that stops at waypoints leaves a path with corners there, which no timing can pass
-    without stopping: the path is split at every stop (|qd| <= 1e-6 rad/s) and the pieces'
-    optimal times are added. Toppra may find no parameterisation (a near-corner left where a
-    planner slowed almost to rest without stopping): the reason then is Toppra's.
+    without stopping: the path is split at every stop and the pieces' optimal times are added.
+    A stop is a sample at rest (|qd| <= 1e-6 rad/s) or a local minimum of |qd| below
+    ``STOP_SPEED``: a stop between two 1 ms samples leaves the nearest one a few 10⁻⁶ rad/s from
+    rest (Ruckig's stops: 3e-6 and 7e-6 rad/s on the bench's random_4; unsplit, Toppra found no
+    parameterisation of 8 of its 20 paths). Toppra may find no parameterisation (a near-corner
+    left where a planner slowed almost to rest without stopping): the reason then is Toppra's.
     """
     q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
-    moving = np.linalg.norm(qd, axis=1) > 1e-6
+    speed = np.linalg.norm(qd, axis=1)
+    moving = speed > 1e-6
+    lowest = np.zeros(len(speed), dtype=bool)
+    lowest[1:-1] = (speed[1:-1] <= speed[:-2]) & (speed[1:-1] <= speed[2:]) & (speed[1:-1] < STOP_SPEED)
+    moving &= ~lowest
     moving[0] = moving[-1] = False  # the motion starts and (within the stop threshold) ends at rest
     starts = np.flatnonzero(moving[1:] & ~moving[:-1])  # last rest sample before each move
     stops = np.flatnonzero(~moving[1:] & moving[:-1]) + 1  # first rest sample after each move

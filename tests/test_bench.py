@@ -221,3 +221,34 @@ def test_every_missing_optimum_has_its_reason(rows):
     for row in rows:
         if row["succeeded"]:
             assert (row["optimal_failure"] == "") == bool(np.isfinite(row["T_over_optimal"])), row
+
+
+def test_the_optimum_of_a_stop_and_go_path_is_the_sum_of_its_moves():
+    # two straight moves with a corner between them, sampled at 1 ms with the stop between two
+    # samples (none at rest, as Ruckig's): the optimum stops at the corner,
+    # and on a straight line it is bang-bang along the path, known in closed form
+    velocity, acceleration = np.array([1.0, 0.5]), np.array([2.0, 1.0])
+    legs = [np.array([0.8, 0.3]), np.array([-0.2, 0.6])]
+
+    def straight(leg):  # rest-to-rest time-optimal duration along a straight leg
+        length = np.linalg.norm(leg)
+        direction = np.abs(leg) / length
+        speed, rate = np.min(velocity / direction), np.min(acceleration / direction)
+        return 2 * np.sqrt(length / rate) if length < speed**2 / rate else length / speed + speed / rate
+
+    first = round(1.5 * straight(legs[0]), 3) + 5e-4  # the corner 0.5 ms after a sample
+    durations = [first, 1.5 * straight(legs[1])]
+    t = np.arange(0.0, sum(durations) + 1e-3, 1e-3)
+    q, qd = np.zeros((len(t), 2)), np.zeros((len(t), 2))
+    for leg, offset, duration, origin in zip(legs, (0.0, first), durations, (np.zeros(2), legs[0])):
+        local = np.clip(t - offset, 0.0, duration)
+        inside = (t >= offset) & (t <= offset + duration)
+        q += np.where(inside[:, None], origin + np.outer(0.5 - 0.5 * np.cos(np.pi * local / duration), leg), 0.0)
+        qd += np.where(inside[:, None], np.outer(0.5 * np.pi / duration * np.sin(np.pi * local / duration), leg), 0.0)
+    q[t > sum(durations)] = legs[0] + legs[1]
+    corner = np.searchsorted(t, first)
+    speed = np.linalg.norm(qd, axis=1)[corner - 1 : corner + 1]
+    assert np.all((speed > 1e-6) & (speed < bench.STOP_SPEED))  # no sample at rest at the corner
+    optimal, reason = bench.optimal_duration(q, qd, velocity, acceleration)
+    assert reason == ""
+    assert optimal == pytest.approx(straight(legs[0]) + straight(legs[1]), rel=2e-3)
