@@ -14,6 +14,7 @@ import pytest
 
 from drake_traj.bench import pajak_walk_tasks
 from drake_traj.planners import pajak as P
+from drake_traj.robots import ur10e as robot
 
 Q0 = P.paper_initial_configuration()
 TASKS = pajak_walk_tasks(200, seed=9, step=1.0)
@@ -96,3 +97,8 @@ def test_a_stall_names_the_singularity():
     assert "near a singular configuration, the wrist singularity (sin q5 near 0" in str(error)
     assert error.field == ("waypoints", 3)
     assert abs(np.sin(error.configuration[4])) < 0.1
+    # the factor named is the smallest of det J's three, the singularity measure
+    factors = P.PajakLaw(TASKS[49]).kinematics.singularity_factors(error.configuration)
+    assert min(value for value, _ in factors.values()) == pytest.approx(
+        robot.singularity_measure(error.configuration), abs=1e-12)
+    assert f"factor {factors['wrist'][0]:.3g}" in str(error)

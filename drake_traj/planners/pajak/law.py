@@ -38,7 +38,6 @@ from drake_traj.planners.pajak.kernel import (
 )
 from drake_traj.planners.pajak.parameters import PajakConfig
 from drake_traj.robots import UR10E, Robot
-from drake_traj.robots.ur10e import singularity_factors
 
 __all__ = ["DISCRETE_NAMES", "PajakLaw"]
 
@@ -56,11 +55,6 @@ def _names(layout) -> tuple[str, ...]:
 
 DISCRETE_NAMES = _names(Discrete)  # the discrete state's entries, in order
 STALL_SCALING = 0.5  # a stall where the limits set c below this is one where a joint's limit held c low
-SINGULARITIES = {  # what each factor of det J (robots.ur10e.singularity_factors) means
-    "elbow": "sin q3 near 0, the arm stretched or folded",
-    "wrist": "sin q5 near 0, joints 4 and 6 aligned",
-    "shoulder": "the wrist centre near the axis of joint 1",
-}
 
 
 class PajakLaw:
@@ -271,7 +265,7 @@ class PajakLaw:
         """(why, field) of a stall at q with the discrete state and the evaluation ``out`` there:
 
         - near a singular configuration (singularity measure below ``singularity_threshold``):
-          which one (the elbow, wrist or shoulder factor of det J, :func:`~drake_traj.robots.ur10e.singularity_factors`),
+          which one (the elbow, wrist or shoulder factor of det J, ``TaskKinematics.singularity_factors``),
           field ``("waypoints", i)``, the waypoint the arm cannot reach from there;
         - near the Euler angles' gimbal lock (cos φ_Y below 0.05): field ``("waypoints", i)``;
         - c held low: set below ``STALL_SCALING`` by the limits since the last progress (the
@@ -282,10 +276,10 @@ class PajakLaw:
         """
         waypoint = ("waypoints", int(discrete[Discrete.WAYPOINT]))
         if out[Evaluation.MEASURE] < self.parameters.singularity_threshold:
-            factors = singularity_factors(q)
-            name = min(factors, key=factors.get)
-            return (f"near a singular configuration, the {name} singularity ({SINGULARITIES[name]}: "
-                    f"factor {factors[name]:.3g})"), waypoint
+            factors = self.kinematics.singularity_factors(q)
+            name = min(factors, key=lambda key: factors[key][0])
+            factor, meaning = factors[name]
+            return f"near a singular configuration, the {name} singularity ({meaning}: factor {factor:.3g})", waypoint
         if out[Evaluation.COS_PITCH] < 0.05:
             return (f"near the gimbal lock of the Z-Y-X Euler angles (cos phi_Y = {out[Evaluation.COS_PITCH]:.3g})",
                     waypoint)
