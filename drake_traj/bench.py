@@ -18,7 +18,8 @@ the limit; max jerk; whether qdd is continuous (no step between 1 ms samples lar
 ``JUMP`` rad/s^2); PD tracking error (joint, TCP); peak torque over the effort limit; planning
 compute time (median of ``repeats`` constructions; for the online Pająk planner, the wall time of
 its law integrated alone); real-time factor of the closed loop; ``failure``, empty or why the run
-failed. Only ``planning_s`` and ``real_time_factor`` are timings: every other column is the same
+failed; ``optimal_failure``, empty or why Toppra found no T_opt on the planner's path (Drake's own
+log line is the reason; it is not printed). Only ``planning_s`` and ``real_time_factor`` are timings: every other column is the same
 however the runs are spread over processes and machines.
 
 Work units and the engine. One unit is one (planner, task) run: :func:`run_planner` for the
@@ -78,20 +79,25 @@ from drake_traj.robots import UR10E
 from drake_traj.robots import ur10e as robot
 
 __all__ = [
-    "COLUMNS", "CONFIG_BUILDERS", "PLANNERS", "BenchSetupError", "Task", "bench", "bench_figure", "medians", "paper_task",
-    "random_tasks", "run_planner", "run_toppra", "tasks",
+    "COLUMNS", "CONFIG_BUILDERS", "PLANNERS", "BenchSetupError", "Task", "bench", "bench_figure", "medians", "optimal_duration",
+    "pajak_walk_tasks", "paper_task", "random_tasks", "run_planner", "run_toppra", "tasks",
 ]
 
 VELOCITY, ACCELERATION = robot.DEFAULT_JOINT_MOVE_VELOCITY, robot.DEFAULT_JOINT_MOVE_ACCELERATION
 BLEND_RADIUS = 0.05  # [m], the paper's experiment 1
 JUMP = 0.07  # [rad/s^2] between 1 ms samples: a jerk of 70 rad/s^3, above every continuous planner here
 TOPPRA_GRID_POINTS = 2000
+STOP_SPEED = 1e-3  # [rad/s]: a local minimum of the joint speed below this is a stop (optimal_duration)
+# knots of the path's spline for Toppra, tried in turn: its reachability analysis fails on some
+# splines of a path and not on others (Ruckig's moves on random_4: 200 knots fail on move 3,
+# 50 pass; on move 2 the other way round; where both pass, T_opt differs by 0.3 %)
+SPLINE_KNOTS = (200, 100, 50)
 SETTLE_TIME, MAX_DURATION = 0.2, 30.0  # [s] of every run
 REFERENCE = "pajak_blend"  # the planner whose path Toppra parameterises
 COLUMNS = (
     "task", "planner", "succeeded", "T_s", "T_over_optimal", "max_qd_over_limit", "max_qdd_over_limit",
     "max_jerk", "qdd_continuous", "tracking_joint_rad", "tracking_tcp_m", "peak_torque_over_limit",
-    "planning_s", "real_time_factor", "failure",
+    "planning_s", "real_time_factor", "failure", "optimal_failure",
 )
 TIMING_COLUMNS = ("planning_s", "real_time_factor")
 
@@ -141,6 +147,34 @@ def random_tasks(count: int, seed: int = 0):
         if far_enough and regular and not any(cell.contacts(q) for q in configurations[1:]):
             tasks.append((q0, poses[1:]))
     return tasks
+
+
+def pajak_walk_tasks(count: int, seed: int = 9, step: float = 0.7) -> list[PajakConfig]:
+    """``count`` seeded Pająk tasks of the law's random sweep (issue 22, tests/planners/test_pajak_random.py):
+    walks in joint space from the paper's q(0), each of 1-4 waypoints the flange pose of a
+    configuration up to ``step`` [rad] per joint from the previous one, limits drawn from
+    0.5-2 rad/s and 0.7-3 rad/s² (one value for every joint or one per joint, by a fair coin).
+    Tasks that ``validate()`` refuses (two waypoints closer than the neighbourhood) are drawn
+    again. Not filtered for collisions or singularities: the law alone is what they measure."""
+    rng = np.random.default_rng(seed)
+    q0 = pajak.paper_initial_configuration()
+    drawn = []
+    while len(drawn) < count:
+        configurations = [q0]
+        for _ in range(int(rng.integers(1, 5))):
+            configurations.append(configurations[-1] + rng.uniform(-step, step, 6))
+        if rng.integers(0, 2):
+            velocity, acceleration = rng.uniform(0.5, 2.0, 6), rng.uniform(0.7, 3.0, 6)
+        else:
+            velocity, acceleration = np.full(6, rng.uniform(0.5, 2.0)), np.full(6, rng.uniform(0.7, 3.0))
+        task = PajakConfig(waypoints=np.array([robot.task_pose(q) for q in configurations[1:]]),
+                           velocity_limit=velocity, acceleration_limit=acceleration)
+        try:
+            task.validate()
+        except ValueError:  # e.g. two waypoints closer than the neighbourhood
+            continue
+        drawn.append(task)
+    return drawn
 
 
 def tasks(count: int, seed: int = 0, repeats: int = 5) -> list[Task]:
@@ -260,32 +294,55 @@ def _planning_time(config, q0, repeats):
     return statistics.median(once() for _ in range(repeats))
 
 
-def _optimal_duration(result) -> float:
-    """Toppra's time-optimal duration on the result's geometric path (reference up to its end).
+def optimal_duration(q, qd, velocity_limit=VELOCITY, acceleration_limit=ACCELERATION) -> tuple[float, str]:
+    """(T_opt [s], reason): Toppra's time-optimal duration along the joint path q [rad] (N, 6)
+    sampled with velocities qd [rad/s] (N, 6), under the joint limits [rad/s, rad/s^2] (scalar
+    or per joint); reason is "" or why there is no T_opt (then T_opt is NaN).
 
     A planner that stops at waypoints leaves a path with corners there, which no timing can pass
     without stopping: the path is split at every stop and the pieces' optimal times are added.
-    NaN where Toppra finds no parameterisation (a near-corner left where a planner slowed almost
-    to rest without stopping).
+    A stop is a sample at rest (|qd| <= 1e-6 rad/s) or a local minimum of |qd| below
+    ``STOP_SPEED``: a stop between two 1 ms samples leaves the nearest one a few 10⁻⁶ rad/s from
+    rest (Ruckig's stops: 3e-6 and 7e-6 rad/s on the bench's random_4; unsplit, Toppra found no
+    parameterisation of 8 of its 20 paths). Toppra may find no parameterisation (a near-corner
+    left where a planner slowed almost to rest without stopping), or fail numerically on one
+    spline of the samples and not on a coarser one: each move is tried on splines of
+    ``SPLINE_KNOTS`` knots in turn, and where all fail the reason is Toppra's.
     """
-    end = np.searchsorted(result.t, result.duration) + 1 if np.isfinite(result.duration) else len(result.t)
-    q, qd = result.q_ref[:end], result.qd_ref[:end]
-    moving = np.linalg.norm(qd, axis=1) > 1e-6
+    q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
+    speed = np.linalg.norm(qd, axis=1)
+    moving = speed > 1e-6
+    lowest = np.zeros(len(speed), dtype=bool)
+    lowest[1:-1] = (speed[1:-1] <= speed[:-2]) & (speed[1:-1] <= speed[2:]) & (speed[1:-1] < STOP_SPEED)
+    moving &= ~lowest
     moving[0] = moving[-1] = False  # the motion starts and (within the stop threshold) ends at rest
     starts = np.flatnonzero(moving[1:] & ~moving[:-1])  # last rest sample before each move
     stops = np.flatnonzero(~moving[1:] & moving[:-1]) + 1  # first rest sample after each move
     total = 0.0
-    for start, stop in zip(starts, stops):
+    for number, (start, stop) in enumerate(zip(starts, stops)):
         piece = q[start : stop + 1]
-        if np.ptp(piece, axis=0).max() > 1e-6:
+        if np.ptp(piece, axis=0).max() <= 1e-6:
+            continue
+        for knots in SPLINE_KNOTS:
             try:
-                total += time_optimal_along_path(geometric_path_from_samples(piece), VELOCITY, ACCELERATION)[0]
-            except ValueError:
-                return float("nan")
-    return total
+                total += time_optimal_along_path(geometric_path_from_samples(piece, max_knots=knots), velocity_limit,
+                                                 acceleration_limit)[0]
+                break
+            except ValueError as error:
+                reason = f"no T_opt: move {number + 1} of {len(starts)}, splines of {SPLINE_KNOTS} knots: {error}"
+        else:
+            return float("nan"), reason
+    return total, ""
+
+
+def _optimal_duration(result) -> tuple[float, str]:
+    """:func:`optimal_duration` on the result's reference up to its end, with the bench's limits."""
+    end = np.searchsorted(result.t, result.duration) + 1 if np.isfinite(result.duration) else len(result.t)
+    return optimal_duration(result.q_ref[:end], result.qd_ref[:end])
 
 
 def _row(task, name, result, planning, optimal) -> dict:
+    optimal, no_optimum = optimal
     metrics = result.metrics()
     steps = np.abs(np.diff(result.qdd_ref[1:], axis=0))  # after t = 0 (Pająk sims start with a step)
     return {
@@ -297,14 +354,14 @@ def _row(task, name, result, planning, optimal) -> dict:
         "tracking_joint_rad": metrics.tracking_error_joint_max_rad,
         "tracking_tcp_m": metrics.tracking_error_tcp_max_m,
         "peak_torque_over_limit": max(metrics.peak_torque_over_limit), "planning_s": planning,
-        "real_time_factor": metrics.real_time_factor, "failure": metrics.failure or "",
+        "real_time_factor": metrics.real_time_factor, "failure": metrics.failure or "", "optimal_failure": no_optimum,
     }
 
 
 def failed_row(task: str, planner: str, reason: str) -> dict:
     """The row of a run that produced no log: NaN metrics and the reason."""
     return {column: float("nan") for column in COLUMNS} | {
-        "task": task, "planner": planner, "succeeded": False, "failure": reason}
+        "task": task, "planner": planner, "succeeded": False, "failure": reason, "optimal_failure": ""}
 
 
 def _reason(error: BaseException) -> str:
@@ -617,8 +674,10 @@ def medians(rows) -> list[dict]:
     for name in _planner_names(rows):
         mine = [row for row in rows if row["planner"] == name]
         failed = sum(bool(row["failure"]) for row in mine)
-        entry = {"task": "median", "planner": name, "failure": f"{failed} of {len(mine)} failed" if failed else ""}
-        for column in COLUMNS[2:-1]:
+        unbounded = sum(bool(row["optimal_failure"]) for row in mine)
+        entry = {"task": "median", "planner": name, "failure": f"{failed} of {len(mine)} failed" if failed else "",
+                 "optimal_failure": f"{unbounded} of {len(mine)} without T_opt" if unbounded else ""}
+        for column in COLUMNS[2:-2]:
             values = [float(row[column]) for row in mine]
             finite = [value for value in values if np.isfinite(value)]
             if column == "succeeded":
@@ -632,25 +691,29 @@ def medians(rows) -> list[dict]:
 
 
 def bench_figure(rows):
-    """The plot of ``bench.png``: per planner, boxes of T over the time-optimal T and of the peak
-    q̈ over the limit across the tasks of ``rows``, the task count in the title."""
+    """The plot of ``bench.png``: per planner, boxes of T over the time-optimal T, of the peak q̈
+    over the limit and of the largest jerk across the tasks of ``rows``, the task count in the
+    title."""
     from matplotlib.figure import Figure
 
     names = _planner_names(rows)
     tasks = list(dict.fromkeys(row["task"] for row in rows))
     seeded = sum(task != "paper" for task in tasks)
-    figure = Figure(figsize=(9, 4.6), layout="constrained")
-    duration_ax, acceleration_ax = figure.subplots(1, 2)
-    for ax, column, label, bound in ((duration_ax, "T_over_optimal", "T / time-optimal T on the same path",
-                                      "1: time-optimal"),
-                                     (acceleration_ax, "max_qdd_over_limit", "max |qdd| / limit", "1: the limit")):
+    figure = Figure(figsize=(13, 4.6), layout="constrained")
+    duration_ax, acceleration_ax, jerk_ax = figure.subplots(1, 3)
+    jerk_ax.set_yscale("log")  # 10-30 rad/s^3 for the smooth planners, thousands for the bang-bang ones
+    for ax, column, label, bound, level in (
+            (duration_ax, "T_over_optimal", "T / time-optimal T on the same path", "1: time-optimal", 1.0),
+            (acceleration_ax, "max_qdd_over_limit", "max |qdd| / limit", "1: the limit", 1.0),
+            (jerk_ax, "max_jerk", "max |jerk| of the reference [rad/s^3]", "JUMP per 1 ms: continuous qdd",
+             JUMP / 1e-3)):
         data = [[row[column] for row in rows if row["planner"] == name and np.isfinite(row[column])]
                 for name in names]
         # a planner whose runs did not all give a value (failed runs) says over how many the box is
         ticks = [name if len(values) == len(tasks) else f"{name}\n({len(values)} of {len(tasks)})"
                  for name, values in zip(names, data)]
         boxes = ax.boxplot(data, tick_labels=ticks)
-        line = ax.axhline(1.0, color="grey", linestyle="--")
+        line = ax.axhline(level, color="grey", linestyle="--")
         ax.legend([boxes["medians"][0], line], ["median over the tasks (box: quartiles)", bound], fontsize="small")
         ax.set_ylabel(label)
         ax.tick_params(axis="x", rotation=45)

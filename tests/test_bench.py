@@ -2,6 +2,7 @@
 a failing run is a row, and bad arguments stop it before any run (not a timing test)."""
 
 import csv
+import logging
 import math
 
 import numpy as np
@@ -144,3 +145,113 @@ def test_the_plot_has_the_task_count_in_its_title_and_a_legend_on_each_panel(row
     # a box over fewer runs than tasks (a failed run has no value) says how many
     labels = [label.get_text() for label in bench.bench_figure(cluster_rows).axes[0].get_xticklabels()]
     assert labels == ["pajak_blend", "quintic_stop", "toppra", "broken\n(0 of 2)"]
+
+
+def independent_optimal_time(path, velocity: float, acceleration: float, points: int = 3000) -> float:
+    """Time-optimal duration along ``path`` (a Drake trajectory q(s)) from rest to rest under
+    |q̇_j| <= velocity, |q̈_j| <= acceleration, by the classic numerical integration on x = ṡ²
+    (forward at the largest s̈, backward at the smallest, under the maximum-velocity curve found
+    by bisection): our own computation, not Drake's Toppra."""
+    s = np.linspace(path.start_time(), path.end_time(), points)
+    step = s[1] - s[0]
+    first = np.array([path.EvalDerivative(x, 1).ravel() for x in s])
+    second = np.array([path.EvalDerivative(x, 2).ravel() for x in s])
+    moving = np.abs(first) > 1e-12
+
+    def accelerations(x, at=slice(None)):
+        """(lowest, highest) s̈ at the grid points ``at`` for ṡ² = x (q̈ = q' s̈ + q'' x)."""
+        slope, bias, free = first[at], second[at] * np.asarray(x)[..., None], moving[at]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            upper = np.where(free, (np.sign(slope) * acceleration - bias) / slope, np.inf)
+            lower = np.where(free, (-np.sign(slope) * acceleration - bias) / slope, -np.inf)
+        blocked = np.any(~free & (np.abs(bias) > acceleration), axis=-1)
+        return np.where(blocked, np.inf, lower.max(axis=-1)), np.where(blocked, -np.inf, upper.min(axis=-1))
+
+    with np.errstate(divide="ignore"):
+        ceiling = np.min(np.where(moving, (velocity / np.abs(first)) ** 2, np.inf), axis=1)
+    low, high = np.zeros(points), ceiling.copy()
+    for _ in range(60):  # the largest x with an admissible s̈ (the feasible x form an interval from 0)
+        middle = 0.5 * (low + high)
+        lowest, highest = accelerations(middle)
+        feasible = lowest <= highest
+        low, high = np.where(feasible, middle, low), np.where(feasible, high, middle)
+    ceiling = low
+    x = np.zeros(points)
+    for k in range(points - 1):  # accelerate
+        x[k + 1] = min(ceiling[k + 1], x[k] + 2 * step * max(accelerations(x[k], k)[1], 0.0))
+    x[-1] = 0.0
+    for k in range(points - 1, 0, -1):  # decelerate
+        x[k - 1] = min(x[k - 1], x[k] - 2 * step * min(accelerations(x[k], k)[0], 0.0))
+    rates = np.sqrt(np.maximum(x, 0.0))
+    return float(np.sum(2 * step / (rates[1:] + rates[:-1])))
+
+
+def test_the_optimal_and_jerk_columns_against_our_own_computation():
+    # pajak_blend on the paper task: T_over_optimal is T over the time-optimal T along its own
+    # path (Toppra in the bench; here our own integration on ṡ², same spline of the path), and
+    # max_jerk the largest rate of change of the reference q̈ (here third differences of q)
+    task = bench.tasks(count=0, repeats=1)[0]
+    output = bench.run_planner(task, "pajak_blend", bench.CONFIG_BUILDERS["pajak_blend"], keep_path=True)
+    row, path = output["row"], output["path"]
+    optimal = independent_optimal_time(bench.geometric_path_from_samples(path), bench.VELOCITY, bench.ACCELERATION)
+    assert row["T_over_optimal"] == pytest.approx(row["T_s"] / optimal, rel=0.01)
+    assert row["optimal_failure"] == ""
+    jerk = np.abs(np.diff(path, 3, axis=0)).max() / 1e-3**3
+    assert row["max_jerk"] == pytest.approx(jerk, rel=0.01)
+
+
+def test_a_path_toppra_cannot_parameterise_gives_its_reason_not_a_log_line(capfd):
+    # task 69 of the Pająk sweep's 0.7 rad set: Drake's Toppra fails on the 200-knot spline of the
+    # law's own path (it logs "Toppra failed to find the maximum path acceleration at knot ..."
+    # through spdlog); optimal_duration then tries coarser splines of the same samples
+    task = bench.pajak_walk_tasks(70, seed=9, step=0.7)[69]
+    result = bench.pajak.integrate(bench.pajak.PajakLaw(task), bench.pajak.paper_initial_configuration())
+    q, qd = result["q"][: result["finish_index"] + 1], result["qd"][: result["finish_index"] + 1]
+    drake_log = logging.getLogger("drake")
+    handlers, propagate = list(drake_log.handlers), drake_log.propagate
+    with pytest.raises(ValueError) as info:
+        bench.time_optimal_along_path(bench.geometric_path_from_samples(q, max_knots=200), task.velocity_limit,
+                                      task.acceleration_limit)
+    assert "Toppra failed to find the maximum path acceleration at knot" in str(info.value)
+    printed = capfd.readouterr()
+    assert "Toppra failed" not in printed.err + printed.out
+    assert drake_log.handlers == handlers and drake_log.propagate == propagate  # the logger as it was
+    optimal, reason = bench.optimal_duration(q, qd, task.velocity_limit, task.acceleration_limit)
+    assert reason == "" and 1.0 < result["T"] / optimal < 2.0
+
+
+def test_every_missing_optimum_has_its_reason(rows):
+    for row in rows:
+        if row["succeeded"]:
+            assert (row["optimal_failure"] == "") == bool(np.isfinite(row["T_over_optimal"])), row
+
+
+def test_the_optimum_of_a_stop_and_go_path_is_the_sum_of_its_moves():
+    # two straight moves with a corner between them, sampled at 1 ms with the stop between two
+    # samples (none at rest, as Ruckig's): the optimum stops at the corner,
+    # and on a straight line it is bang-bang along the path, known in closed form
+    velocity, acceleration = np.array([1.0, 0.5]), np.array([2.0, 1.0])
+    legs = [np.array([0.8, 0.3]), np.array([-0.2, 0.6])]
+
+    def straight(leg):  # rest-to-rest time-optimal duration along a straight leg
+        length = np.linalg.norm(leg)
+        direction = np.abs(leg) / length
+        speed, rate = np.min(velocity / direction), np.min(acceleration / direction)
+        return 2 * np.sqrt(length / rate) if length < speed**2 / rate else length / speed + speed / rate
+
+    first = round(1.5 * straight(legs[0]), 3) + 5e-4  # the corner 0.5 ms after a sample
+    durations = [first, 1.5 * straight(legs[1])]
+    t = np.arange(0.0, sum(durations) + 1e-3, 1e-3)
+    q, qd = np.zeros((len(t), 2)), np.zeros((len(t), 2))
+    for leg, offset, duration, origin in zip(legs, (0.0, first), durations, (np.zeros(2), legs[0])):
+        local = np.clip(t - offset, 0.0, duration)
+        inside = (t >= offset) & (t <= offset + duration)
+        q += np.where(inside[:, None], origin + np.outer(0.5 - 0.5 * np.cos(np.pi * local / duration), leg), 0.0)
+        qd += np.where(inside[:, None], np.outer(0.5 * np.pi / duration * np.sin(np.pi * local / duration), leg), 0.0)
+    q[t > sum(durations)] = legs[0] + legs[1]
+    corner = np.searchsorted(t, first)
+    speed = np.linalg.norm(qd, axis=1)[corner - 1 : corner + 1]
+    assert np.all((speed > 1e-6) & (speed < bench.STOP_SPEED))  # no sample at rest at the corner
+    optimal, reason = bench.optimal_duration(q, qd, velocity, acceleration)
+    assert reason == ""
+    assert optimal == pytest.approx(straight(legs[0]) + straight(legs[1]), rel=2e-3)

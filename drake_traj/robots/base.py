@@ -80,6 +80,9 @@ class TaskKinematics(NamedTuple):
             [rad]; ValueError for a pose out of reach, SingularConfigurationError at a singular one.
         tool: X_FT (4, 4), the TCP in the flange frame (:attr:`Robot.tcp_offset`), the ``tool``
             argument of ``kinematics_into``.
+        singularity_factors: ``q (n,) -> {name: (factor, meaning)}``, the factors of det J at q,
+            each in [0, 1] and 0 at its singularity (the singularity measure is the smallest),
+            with what that singularity is (to name it in a message).
     """
 
     kinematics_into: Callable
@@ -89,6 +92,7 @@ class TaskKinematics(NamedTuple):
     pose_error: Callable
     inverse_kinematics_all: Callable
     tool: np.ndarray
+    singularity_factors: Callable
 
 
 class Robot:

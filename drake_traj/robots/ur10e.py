@@ -354,6 +354,18 @@ def singularity_measure(q):
     return float(out[0]) if q.ndim == 1 else out.reshape(q.shape[:-1])
 
 
+def singularity_factors(q) -> dict[str, tuple[float, str]]:
+    """The three factors of det J_g at one configuration q [rad] (6,), each in [0, 1] and zero at
+    its singularity (:func:`singularity_measure` is the smallest), with what that singularity is:
+    ``elbow`` |sin q3|, ``wrist`` |sin q5|, ``shoulder`` |a2 c2 + a3 c23 + d5 s234| / (|a2| + |a3|)."""
+    q = np.asarray(q, dtype=float)
+    shoulder = (_A2 * np.cos(q[1]) + _A3 * np.cos(q[1] + q[2]) + _D5 * np.sin(q[1] + q[2] + q[3])) / (
+        abs(_A2) + abs(_A3))
+    return {"elbow": (float(abs(np.sin(q[2]))), "sin q3 near 0, the arm stretched or folded"),
+            "wrist": (float(abs(np.sin(q[4]))), "sin q5 near 0, joints 4 and 6 aligned"),
+            "shoulder": (float(abs(shoulder)), "the wrist centre near the axis of joint 1")}
+
+
 # --------------------------------------------------------------------------------------------
 # Analytic inverse kinematics of the flange (closed form from the standard-DH chain above).
 # --------------------------------------------------------------------------------------------
@@ -754,5 +766,5 @@ class UR10e(Robot):
 
 
 _TASK_KINEMATICS = TaskKinematics(kinematics_into, wrapped, orientation_error, wrap_angle, pose_error,
-                                  inverse_kinematics_all, FLANGE)
+                                  inverse_kinematics_all, FLANGE, singularity_factors)
 UR10E = UR10e()

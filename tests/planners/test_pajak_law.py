@@ -16,6 +16,7 @@ import pytest
 from drake_traj.robots import task_space
 from drake_traj.robots import ur10e as robot
 from drake_traj.planners import pajak as P
+from drake_traj.planners.pajak.kernel import PENALTY_STIFFNESS
 
 Q0 = P.paper_initial_configuration()
 # Every improvement off: the paper's method as printed (with the corrections of docs/papers.md).
@@ -181,10 +182,14 @@ def test_velocity_penalty_is_the_gradient_of_eq_14():
     def penalty_of(v, smooth):
         return np.array([P.velocity_penalty(x, VMAX, rho, vartheta, smooth) for x in np.atleast_1d(v)])
 
+    # the smooth penalty's stiffness |∂Δq̈/∂q̇| = 2ρ/(d³ span²) is capped: linear below this d
+    knee = (2 * rho / (PENALTY_STIFFNESS * span**2)) ** (1 / 3)
     for smooth in (False, True):
         penalty = penalty_of(qd, smooth)
         gradient = (kappa(qd + h, smooth) - kappa(qd - h, smooth)) / (2 * h)
         inside = np.abs(np.abs(qd) - VMAX * (1 - 2 * vartheta)) > 1e-4  # away from the kink
+        if smooth:
+            inside &= VMAX - np.abs(qd) > knee * span
         np.testing.assert_allclose(penalty[inside], -gradient[inside], rtol=1e-5, atol=1e-6)  # eq. 15
         assert np.all(penalty[qd > 0.9] < 0) and np.all(penalty[qd < -0.9] > 0)  # pushes away
         assert np.all(penalty[np.abs(qd) < 0.84] == 0.0)  # only inside the threshold d < ϑ
@@ -193,6 +198,13 @@ def test_velocity_penalty_is_the_gradient_of_eq_14():
     edge = VMAX * (1 - 2 * vartheta) + 1e-9
     assert penalty_of(edge, False)[0] == pytest.approx(-rho / (span * vartheta**2), rel=1e-6)
     assert abs(penalty_of(edge, True)[0]) < 1e-6
+    # below the knee (d < 0.036 here) the smooth penalty goes on with the capped slope, continuous
+    # at the knee; the literal one steepens as 1/d³ (2ρ/(d³ span²) = 38 000 1/s at d = 0.007)
+    near = VMAX - span * np.array([knee * 0.2, knee * 0.6, knee - 1e-9, knee + 1e-9])
+    smooth_near, literal_near = penalty_of(near, True), penalty_of(near, False)
+    assert np.diff(smooth_near[:2])[0] / np.diff(near[:2])[0] == pytest.approx(-PENALTY_STIFFNESS, rel=1e-9)
+    assert abs(smooth_near[3] - smooth_near[2]) <= 1.01 * PENALTY_STIFFNESS * span * 2e-9  # the slope times the gap
+    assert np.diff(literal_near[:2])[0] / np.diff(near[:2])[0] < -10 * PENALTY_STIFFNESS
 
 
 def test_scaling_interval_cases_1_to_4():

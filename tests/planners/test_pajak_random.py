@@ -12,6 +12,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from drake_traj.bench import pajak_walk_tasks
 from drake_traj.planners import pajak as P
 from drake_traj.planners.pajak.kernel import Discrete
 from drake_traj.robots import task_space
@@ -23,27 +24,10 @@ TOL = 1e-9  # floating-point slack on "limit held"
 
 
 def random_tasks(count: int = 200, seed: int = 9) -> list[P.PajakConfig]:
-    """``count`` valid tasks (tasks validate() refuses are drawn again), seeded. The law is
-    integrated alone here, without the arm's body or a cell: the set is not filtered for
-    collisions, so that the measured set (README "Beyond the paper's task") stays the same."""
-    rng = np.random.default_rng(seed)
-    tasks = []
-    while len(tasks) < count:
-        configurations = [Q0]
-        for _ in range(int(rng.integers(1, 5))):
-            configurations.append(configurations[-1] + rng.uniform(-0.7, 0.7, 6))
-        if rng.integers(0, 2):
-            velocity, acceleration = rng.uniform(0.5, 2.0, 6), rng.uniform(0.7, 3.0, 6)
-        else:
-            velocity, acceleration = np.full(6, rng.uniform(0.5, 2.0)), np.full(6, rng.uniform(0.7, 3.0))
-        task = P.PajakConfig(waypoints=np.array([robot.task_pose(q) for q in configurations[1:]]),
-                             velocity_limit=velocity, acceleration_limit=acceleration)
-        try:
-            task.validate()
-        except ValueError:  # e.g. two waypoints closer than the neighbourhood
-            continue
-        tasks.append(task)
-    return tasks
+    """``count`` valid tasks of moves of up to 0.7 rad per joint, seeded (bench.pajak_walk_tasks).
+    The law is integrated alone here, without the arm's body or a cell: the set is not filtered
+    for collisions, so that the measured set (README "Beyond the paper's task") stays the same."""
+    return pajak_walk_tasks(count, seed, step=0.7)
 
 
 def largest_step(qdd: np.ndarray) -> float:
@@ -88,11 +72,11 @@ def test_random_tasks(random_runs):
         continuous += largest_step(result["qdd"][:end]) <= STEP
     print(f"\n200 random tasks: {finished} finished, failures {causes}, q̈ continuous on {continuous}")
     # Measured: 192 finished (8 stalls, 6 of them near a singular configuration), q̈ continuous
-    # on 195 of 200 (187 of the 192 finished; median largest change 0.037 rad/s²). Before the
-    # jerk budget: 191 finished, continuous on 187 (181 of 191). The rest change q̈ by
-    # 0.100-0.106 rad/s² in 1 ms where the penalty of eq. 15 steepens near a velocity limit, and
-    # by 0.63 rad/s² on one task where q̈ leaves the box's bound that clipped it (the law's own
-    # value falls that steeply there).
+    # on 196 of 200 (188 of the 192 finished; median largest change 0.037 rad/s²). Before the
+    # penalty's stiffness cap and the continuous orientation error (issue 22): continuous on 195
+    # (187 of 192), the largest change 0.63 rad/s²; now 0.125. Before the jerk budget: 191
+    # finished, continuous on 187 (181 of 191). The other 4 change q̈ by 0.10-0.13 rad/s² in
+    # 1 ms and by half that at 0.5 ms (steep, not a jump: examples/pajak_sweep.py).
     assert finished >= 190
     assert continuous >= 190
 
@@ -150,9 +134,12 @@ def test_jerk_budget_keeps_qdd_continuous(random_runs, index, cause):
         final = result["waypoint"] == len(task.waypoints) - 1
         assert np.any(final & (d[:, Discrete.APPROACH] > np.array(closing) + 1.0))
         assert error is None
-    # a budget no rate reaches: the same task as before the budget
+    # a budget no rate reaches: the same task as before the budget. Task 119 no longer needs it:
+    # with the penalty's stiffness capped (kernel.PENALTY_STIFFNESS) |b| stays far lower there,
+    # and without the budget q̈ changes by 0.043 rad/s² in 1 ms at most (measured)
     unbudgeted, failure = run(dataclasses.replace(task, jerk_budget=1e9), settle_time=0.5)
-    assert largest_step(unbudgeted["qdd"][: end_of_run(unbudgeted, failure)]) > 1.4 * STEP
+    unbudgeted_step = largest_step(unbudgeted["qdd"][: end_of_run(unbudgeted, failure)])
+    assert unbudgeted_step > 1.4 * STEP if cause != "scaling" else unbudgeted_step < 0.5 * STEP
 
 
 def test_literal_scaling_diverges_where_bounded_scaling_holds(random_runs):

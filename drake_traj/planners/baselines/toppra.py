@@ -25,6 +25,8 @@ has continuous q''; its weakness (overshoot between unevenly spaced or noisy kno
 decimating the samples to knots roughly evenly spaced in arc length, on a dense, smooth log.
 """
 
+import contextlib
+import logging
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -125,6 +127,26 @@ def _joint_chain_plant(num_joints: int) -> MultibodyPlant:
     return plant
 
 
+@contextlib.contextmanager
+def _drake_log():
+    """Collect what Drake logs (pydrake's ``logging`` logger "drake", fed by its C++ spdlog) in
+    the block into the yielded list of messages instead of printing it: Toppra reports why it
+    failed there ("Toppra failed to find the maximum path acceleration at knot 324/362"), and
+    :func:`time_optimal_along_path` puts that into its ValueError."""
+    logger = logging.getLogger("drake")
+    said = []
+    handler = logging.Handler(logging.WARNING)
+    handler.emit = lambda record: said.append(record.getMessage())
+    propagate = logger.propagate
+    logger.addHandler(handler)
+    logger.propagate = False
+    try:
+        yield said
+    finally:
+        logger.removeHandler(handler)
+        logger.propagate = propagate
+
+
 def time_optimal_along_path(
     path,
     velocity_limit,
@@ -189,13 +211,14 @@ def time_optimal_along_path(
     toppra = Toppra(path, plant, grid)
     toppra.AddJointVelocityLimit(-kv, kv)
     toppra.AddJointAccelerationLimit(-ka, ka, discretization)
-    s_of_t = toppra.SolvePathParameterization()
+    with _drake_log() as said:
+        s_of_t = toppra.SolvePathParameterization()
     if s_of_t is None:
         raise ValueError(
-            "Toppra found no feasible time parameterisation of the path (the reachability analysis "
-            "failed: usually the path's curvature q''(s) is so large somewhere that no path speed "
-            "keeps every joint acceleration within its limit while starting and stopping at rest, "
-            "e.g. a kink left by noisy or badly decimated samples; try a smoother path or more grid points)"
+            f"Toppra found no feasible time parameterisation of the path ({'; '.join(said) or 'no reason given'}). "
+            "The reachability analysis failed: usually the path's curvature q''(s) is so large somewhere that no "
+            "path speed keeps every joint acceleration within its limit while starting and stopping at rest, "
+            "e.g. a kink left by noisy or badly decimated samples; try a smoother path or more grid points"
         )
     duration = float(s_of_t.end_time() - s_of_t.start_time())
     if not np.isfinite(duration) or duration <= 0.0:

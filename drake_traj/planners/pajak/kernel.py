@@ -32,7 +32,7 @@ from drake_traj.planners.laws import scaling
 from drake_traj.planners.laws.scaling import relaxed_scaling
 from drake_traj.planners.pajak import limits
 from drake_traj.planners.pajak.limits import (BRAKE_LAG, BRAKE_SLEW, brake, brake_weight, choose_scaling,
-                                              keep_limits, scaling_interval, scaling_slew)
+                                              holding_joint, keep_limits, scaling_interval, scaling_slew)
 from drake_traj.robots import UR10E
 
 __all__ = [
@@ -74,6 +74,7 @@ Parameter = _layout("Parameter", [
     # switches (1.0 on, 0.0 off): PajakConfig's flags
     ("LIMIT_VELOCITY", 1), ("LIMIT_ACCELERATION", 1), ("BLEND_WAYPOINTS", 1), ("SMOOTH_PENALTY", 1),
     ("CONTINUOUS_SWITCHING", 1), ("BOUNDED_SCALING", 1), ("DAMPED_INVERSE", 1), ("PRESERVE_DAMPING", 1),
+    ("CONTINUOUS_ORIENTATION", 1),
 ])
 
 Discrete = _layout("Discrete", [
@@ -91,6 +92,9 @@ Discrete = _layout("Discrete", [
     ("BRAKE", 1), ("BRAKE_SLOPE", 1),  # fallback braking weight at the last update and its slope [1/s]
     ("SATURATED", 1),  # updates at which the limits overruled the law (improvement 2)
     ("APPROACH", 1),  # approach rate of improvement 4 at the last update (0 where unused) [1/s]
+    ("BRANCH", 1),  # 1 once ERROR and FINAL_ERROR hold the last update's orientation errors (improvement 6)
+    ("ERROR", 3), ("FINAL_ERROR", 3),  # orientation part of e (eq. 6/19) and of the error to p_w there [rad]
+    ("HELD_BY", 1), ("HELD_BY_VELOCITY", 1),  # Evaluation.HOLDING(_VELOCITY) when the limits last set c (the anchor)
 ])
 
 Evaluation = _layout("Evaluation", [
@@ -104,6 +108,9 @@ Evaluation = _layout("Evaluation", [
     ("POSITION_ERROR", 1), ("ORIENTATION_ERROR", 1),  # to the active waypoint (update_kernel) [m, rad]
     ("REMAINING", 1),  # remaining path to p_w (update_kernel) [m]
     ("APPROACH", 1),  # approach rate the damping of improvement 4 is sized for (0 where unused) [1/s]
+    ("ERROR", 3), ("FINAL_ERROR", 3),  # orientation part of e and of the error to p_w (improvement 6) [rad]
+    ("HOLDING", 1),  # the joint whose limit bounds c lowest (limits.holding_joint; -1: none below 1)
+    ("HOLDING_VELOCITY", 1),  # 1 where that bound is its velocity limit's viability bound, 0 its acceleration limit
 ])
 
 _EVALUATION_SIZE = int(Evaluation.SIZE)  # a plain int for np.empty in compiled code
@@ -128,6 +135,9 @@ class Status(IntEnum):
 ORIENTATION_LENGTH = 0.1  # [m/rad], weight of orientation in the progress measure and the approach rate
 MIN_COS_PITCH = 1e-6  # Euler gimbal lock (as the UR10e's analytic_jacobian_and_bias)
 SCALE_FLOOR = 0.1  # smallest c_r the approach damping is sized for (improvement 4)
+# largest |∂Δq̈_i/∂q̇_i| of the smooth penalty [1/s] (improvement 1): above the paper task's 59 1/s
+# (sim 3 keeps its numbers), far below the 1 ms step's stability bound of 2.8/1 ms (RK4)
+PENALTY_STIFFNESS = 300.0
 
 # The robot's compiled task kinematics (Robot.task_kinematics), bound once as module globals: numba
 # compiles the calls to them into the law and caches the law on disk. Passed in (a closure over
@@ -153,8 +163,12 @@ def velocity_penalty(qd: float, qd_max: float, rho: float, vartheta: float, smoo
     d(q̇_i) = min(q̇_i - q̇_min, q̇_max - q̇_i) / (q̇_max - q̇_min) (eq. 14). Literal (``smooth``
     False): κ = ρ (1/d - 1/ϑ) for d < ϑ, whose slope -ρ/ϑ² at d = ϑ makes q̈ jump by
     ρ/((q̇_max - q̇_min) ϑ²) when the penalty switches on. Smooth (improvement 1): κ minus its
-    tangent at ϑ, κ = ρ (1/d - 1/ϑ + (d - ϑ)/ϑ²), zero value and slope at the threshold, the
-    same 1/d growth at the limit. d is floored at 1e-3 beyond the limits.
+    tangent at ϑ, κ = ρ (1/d - 1/ϑ + (d - ϑ)/ϑ²), zero value and slope at the threshold; and
+    its stiffness |∂Δq̈_i/∂q̇_i| = 2ρ/(d³ span²) capped at PENALTY_STIFFNESS: below the d where
+    it reaches the cap, Δq̈_i goes on linearly with that slope (an affine κ' in q̇), so the
+    penalty never makes the law stiff (with d of 0.02 the uncapped stiffness was 4000 1/s and
+    q̈ chattered by 1 rad/s² at a 1 ms step; the velocity limit itself is held by the
+    acceleration box's viability bound, improvement 2). d is floored at 1e-3 beyond the limits.
     """
     span = 2.0 * qd_max
     to_min = qd + qd_max
@@ -162,9 +176,13 @@ def velocity_penalty(qd: float, qd_max: float, rho: float, vartheta: float, smoo
     d = max(min(to_min, to_max) / span, 1e-3)  # eq. 14
     if d >= vartheta:
         return 0.0
-    magnitude = rho / (d * d * span)
     if smooth:
-        magnitude -= rho / (vartheta * vartheta * span)
+        knee = (2.0 * rho / (PENALTY_STIFFNESS * span * span)) ** (1.0 / 3.0)  # stiffness = the cap
+        magnitude = rho / (max(d, knee) ** 2 * span) - rho / (vartheta * vartheta * span)
+        if d < knee:
+            magnitude += PENALTY_STIFFNESS * span * (knee - d)
+    else:
+        magnitude = rho / (d * d * span)
     # ∂κ/∂q̇_i = κ'(d) ∂d/∂q̇_i, ∂d/∂q̇_i = -1/span near q̇_max: eq. 15 pushes from the nearer limit
     return -magnitude if to_max < to_min else magnitude
 
@@ -432,6 +450,8 @@ def _evaluate_kernel(dependencies):
         # c is at most this until the next update (improvement 1's rate limit of c)
         scale_bound = min(d[Discrete.C] + p[Parameter.SCALING_SLEW] * elapsed, 1.0)
         out[Evaluation.APPROACH] = 0.0
+        out[Evaluation.HOLDING] = -1.0
+        out[Evaluation.HOLDING_VELOCITY] = 0.0
         sigma = 0.0
         if p[Parameter.BLEND_WAYPOINTS] > 0.0 and d[Discrete.BLENDING] > 0.5:
             raw, _ = blend_progress(pose, d[Discrete.X_REF:Discrete.X_REF + 3], d[Discrete.TRAVEL],
@@ -458,10 +478,27 @@ def _evaluate_kernel(dependencies):
         out[Evaluation.SIGMA] = sigma
         error = np.empty(6)
         error_rate = np.empty(6)
+        final = np.empty(6)  # the error to p_w (improvement 4's approach rate)
+        goal = i if p[Parameter.BLEND_WAYPOINTS] == 0.0 else last
+        # improvement 6: each orientation component on the branch (a multiple of 2π) nearest to its
+        # value at the last update, so that it is continuous where it passes ±π (wrapped to the
+        # shortest branch it jumps by 2π there, and q̈ with it: by up to 3.8 rad/s² in 1 ms on
+        # moves of 1 rad per joint, where φ_X and φ_Z turn fast near the Euler angles' gimbal lock)
+        continued = p[Parameter.CONTINUOUS_ORIENTATION] > 0.0 and d[Discrete.BRANCH] > 0.5
         for k in range(6):
             error[k] = pose[k] - target[k]  # eq. 6
+            final[k] = pose[k] - waypoints[goal, k]
             if k >= 3:
-                error[k] = wrapped(error[k])  # orientation wrapped (docs/papers.md)
+                if continued:
+                    last_error = d[Discrete.ERROR + k - 3]
+                    last_final = d[Discrete.FINAL_ERROR + k - 3]
+                    error[k] = last_error + wrapped(error[k] - last_error)
+                    final[k] = last_final + wrapped(final[k] - last_final)
+                else:
+                    error[k] = wrapped(error[k])  # orientation wrapped (docs/papers.md)
+                    final[k] = wrapped(final[k])
+                out[Evaluation.ERROR + k - 3] = error[k]
+                out[Evaluation.FINAL_ERROR + k - 3] = final[k]
             rate = 0.0
             for j in range(6):
                 rate += jac[k, j] * qd[j]
@@ -490,12 +527,6 @@ def _evaluate_kernel(dependencies):
             elif i == last - 1:
                 weight = sigma
             if weight > 0.0:
-                goal = i if p[Parameter.BLEND_WAYPOINTS] == 0.0 else last
-                final = np.empty(6)
-                for k in range(6):
-                    final[k] = pose[k] - waypoints[goal, k]
-                    if k >= 3:
-                        final[k] = wrapped(final[k])
                 closing = approach_rate(final, error_rate, p[Parameter.APPROACH_DELTA])
                 scale = min(max(c_r, SCALE_FLOOR), 1.0)
                 previous = d[Discrete.APPROACH]
@@ -531,6 +562,9 @@ def _evaluate_kernel(dependencies):
         lower = np.empty(6)
         upper = np.empty(6)
         acceleration_box(qd, p, lower, upper)
+        holding, by_velocity = holding_joint(a, b, lower, upper, p[Parameter.QDD_MAX:Parameter.QDD_MAX + 6])
+        out[Evaluation.HOLDING] = holding
+        out[Evaluation.HOLDING_VELOCITY] = 1.0 if by_velocity else 0.0
         if p[Parameter.BOUNDED_SCALING] == 0.0:  # the paper's choice of c (may leave [0, 1])
             c_lo, c_hi = scaling_interval(a, b, lower, upper)  # cases 1-4
             c, _ = choose_scaling(c_r, c_lo, c_hi, False)  # cases a-c
@@ -598,6 +632,8 @@ def _update_kernel(dependencies):
             if abs(c - out[Evaluation.C_RELAXED]) > 1e-12:  # the limits moved c off eq. 18: new anchor
                 d[Discrete.T0] = t
                 d[Discrete.C0] = c
+                d[Discrete.HELD_BY] = out[Evaluation.HOLDING]  # which joint's limit (a stall's cause)
+                d[Discrete.HELD_BY_VELOCITY] = out[Evaluation.HOLDING_VELOCITY]
             weight, target = brake_weight(out[Evaluation.VIOLATION], d[Discrete.BRAKE], d[Discrete.BRAKE_SLOPE],
                                           max(t - d[Discrete.T_UPDATE], 0.0))
             if abs(target - weight) < 1e-6:  # settled: exactly on the target (0 when the fallback is over)
@@ -607,6 +643,9 @@ def _update_kernel(dependencies):
             d[Discrete.SATURATED] += out[Evaluation.SATURATED]
         d[Discrete.C] = c
         d[Discrete.APPROACH] = out[Evaluation.APPROACH]
+        d[Discrete.ERROR:Discrete.ERROR + 3] = out[Evaluation.ERROR:Evaluation.ERROR + 3]
+        d[Discrete.FINAL_ERROR:Discrete.FINAL_ERROR + 3] = out[Evaluation.FINAL_ERROR:Evaluation.FINAL_ERROR + 3]
+        d[Discrete.BRANCH] = 1.0
         d[Discrete.T_UPDATE] = t
         i = int(d[Discrete.WAYPOINT])
         last = int(p[Parameter.NUM_WAYPOINTS]) - 1
@@ -651,6 +690,7 @@ def _update_kernel(dependencies):
                     d[Discrete.C0] = 0.0
                     d[Discrete.C] = 0.0
                     d[Discrete.APPROACH] = 0.0  # a new approach (with c = 0, b does not move q̈)
+                d[Discrete.BRANCH] = 0.0  # a new target: its shortest branch
         finished = pose_reached(pose, waypoints[i], p, out) and i >= last
         # progress monitor: remaining path = distance to p_i (+ weighted orientation) + the rest
         left = out[Evaluation.POSITION_ERROR] + ORIENTATION_LENGTH * out[Evaluation.ORIENTATION_ERROR] + remaining[i]

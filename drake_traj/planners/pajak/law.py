@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from drake_traj.errors import Cause, PlanningError, SingularConfigurationError
+from drake_traj.errors import Cause, PlanningError, SingularConfigurationError, joint_label
 from drake_traj.planners.pajak.kernel import (
     KINEMATICS,
     MIN_COS_PITCH,
@@ -54,6 +54,7 @@ def _names(layout) -> tuple[str, ...]:
 
 
 DISCRETE_NAMES = _names(Discrete)  # the discrete state's entries, in order
+STALL_SCALING = 0.5  # a stall where the limits set c below this is one where a joint's limit held c low
 
 
 class PajakLaw:
@@ -121,6 +122,7 @@ class PajakLaw:
             (Parameter.BLEND_WAYPOINTS, p.blend_waypoints), (Parameter.SMOOTH_PENALTY, p.smooth_penalty),
             (Parameter.CONTINUOUS_SWITCHING, p.continuous_switching), (Parameter.BOUNDED_SCALING, p.bounded_scaling),
             (Parameter.DAMPED_INVERSE, p.damped_inverse), (Parameter.PRESERVE_DAMPING, p.preserve_damping),
+            (Parameter.CONTINUOUS_ORIENTATION, p.continuous_orientation),
         ):
             v[slot] = float(value)
         self.vector = v
@@ -138,6 +140,7 @@ class PajakLaw:
         d[Discrete.C] = d[Discrete.C0] = c
         d[Discrete.GOAL] = 1.0
         d[Discrete.BEST] = np.inf
+        d[Discrete.HELD_BY] = -1.0  # no limit has set c yet
         return d
 
     # --- evaluation ----------------------------------------------------------------------------
@@ -246,18 +249,56 @@ class PajakLaw:
                        f"(singularity measure {out[Evaluation.MEASURE]:.2e})")
             cause, field = Cause.NON_FINITE, ()
         elif status == Status.STALL:
-            near = " near a singular configuration" if out[Evaluation.MEASURE] < self.parameters.singularity_threshold \
-                else ""
+            why, field = self.stall_cause(q, discrete, out)
             message = (
                 f"no progress towards waypoint {int(discrete[Discrete.WAYPOINT])} for "
-                f"{self.parameters.stall_time:.1f} s{near}: remaining path {out[Evaluation.REMAINING]:.4f} m, TCP "
+                f"{self.parameters.stall_time:.1f} s {why}: remaining path {out[Evaluation.REMAINING]:.4f} m, TCP "
                 f"{np.round(out[Evaluation.POSE:Evaluation.POSE + 3], 4).tolist()}, c = {out[Evaluation.C]:.3g}, "
                 f"singularity measure {out[Evaluation.MEASURE]:.3g}"
             )
-            cause, field = Cause.STALL, ("waypoints", int(discrete[Discrete.WAYPOINT]))
+            cause = Cause.STALL
         else:
             raise ValueError(f"status {status!r} is not a failure")
         return PlanningError(message, time=float(t), configuration=q, cause=cause, field=field)
+
+    def stall_cause(self, q, discrete, out) -> tuple[str, tuple]:
+        """(why, field) of a stall at q with the discrete state and the evaluation ``out`` there:
+
+        - near a singular configuration (singularity measure below ``singularity_threshold``):
+          which one (the elbow, wrist or shoulder factor of det J, ``TaskKinematics.singularity_factors``),
+          field ``("waypoints", i)``, the waypoint the arm cannot reach from there;
+        - near the Euler angles' gimbal lock (cos φ_Y below 0.05): field ``("waypoints", i)``;
+        - c held low: set below ``STALL_SCALING`` by the limits since the last progress (the
+          joint whose limit set it, recorded with eq. 18's anchor), or below ``STALL_SCALING`` or
+          eq. 18's value now (the joint whose limit bounds c lowest, :func:`~.limits.holding_joint`):
+          its acceleration limit or the viability bound of its velocity limit, field ``("acceleration_limit",)`` or ``("velocity_limit",)``;
+        - otherwise: the law's feedback stops short, c not held low and J regular, field ``("waypoints", i)``.
+        """
+        waypoint = ("waypoints", int(discrete[Discrete.WAYPOINT]))
+        if out[Evaluation.MEASURE] < self.parameters.singularity_threshold:
+            factors = self.kinematics.singularity_factors(q)
+            name = min(factors, key=lambda key: factors[key][0])
+            factor, meaning = factors[name]
+            return f"near a singular configuration, the {name} singularity ({meaning}: factor {factor:.3g})", waypoint
+        if out[Evaluation.COS_PITCH] < 0.05:
+            return (f"near the gimbal lock of the Z-Y-X Euler angles (cos phi_Y = {out[Evaluation.COS_PITCH]:.3g})",
+                    waypoint)
+        c = out[Evaluation.C]
+        # the joint whose limit set c at the last anchor of eq. 18, where that was since the last progress
+        # and set c low (c relaxes from there at eq. 18's rate); else the one that bounds c now
+        joint, by_velocity = int(discrete[Discrete.HELD_BY]), discrete[Discrete.HELD_BY_VELOCITY] > 0.5
+        held = joint >= 0 and discrete[Discrete.C0] < STALL_SCALING and discrete[Discrete.T0] > discrete[Discrete.T_BEST]
+        if not held:
+            joint, by_velocity = int(out[Evaluation.HOLDING]), out[Evaluation.HOLDING_VELOCITY] > 0.5
+            held = joint >= 0 and (c < STALL_SCALING or c < out[Evaluation.C_RELAXED] - 1e-3)
+        if held:
+            names = self.robot.joint_names
+            if by_velocity:
+                return (f"with c held low by {joint_label(joint, names)}'s velocity limit "
+                        f"({self.qd_max[joint]:.3g} rad/s, its acceleration box narrowed near it)"), ("velocity_limit",)
+            return (f"with c held low by {joint_label(joint, names)}'s acceleration limit "
+                    f"({self.qdd_max[joint]:.3g} rad/s^2)"), ("acceleration_limit",)
+        return "with c not held by a limit and J regular (the feedback stops short)", waypoint
 
     def tcp_positions(self) -> np.ndarray:
         """Waypoint positions [m], (w, 3), for plots."""

@@ -8,7 +8,7 @@ import numpy as np
 from drake_traj.compiled import compiled
 
 __all__ = ["BRAKE_LAG", "BRAKE_ONSET", "BRAKE_SLEW", "BRAKE_TIME", "brake", "brake_weight", "choose_scaling",
-           "keep_limits", "scaling_interval", "scaling_slew"]
+           "holding_joint", "keep_limits", "scaling_interval", "scaling_slew"]
 
 BRAKE_TIME = 0.05  # [s], time constant of the fallback braking at low speed (improvement 2)
 BRAKE_ONSET = 0.5  # violation (relative to q̈_max) at which the fallback is pure braking
@@ -49,6 +49,28 @@ def scaling_interval(a, b, lower, upper):
         c_lo = max(c_lo, np.fmin(to_max, to_min))  # fmin, fmax: a NaN (0 / 0) bounds nothing
         c_hi = min(c_hi, np.fmax(to_max, to_min))
     return c_lo, c_hi
+
+
+@compiled
+def holding_joint(a, b, lower, upper, qdd_max):
+    """(j, by_velocity): the joint whose bound of cases 1-4 (:func:`scaling_interval`) is the
+    smallest upper bound of c, where it is below 1 (j = -1 where no joint bounds c below 1), and
+    whether its box edge there is narrower than ±q̈_max, i.e. the viability bound of its
+    velocity limit (:func:`~.kernel.acceleration_box`) rather than its acceleration limit. What
+    holds c near 0 when the law stalls; diagnosis only, c is chosen elsewhere."""
+    smallest = 1.0
+    j = -1
+    by_velocity = False
+    for i in range(a.shape[0]):
+        to_max = (upper[i] - a[i]) / b[i]
+        to_min = (lower[i] - a[i]) / b[i]
+        bound = np.fmax(to_max, to_min)  # a NaN (0 / 0) bounds nothing
+        if bound < smallest:
+            smallest = bound
+            j = i
+            edge = upper[i] if to_max >= to_min else lower[i]
+            by_velocity = abs(edge) < qdd_max[i] * (1.0 - 1e-9)
+    return j, by_velocity
 
 
 @compiled

@@ -19,6 +19,7 @@ PAPER_METHOD = dict(
     bounded_scaling=False,
     damped_inverse=False,
     preserve_damping=False,
+    continuous_orientation=False,
 )
 
 
@@ -45,13 +46,17 @@ class PajakConfig:
         limit_velocity: add the penalty perturbation Δq̈ (eq. 15-16); sims 2 and 3.
         limit_acceleration: scale the trajectory (eq. 17-18), c(0) = 0; sim 3.
         blend_waypoints: pass waypoints without stopping (eq. 19); False stops at each.
-        smooth_penalty: improvement 1, penalty with zero slope at the threshold.
+        smooth_penalty: improvement 1, penalty with zero slope at the threshold and a capped
+            stiffness (kernel.PENALTY_STIFFNESS).
         continuous_switching: improvement 1, the waypoint switches when σ reaches 1 (literal:
             when the TCP leaves the ball).
         bounded_scaling: improvement 2, c in [0, 1], limits kept by braking when no c works.
         damped_inverse: improvement 3, damped least squares near a singular J.
         preserve_damping: improvement 4, no error component changes sign (overshoot) near the
             final goal, whatever c.
+        continuous_orientation: improvement 6, each orientation component of the error on the
+            branch (a multiple of 2π) nearest its value at the last update, so e is continuous
+            where a component passes ±π (literal: wrapped to (-π, π], a jump of 2π there).
         scaling_rate: rate of eq. 18 [1/s] (1 in the paper).
         scaling_slew: improvement 1 (with ``bounded_scaling``): c changes by at most this per
             second [1/s]; where the limits would need c to fall faster, q̈ is clipped to them.
@@ -90,6 +95,7 @@ class PajakConfig:
     bounded_scaling: bool = True
     damped_inverse: bool = True
     preserve_damping: bool = True
+    continuous_orientation: bool = True
     scaling_rate: float = 1.0
     scaling_slew: float = 3.0
     jerk_budget: float = 40.0
@@ -152,7 +158,7 @@ class PajakConfig:
                 f"neighbourhood {values['neighbourhood']} m", field=("waypoints", k + 1), cause=Cause.INFEASIBLE)
         for name in (
             "limit_velocity", "limit_acceleration", "blend_waypoints", "smooth_penalty",
-            "continuous_switching", "bounded_scaling", "damped_inverse", "preserve_damping",
+            "continuous_switching", "bounded_scaling", "damped_inverse", "preserve_damping", "continuous_orientation",
         ):
             flag(getattr(self, name), name)
         return replace(self, waypoints=waypoints, vartheta=float(vartheta), **values)
