@@ -114,3 +114,13 @@ def test_the_pajak_law_reaches_the_robot_through_the_robot_interface():
     for name in MODULES:
         if name.startswith("drake_traj.planners.pajak") and name != "drake_traj.planners.pajak.parameters":
             assert "drake_traj.robots.ur10e" not in GRAPH[name], name
+
+
+def test_every_package_of_the_source_tree_is_installed():
+    """pyproject.toml lists the packages a non-editable install ships (as CI installs): a new
+    subpackage missing from that list imports in a checkout but not after `pip install .`."""
+    repository = Path(__file__).resolve().parents[1]
+    listed = (repository / "pyproject.toml").read_text()
+    for init in (repository / "drake_traj").rglob("__init__.py"):
+        dotted = ".".join(init.parent.relative_to(repository).parts)
+        assert f'"{dotted}"' in listed, f"{dotted} is not in pyproject.toml's [tool.setuptools] packages"
