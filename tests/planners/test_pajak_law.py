@@ -16,7 +16,7 @@ import pytest
 from drake_traj.robots import task_space
 from drake_traj.robots import ur10e as robot
 from drake_traj.planners import pajak as P
-from drake_traj.planners.pajak.kernel import PENALTY_STIFFNESS
+from drake_traj.planners.pajak.kernel import PENALTY_STIFFNESS, VIABILITY_MARGIN, Parameter, viability_bound
 
 Q0 = P.paper_initial_configuration()
 # Every improvement off: the paper's method as printed (with the corrections of docs/papers.md).
@@ -198,13 +198,34 @@ def test_velocity_penalty_is_the_gradient_of_eq_14():
     edge = VMAX * (1 - 2 * vartheta) + 1e-9
     assert penalty_of(edge, False)[0] == pytest.approx(-rho / (span * vartheta**2), rel=1e-6)
     assert abs(penalty_of(edge, True)[0]) < 1e-6
-    # below the knee (d < 0.036 here) the smooth penalty goes on with the capped slope, continuous
-    # at the knee; the literal one steepens as 1/d³ (2ρ/(d³ span²) = 38 000 1/s at d = 0.007)
+    # below the knee (d < 0.045 here) the smooth penalty goes on with the capped slope, continuous
+    # at the knee; the literal one steepens as 1/d³ (2ρ/(d³ span²) = 19 000 1/s at d = 0.009)
     near = VMAX - span * np.array([knee * 0.2, knee * 0.6, knee - 1e-9, knee + 1e-9])
     smooth_near, literal_near = penalty_of(near, True), penalty_of(near, False)
     assert np.diff(smooth_near[:2])[0] / np.diff(near[:2])[0] == pytest.approx(-PENALTY_STIFFNESS, rel=1e-9)
     assert abs(smooth_near[3] - smooth_near[2]) <= 1.01 * PENALTY_STIFFNESS * span * 2e-9  # the slope times the gap
     assert np.diff(literal_near[:2])[0] / np.diff(near[:2])[0] < -10 * PENALTY_STIFFNESS
+
+
+def test_the_velocity_viability_bound_is_jerk_limited():
+    # improvement 2 with improvement 1's jerk budget J: q̈ riding the bound f(q̇_max - q̇) changes
+    # at f f' <= J; its slope at the limit is K (q̇ approaches the limit exponentially, never past it)
+    task = P.PajakLaw(P.paper_parameters(3, velocity_limit=1.0, acceleration_limit=2.6))  # the sweep's limits
+    p, k = task.vector, 0
+    gain, jerk = p[Parameter.VIABILITY_GAIN + k], p[Parameter.JERK_BUDGET]
+    limit, speed = p[Parameter.QDD_MAX + k], p[Parameter.QD_MAX + k]
+    gap = np.linspace(0.0, speed * (1 - VIABILITY_MARGIN) - p[Parameter.VIABILITY_ONSET + k], 20001)  # aimed below
+    bound = np.array([viability_bound(x, gain, jerk) for x in gap])
+    assert bound[0] == 0.0 and np.all(np.diff(bound) > 0)
+    assert bound[-1] == pytest.approx(limit, rel=1e-9)  # it meets q̈_max where the box narrows
+    rate = np.gradient(bound, gap) * bound  # d(q̈)/dt = f'(x) ẋ = -f'(x) f(x) riding the bound
+    assert rate.max() <= jerk
+    assert rate[-1] == pytest.approx(jerk * limit / (limit + jerk / gain), rel=1e-3)  # J (1 - (J/K) / (f + J/K))
+    assert np.gradient(bound, gap)[0] == pytest.approx(gain, rel=1e-3)
+    # the linear bound K x of the same slope changed q̈ at K q̈_max where it set in
+    assert gain * limit > 2 * jerk
+    # beyond the limit it goes on linearly (braking back), continuous at 0
+    assert viability_bound(-1e-3, gain, jerk) == pytest.approx(-gain * 1e-3)
 
 
 def test_scaling_interval_cases_1_to_4():

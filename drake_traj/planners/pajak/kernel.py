@@ -39,6 +39,7 @@ __all__ = [
     "Discrete", "Evaluation", "Log", "Parameter", "Status", "acceleration_box", "acceleration_terms",
     "approach_damping", "approach_rate", "blend_progress", "blended_target", "budgeted_rate", "damping_factor",
     "KINEMATICS", "evaluate_kernel", "finished_kernel", "integrate_kernel", "update_kernel", "velocity_penalty",
+    "viability_bound",
 ]
 
 
@@ -55,7 +56,7 @@ def _layout(name: str, fields) -> type[IntEnum]:
 Parameter = _layout("Parameter", [
     ("KP", 6), ("KV", 6),  # Λ_P [1/s²], Λ_V [1/s] per task component (eq. 9)
     ("QD_MAX", 6), ("QDD_MAX", 6),  # joint limits [rad/s], [rad/s²] (eq. 4-5)
-    ("VIABILITY_GAIN", 6),  # K of the velocity-viability bound q̈_i <= K (q̇_max - q̇_i) [1/s]
+    ("VIABILITY_GAIN", 6),  # K, the slope of the velocity-viability bound at the limit (viability_bound) [1/s]
     ("VIABILITY_ONSET", 6),  # |q̇_i| above which that bound can bind [rad/s]
     ("PENALTY_ONSET", 6),  # |q̇_i| above which the penalty of eq. 14 is active [rad/s]
     ("VARTHETA", 1), ("RHO", 1),  # ϑ, ρ of eq. 14
@@ -136,8 +137,14 @@ ORIENTATION_LENGTH = 0.1  # [m/rad], weight of orientation in the progress measu
 MIN_COS_PITCH = 1e-6  # Euler gimbal lock (as the UR10e's analytic_jacobian_and_bias)
 SCALE_FLOOR = 0.1  # smallest c_r the approach damping is sized for (improvement 4)
 # largest |∂Δq̈_i/∂q̇_i| of the smooth penalty [1/s] (improvement 1): above the paper task's 59 1/s
-# (sim 3 keeps its numbers), far below the 1 ms step's stability bound of 2.8/1 ms (RK4)
-PENALTY_STIFFNESS = 300.0
+# (sim 3 keeps its numbers), far below the 1 ms step's stability bound of 2.8/1 ms (RK4). Riding
+# it, the penalty changes q̈_i at c · stiffness · q̈_i: at 300 1/s that was 0.10-0.17 rad/s² per ms
+# on moves of 1 rad per joint (c of 0.15-0.5, q̈_i near its limit); at 150 half that
+PENALTY_STIFFNESS = 150.0
+# the velocity-viability bound aims this fraction of q̇_max below the limit: riding it for seconds
+# (q̇ within 1e-15 of the limit), an RK4 stage, whose q̇ uses another stage's q̈, passed the limit
+# by 1e-10 rad/s (measured)
+VIABILITY_MARGIN = 1e-6
 
 # The robot's compiled task kinematics (Robot.task_kinematics), bound once as module globals: numba
 # compiles the calls to them into the law and caches the law on disk. Passed in (a closure over
@@ -327,19 +334,33 @@ def budgeted_rate(jac, lam2, use_damped, direction, scale: float, budget: float)
 @compiled
 def acceleration_box(qd, p, lower, upper):
     """The box [lower, upper] (6 each) that q̈ must stay in: ±q̈_max (eq. 5), narrowed near the
-    velocity limits (improvement 2) so that q̇ stays viable: q̈_i <= K (q̇_max - q̇_i) and the
-    mirror bound, so q̇ can only approach its limit exponentially even when c is held small by
-    another joint and the penalty (scaled by c) cannot act. K puts the bound's onset at d = ϑ/4,
-    inside the penalty zone."""
+    velocity limits (improvement 2) so that q̇ stays viable: q̈_i <= viability_bound(q̇_max - q̇_i)
+    and the mirror bound, so q̇ can only approach its limit exponentially even when c is held
+    small by another joint and the penalty (scaled by c) cannot act."""
     viable = p[Parameter.BOUNDED_SCALING] > 0.0 and p[Parameter.LIMIT_VELOCITY] > 0.0
+    jerk = p[Parameter.JERK_BUDGET]
     for k in range(6):
         limit = p[Parameter.QDD_MAX + k]
         lower[k], upper[k] = -limit, limit
         if viable and abs(qd[k]) > p[Parameter.VIABILITY_ONSET + k]:
             gain = p[Parameter.VIABILITY_GAIN + k]
-            speed = p[Parameter.QD_MAX + k]
-            upper[k] = min(max(gain * (speed - qd[k]), -limit), limit)
-            lower[k] = min(max(gain * (-speed - qd[k]), -limit), limit)
+            speed = p[Parameter.QD_MAX + k] * (1.0 - VIABILITY_MARGIN)
+            upper[k] = min(max(viability_bound(speed - qd[k], gain, jerk), -limit), limit)
+            lower[k] = min(max(-viability_bound(speed + qd[k], gain, jerk), -limit), limit)
+
+
+@compiled
+def viability_bound(gap: float, gain: float, jerk: float) -> float:
+    """The largest q̈_i [rad/s²] towards a velocity limit ``gap`` = q̇_max - |q̇_i| away [rad/s]
+    (improvement 2, with improvement 1's jerk budget): f(x) = sqrt(2 J x + (J/K)²) - J/K for
+    x >= 0, K x beyond the limit (x < 0). q̈ riding the bound changes at f'(x) f(x) =
+    J (1 - (J/K) / sqrt(2 J x + (J/K)²)) < ``jerk`` J [rad/s³], where the linear bound K x
+    changed it at K f, up to K q̈_max (0.1-0.3 rad/s² per ms at moves of 1 rad); its slope at the limit is ``gain`` K
+    [1/s], so q̇ still approaches the limit exponentially, at rate K."""
+    if gap <= 0.0:
+        return gain * gap
+    offset = jerk / gain
+    return math.sqrt(2.0 * jerk * gap + offset * offset) - offset
 
 
 @compiled

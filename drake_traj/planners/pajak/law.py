@@ -28,6 +28,7 @@ from drake_traj.planners.pajak.kernel import (
     KINEMATICS,
     MIN_COS_PITCH,
     ORIENTATION_LENGTH,
+    VIABILITY_MARGIN,
     Discrete,
     Evaluation,
     Parameter,
@@ -102,10 +103,13 @@ class PajakLaw:
         put(Parameter.KV, p.velocity_gain)
         put(Parameter.QD_MAX, p.velocity_limit)
         put(Parameter.QDD_MAX, p.acceleration_limit)
-        # velocity-viability bound of the acceleration box (improvement 2): it falls from q̈_max
-        # at d = ϑ/4 to 0 at the velocity limit
-        put(Parameter.VIABILITY_GAIN, p.acceleration_limit / (0.25 * p.vartheta * 2.0 * p.velocity_limit))
-        put(Parameter.VIABILITY_ONSET, p.velocity_limit * (1.0 - 0.5 * p.vartheta))
+        # velocity-viability bound of the acceleration box (improvement 2, kernel.viability_bound):
+        # slope K at the velocity limit (the linear bound K x would reach q̈_max at d = ϑ/4); with
+        # the jerk budget J it reaches q̈_max at x = q̈_max (q̈_max + 2 J/K) / (2 J) from the limit
+        gain = p.acceleration_limit / (0.25 * p.vartheta * 2.0 * p.velocity_limit)
+        put(Parameter.VIABILITY_GAIN, gain)
+        onset_gap = p.acceleration_limit * (p.acceleration_limit + 2.0 * p.jerk_budget / gain) / (2.0 * p.jerk_budget)
+        put(Parameter.VIABILITY_ONSET, p.velocity_limit * (1.0 - VIABILITY_MARGIN) - onset_gap)
         # |q̇| above which the penalty of eq. 14 is active: d < ϑ  <=>  |q̇| > q̇_max (1 - 2ϑ)
         put(Parameter.PENALTY_ONSET, p.velocity_limit * (1.0 - 2.0 * p.vartheta))
         for slot, value in (
