@@ -16,7 +16,7 @@ import pytest
 from drake_traj.robots import task_space
 from drake_traj.robots import ur10e as robot
 from drake_traj.planners import pajak as P
-from drake_traj.planners.pajak.kernel import PENALTY_STIFFNESS, VIABILITY_MARGIN, Parameter, viability_bound
+from drake_traj.planners.pajak.kernel import PENALTY_SPAN, PENALTY_STIFFNESS, VIABILITY_MARGIN, Parameter, viability_bound
 
 Q0 = P.paper_initial_configuration()
 # Every improvement off: the paper's method as printed (with the corrections of docs/papers.md).
@@ -226,6 +226,31 @@ def test_the_velocity_viability_bound_is_jerk_limited():
     assert gain * limit > 2 * jerk
     # beyond the limit it goes on linearly (braking back), continuous at 0
     assert viability_bound(-1e-3, gain, jerk) == pytest.approx(-gain * 1e-3)
+
+
+def test_the_penalty_cap_scales_with_low_velocity_limits():
+    """Below a span of PENALTY_SPAN the cap grows as 1/span², so the knee stays at one d: an
+    absolute cap put the knee above ϑ at 0.06 rad/s, where the penalty jumped at the threshold
+    and pushed towards the limit, and the law stalled with c held near 0 by the velocity limit."""
+    rho, vartheta = 0.03, 0.1
+    knee = (2 * rho / (PENALTY_STIFFNESS * PENALTY_SPAN**2)) ** (1 / 3)  # 0.074
+    for vmax in (0.06, 0.3, PENALTY_SPAN / 2):
+        span = 2 * vmax
+        d = np.array([vartheta + 1e-9, vartheta - 1e-9, 0.08, knee * (1 + 1e-9), knee * (1 - 1e-9), 0.02, 0.01])
+        penalty = np.array([P.velocity_penalty(vmax - x * span, vmax, rho, vartheta, True) for x in d])
+        assert penalty[0] == 0.0 and -1e-6 < penalty[1] < 0.0  # continuous at the threshold
+        assert np.all(np.diff(penalty) < 0)  # away from the limit, harder the nearer
+        np.testing.assert_allclose(penalty[2], -rho / span * (1 / 0.08**2 - 1 / vartheta**2), rtol=1e-12)
+        assert penalty[4] - penalty[3] == pytest.approx(0.0, abs=1e-6 * abs(penalty[3]))  # continuous at the knee
+        slope = (penalty[6] - penalty[5]) / (0.01 * span)  # ∂Δq̈/∂q̇ below the knee [1/s]
+        assert slope == pytest.approx(-PENALTY_STIFFNESS * (PENALTY_SPAN / span) ** 2, rel=1e-9)
+    # the paper's task at 1/20 of its limits finishes (it stalled at waypoint 1), q̇ held off the limit
+    task = P.paper_parameters(3, velocity_limit=0.05 * VMAX, acceleration_limit=0.05 * AMAX)
+    result = P.integrate(P.PajakLaw(task), Q0, t_max=60.0)
+    assert 30.0 < result["T"] < 60.0
+    assert np.abs(result["qd"]).max() < 0.9 * 0.05 * VMAX
+    assert np.abs(result["qdd"]).max() <= 0.05 * AMAX * (1 + TOL)
+    assert np.abs(np.diff(result["qdd"][1:], axis=0)).max() < 0.1  # no chatter at the 1 ms step [rad/s²]
 
 
 def test_scaling_interval_cases_1_to_4():

@@ -145,6 +145,11 @@ PENALTY_STIFFNESS = 150.0
 # (q̇ within 1e-15 of the limit), an RK4 stage, whose q̇ uses another stage's q̈, passed the limit
 # by 1e-10 rad/s (measured)
 VIABILITY_MARGIN = 1e-6
+# q̇_max - q̇_min [rad/s] below which the cap grows as (PENALTY_SPAN/span)², so the knee stays at
+# one d, (2ρ/(cap PENALTY_SPAN²))^(1/3) (0.074 with the defaults): the stiffness at a given d grows
+# as 1/span², and an absolute cap made the penalty too weak to keep q̇ off low limits (c then held
+# near 0 by the velocity limit's viability bound: a stall)
+PENALTY_SPAN = 1.0
 
 # The robot's compiled task kinematics (Robot.task_kinematics), bound once as module globals: numba
 # compiles the calls to them into the law and caches the law on disk. Passed in (a closure over
@@ -171,11 +176,15 @@ def velocity_penalty(qd: float, qd_max: float, rho: float, vartheta: float, smoo
     False): κ = ρ (1/d - 1/ϑ) for d < ϑ, whose slope -ρ/ϑ² at d = ϑ makes q̈ jump by
     ρ/((q̇_max - q̇_min) ϑ²) when the penalty switches on. Smooth (improvement 1): κ minus its
     tangent at ϑ, κ = ρ (1/d - 1/ϑ + (d - ϑ)/ϑ²), zero value and slope at the threshold; and
-    its stiffness |∂Δq̈_i/∂q̇_i| = 2ρ/(d³ span²) capped at PENALTY_STIFFNESS: below the d where
-    it reaches the cap, Δq̈_i goes on linearly with that slope (an affine κ' in q̇), so the
-    penalty never makes the law stiff (with d of 0.02 the uncapped stiffness was 4000 1/s and
-    q̈ chattered by 1 rad/s² at a 1 ms step; the velocity limit itself is held by the
-    acceleration box's viability bound, improvement 2). d is floored at 1e-3 beyond the limits.
+    its stiffness |∂Δq̈_i/∂q̇_i| = 2ρ/(d³ span²) capped at PENALTY_STIFFNESS, scaled by
+    (PENALTY_SPAN/span)² for a span = q̇_max - q̇_min below PENALTY_SPAN [rad/s]: below the d where
+    it reaches the cap (the knee, at most ϑ), Δq̈_i goes on linearly with that slope (an affine κ'
+    in q̇), so the penalty never makes the law stiff (with d of 0.02 the uncapped stiffness was
+    4000 1/s and q̈ chattered by 1 rad/s² at a 1 ms step; the velocity limit itself is held by the
+    acceleration box's viability bound, improvement 2). The scaling keeps the knee at one d for
+    low limits: the stiffness at a given d grows as 1/span², and an absolute cap moved the knee
+    above ϑ at 0.06 rad/s, where the penalty jumped at ϑ and pushed towards the limit (the law
+    stalled). d is floored at 1e-3 beyond the limits.
     """
     span = 2.0 * qd_max
     to_min = qd + qd_max
@@ -184,10 +193,12 @@ def velocity_penalty(qd: float, qd_max: float, rho: float, vartheta: float, smoo
     if d >= vartheta:
         return 0.0
     if smooth:
-        knee = (2.0 * rho / (PENALTY_STIFFNESS * span * span)) ** (1.0 / 3.0)  # stiffness = the cap
+        cap = PENALTY_STIFFNESS * max(1.0, (PENALTY_SPAN / span) ** 2)
+        # stiffness = the cap at d = knee; a knee at or above ϑ (a large ρ) makes the penalty linear from ϑ
+        knee = min((2.0 * rho / (cap * span * span)) ** (1.0 / 3.0), vartheta)
         magnitude = rho / (max(d, knee) ** 2 * span) - rho / (vartheta * vartheta * span)
         if d < knee:
-            magnitude += PENALTY_STIFFNESS * span * (knee - d)
+            magnitude += cap * span * (knee - d)
     else:
         magnitude = rho / (d * d * span)
     # ∂κ/∂q̇_i = κ'(d) ∂d/∂q̇_i, ∂d/∂q̇_i = -1/span near q̇_max: eq. 15 pushes from the nearer limit
