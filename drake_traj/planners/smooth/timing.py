@@ -27,8 +27,8 @@ from dataclasses import dataclass
 from math import comb
 
 import numpy as np
-import scipy.optimize
 import scipy.sparse
+from scipy.optimize._highspy import _core as highs  # HiGHS's own bindings, as scipy ships them
 from pydrake.trajectories import PiecewisePolynomial, Trajectory
 
 from drake_traj.errors import Cause, DrakeTrajError, joint_label
@@ -340,47 +340,83 @@ class _Program:
         w[:-1] += 0.5 * h
         w[1:] += 0.5 * h
         self.weights = w
+        # every program has the same rows (the first with the jerk rows unbounded) and the jerk
+        # programs the same matrix (√x frozen divides the jerk rows' bounds), so HiGHS keeps its
+        # factorisation and basis from one jerk program to the next and only the bounds change:
+        # its dual simplex then takes tens of iterations, not thousands
+        self.matrix = sp.vstack([self.accel, self.mid, self.equality, self.jerk], format="csr")
+        self.num_fixed_rows = self.matrix.shape[0] - self.jerk.shape[0]
+        zeros = np.zeros(self.equality.shape[0])
+        self.row_low = np.concatenate([-self.accel_bound, self.mid_low, zeros, np.full(self.jerk.shape[0], -np.inf)])
+        self.row_high = np.concatenate([self.accel_bound, self.mid_bound, zeros, np.full(self.jerk.shape[0], np.inf)])
+        self.solver, self.scale, self.jerk_programs, self.status = None, np.ones(2 * N), 0, ""
 
     def solve(self, previous, growth: float) -> tuple[np.ndarray, np.ndarray]:
         """(x, p) of the LP; without ``previous`` (x, p) the jerk is left out (a bang-bang profile
         with continuous s̈); with it, x grows by at most the factor ``growth`` (the trust region)."""
         N = self.num_nodes
         upper = self.velocity_bound.copy()
-        rows = [self.accel, self.mid, self.equality]
-        lows = [-self.accel_bound, self.mid_low, np.zeros(self.equality.shape[0])]
-        highs = [self.accel_bound, self.mid_bound, np.zeros(self.equality.shape[0])]
-        cost = np.concatenate([-self.weights, np.zeros(N)])
         if previous is not None:
-            x_previous = previous[0]
-            root = np.sqrt(np.maximum(x_previous[1:-1], 0.0))
-            rows.append(scipy.sparse.diags(np.tile(root, 2 * self.num_joints)) @ self.jerk)
-            lows.append(-self.jerk_bound)
-            highs.append(self.jerk_bound)
-            upper = np.minimum(upper, growth * x_previous)
+            upper = np.minimum(upper, growth * previous[0])
         lower = np.concatenate([np.zeros(N), np.full(N, -np.inf)])
         high = np.concatenate([upper, np.full(N, np.inf)])
         lower[[N, 2 * N - 1]] = high[[N, 2 * N - 1]] = 0.0
-        if previous is not None:  # the nodes next to the ends weigh nothing in the sum but their time,
-            ends = [1, 2, N - 3, N - 2]  # 3 h / √x, is long: they may fall by the trust region's factor at most
-            lower[ends] = np.minimum(previous[0][ends] / growth, high[ends])
-        # columns scaled to the last iterate (x spans 1e-6 near the ends to 1 mid-path, beyond
-        # HiGHS's absolute tolerances), 1 for the first program
-        scale = np.ones(2 * N) if previous is None else self._scale(*previous)
-        matrix = scipy.sparse.vstack(rows, format="csr") @ scipy.sparse.diags(scale)
-        constraint = scipy.optimize.LinearConstraint(matrix, np.concatenate(lows), np.concatenate(highs))
-        result = scipy.optimize.milp(cost * scale, constraints=constraint,
-                                     bounds=scipy.optimize.Bounds(lower / scale, high / scale))
-        if result.status != 0 and previous is not None and lower[1] > 0:  # without the floor at the ends
+        if previous is None:
+            self._start(np.ones(2 * N))
+        else:
+            if not self.jerk_programs:
+                # columns scaled to the first program's solution (x spans 1e-6 near the ends to 1
+                # mid-path, beyond HiGHS's absolute tolerances)
+                self._start(self._scale(*previous))
+            self.jerk_programs += 1
+            ends = [1, 2, N - 3, N - 2]  # the nodes next to the ends weigh nothing in the sum but their time,
+            lower[ends] = np.minimum(previous[0][ends] / growth, high[ends])  # 3 h / √x, is long: they fall by the trust region's factor at most
+            with np.errstate(divide="ignore"):
+                bound = self.jerk_bound / np.tile(np.sqrt(np.maximum(previous[0][1:-1], 0.0)), 2 * self.num_joints)
+            for row, value in enumerate(bound.tolist(), start=self.num_fixed_rows):  # (scipy's HiGHS has no changeRowsBounds)
+                self.solver.changeRowBounds(row, -value, value)
+        z = self._run(lower, high)
+        if z is None and previous is not None and lower[1] > 0:  # without the floor at the ends
             lower[[1, 2, N - 3, N - 2]] = 0.0
-            result = scipy.optimize.milp(cost * scale, constraints=constraint,
-                                         bounds=scipy.optimize.Bounds(lower / scale, high / scale))
-        if result.status != 0:
-            raise InfeasibleTimingError(f"the timing's linear program failed: {result.message}", field=("path",))
-        z = result.x * scale
+            z = self._run(lower, high)
+        if z is None:
+            raise InfeasibleTimingError(f"the timing's linear program failed: {self.status}", field=("path",))
+        z = z * self.scale
         return np.maximum(z[:N], 0.0), z[N:]
 
+    def _start(self, scale: np.ndarray) -> None:
+        """A HiGHS model of the programs with columns scaled by ``scale``, from the last basis."""
+        basis = None if self.solver is None else self.solver.getBasis()
+        matrix = self.matrix @ scipy.sparse.diags(scale)
+        cost = np.concatenate([-self.weights, np.zeros(self.num_nodes)]) * scale
+        lp = highs.HighsLp()
+        lp.num_col_, lp.num_row_ = len(cost), matrix.shape[0]
+        lp.col_cost_, lp.col_lower_, lp.col_upper_ = cost, np.zeros(len(cost)), np.zeros(len(cost))
+        lp.row_lower_, lp.row_upper_ = self.row_low, self.row_high
+        lp.a_matrix_.format_ = highs.MatrixFormat.kRowwise
+        lp.a_matrix_.num_col_, lp.a_matrix_.num_row_ = matrix.shape[1], matrix.shape[0]
+        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = matrix.indptr, matrix.indices, matrix.data
+        self.solver = highs._Highs()
+        self.solver.setOptionValue("output_flag", False)
+        self.solver.passModel(lp)
+        if basis is not None:
+            self.solver.setBasis(basis)
+        self.scale, self.jerk_programs = scale, 0
+
+    def _run(self, lower: np.ndarray, upper: np.ndarray) -> np.ndarray | None:
+        """The solution (scaled columns) of the program with these column bounds, None if HiGHS
+        does not find it optimal (``status`` says why)."""
+        columns = np.arange(len(lower), dtype=np.int32)
+        self.solver.changeColsBounds(len(columns), columns, lower / self.scale, upper / self.scale)
+        self.solver.run()
+        status = self.solver.getModelStatus()
+        if status != highs.HighsModelStatus.kOptimal:
+            self.status = self.solver.modelStatusToString(status)
+            return None
+        return np.asarray(self.solver.getSolution().col_value)
+
     def _scale(self, x: np.ndarray, p: np.ndarray) -> np.ndarray:
-        """Column scales: x at the last iterate, p at the larger of its last value and x / h."""
+        """Column scales: x at the given iterate, p at the larger of its value and x / h."""
         h = np.diff(self.s)
         spacing = np.minimum(np.append(h, h[-1]), np.insert(h, 0, h[0]))
         x_scale = np.maximum(x, 1e-9 * x.max())
