@@ -203,7 +203,7 @@ def _check_corners(path: Trajectory, name: str) -> None:
 
 def _check_cusps(path: Trajectory, name: str) -> None:
     s = np.linspace(path.start_time(), path.end_time(), 2001)
-    speed = np.array([np.linalg.norm(path.EvalDerivative(v, 1)) for v in s])
+    speed = np.linalg.norm(path.MakeDerivative(1).vector_values(s), axis=0)
     typical = np.median(speed)
     if not typical > 0:
         raise InfeasibleTimingError(f"{name} does not move: |q'(s)| is 0 along it", field=(name,))
@@ -254,9 +254,10 @@ def _grid(path, velocity, acceleration, jerk, points: int) -> np.ndarray:
     return s
 
 
-def _path_derivatives(path, s):
-    """First, second and third derivatives of q(s) at ``s``, each (N, n)."""
-    return [np.array([path.EvalDerivative(v, k).ravel() for v in s]) for k in (1, 2, 3)]
+def _path_derivatives(derivatives, s):
+    """First, second and third derivatives of q(s) at ``s``, each (N, n), from ``derivatives``:
+    the trajectories of those derivatives (``_Program.derivatives``)."""
+    return [derivative.vector_values(s).T for derivative in derivatives]
 
 
 _GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(8)
@@ -287,11 +288,12 @@ class _Program:
         N, n = len(s), path.rows()
         h = np.diff(s)
         self.s, self.num_nodes, self.num_joints = s, N, n
-        d1, d2, _ = _path_derivatives(path, s)
+        self.derivatives = [path.MakeDerivative(k) for k in (1, 2, 3)]
+        d1, d2, _ = _path_derivatives(self.derivatives, s)
         # q''' on each side of the nodes (it jumps at the breaks of a cubic spline)
         offset = 1e-9 * (s[-1] - s[0])
-        after = _path_derivatives(path, np.minimum(s + offset, s[-1]))[2]
-        before = _path_derivatives(path, np.maximum(s - offset, s[0]))[2]
+        after = _path_derivatives(self.derivatives, np.minimum(s + offset, s[-1]))[2]
+        before = _path_derivatives(self.derivatives, np.maximum(s - offset, s[0]))[2]
         sp = scipy.sparse
         X = sp.hstack([sp.identity(N), sp.csr_matrix((N, N))], format="csr")
         P = sp.hstack([sp.csr_matrix((N, N)), sp.identity(N)], format="csr")
@@ -305,7 +307,7 @@ class _Program:
         self.equality = sp.vstack([continuity, P[1] - X[1] * (4 / (3 * h[0])), P[N - 2] + X[N - 2] * (4 / (3 * h[-1]))],
                                   format="csr")
         mid = 0.5 * (s[1:-2] + s[2:-1])  # interior intervals 1..N-3
-        m1, m2 = _path_derivatives(path, mid)[:2]
+        m1, m2 = _path_derivatives(self.derivatives, mid)[:2]
         hm = h[1:-1]
         x_mid = X[1:N - 2] + sp.diags(hm / 8) @ (3 * P[1:N - 2] + P[2:N - 1])
         p_mid = 0.5 * (P[1:N - 2] + P[2:N - 1])
@@ -373,8 +375,8 @@ class _Program:
             lower[ends] = np.minimum(previous[0][ends] / growth, high[ends])  # 3 h / √x, is long: they fall by the trust region's factor at most
             with np.errstate(divide="ignore"):
                 bound = self.jerk_bound / np.tile(np.sqrt(np.maximum(previous[0][1:-1], 0.0)), 2 * self.num_joints)
-            for row, value in enumerate(bound.tolist(), start=self.num_fixed_rows):  # (scipy's HiGHS has no changeRowsBounds)
-                self.solver.changeRowBounds(row, -value, value)
+            rows = range(self.num_fixed_rows, self.matrix.shape[0])  # (scipy's HiGHS has no changeRowsBounds)
+            list(map(self.solver.changeRowBounds, rows, (-bound).tolist(), bound.tolist()))
         z = self._run(lower, high)
         if z is None and previous is not None and lower[1] > 0:  # without the floor at the ends
             lower[[1, 2, N - 3, N - 2]] = 0.0
@@ -451,9 +453,9 @@ def _samples(path, program: _Program, x: np.ndarray, p: np.ndarray):
     x = np.concatenate([x, x_mid])[order]
     p = np.concatenate([p, p_mid])[order]
     t = np.concatenate([nodes, nodes[:-1] + dt_mid])[order]
-    d1, d2 = _path_derivatives(path, s)[:2]
+    d1, d2 = _path_derivatives(program.derivatives[:2], s)
     rate = np.sqrt(np.maximum(x, 0.0))
-    q = np.array([path.value(v).ravel() for v in s])
+    q = path.vector_values(s).T
     qd = d1 * rate[:, None]
     qdd = d1 * (0.5 * p)[:, None] + d2 * x[:, None]
     return t, np.stack([q, qd, qdd], axis=1), np.stack([s, rate, 0.5 * p], axis=1)
@@ -484,17 +486,11 @@ def _deviation(path, knots, joint_coefficients, path_samples) -> float:
     """Upper bound [rad] of the distance of the pieces from the path: at 4 points inside every
     piece, |q_piece(t) - q(s_piece(t))|, s_piece the quintic Hermite of (s, ṡ, s̈)."""
     s_coefficients = quintic_hermite_coefficients(knots, path_samples[:, :, None], path_samples[:, :, None])
-    worst = 0.0
-    fractions = np.array([0.2, 0.4, 0.6, 0.8])
-    h = np.diff(knots)
-    for k in range(len(h)):
-        tau = fractions * h[k]
-        powers = tau[:, None] ** np.arange(6)
-        q = powers @ joint_coefficients[k]
-        s = np.clip(powers @ s_coefficients[k, :, 0], path.start_time(), path.end_time())
-        on_path = np.array([path.value(v).ravel() for v in s])
-        worst = max(worst, float(np.abs(q - on_path).max()))
-    return worst
+    tau = np.array([0.2, 0.4, 0.6, 0.8])[None, :] * np.diff(knots)[:, None]  # (K, 4)
+    powers = tau[:, :, None] ** np.arange(6)  # (K, 4, 6)
+    q = np.einsum("kfp,kpn->kfn", powers, joint_coefficients).reshape(-1, joint_coefficients.shape[2])
+    s = np.clip(np.einsum("kfp,kp->kf", powers, s_coefficients[:, :, 0]).ravel(), path.start_time(), path.end_time())
+    return float(np.abs(q - path.vector_values(s).T).max())
 
 
 def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 250,
