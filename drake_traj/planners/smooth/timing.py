@@ -311,18 +311,19 @@ class _Program:
         hm = h[1:-1]
         x_mid = X[1:N - 2] + sp.diags(hm / 8) @ (3 * P[1:N - 2] + P[2:N - 1])
         p_mid = 0.5 * (P[1:N - 2] + P[2:N - 1])
-        accel, jerk_rows = [], []
-        for j in range(n):
-            accel.append(sp.diags(d2[inner, j]) @ X[inner] + sp.diags(0.5 * d1[inner, j]) @ P[inner])
-            accel.append(sp.diags(m2[:, j]) @ x_mid + sp.diags(0.5 * m1[:, j]) @ p_mid)
-            node = sp.diags(1.5 * d2[inner, j]) @ P[inner]
-            q1 = sp.diags(0.5 * d1[inner, j])
-            # node i on interval i (its left end), then on interval i - 1 (its right end)
-            jerk_rows.append(node + q1 @ curvature[1:] + sp.diags(after[inner, j]) @ X[inner])
-            jerk_rows.append(node + q1 @ curvature[:-1] + sp.diags(before[inner, j]) @ X[inner])
-        self.accel = sp.vstack(accel, format="csr")
+
+        def per_joint(coefficients, block):
+            """The rows diag(coefficients[:, j]) @ block for every joint j, joint after joint."""
+            return sp.diags(coefficients.T.ravel()) @ sp.vstack([block] * n, format="csr")
+
+        # per joint: the acceleration at the nodes, then mid-interval
+        self.accel = (per_joint(np.concatenate([d2[inner], m2]), sp.vstack([X[inner], x_mid]))
+                      + per_joint(0.5 * np.concatenate([d1[inner], m1]), sp.vstack([P[inner], p_mid]))).tocsr()
         self.accel_bound = LIMIT_MARGIN * np.concatenate([np.full(N - 2 + len(mid), acceleration[j]) for j in range(n)])
-        self.jerk = sp.vstack(jerk_rows, format="csr")
+        # per joint: node i on interval i (its left end), then on interval i - 1 (its right end)
+        self.jerk = (per_joint(1.5 * np.concatenate([d2[inner], d2[inner]]), sp.vstack([P[inner], P[inner]]))
+                     + per_joint(0.5 * np.concatenate([d1[inner], d1[inner]]), sp.vstack([curvature[1:], curvature[:-1]]))
+                     + per_joint(np.concatenate([after[inner], before[inner]]), sp.vstack([X[inner], X[inner]]))).tocsr()
         # the jerk ramps at the ends are where the pieces' jerk exceeds the nodes' most (by up to 8 %
         # on the seeded sweeps, through the frozen √x): aim lower on the first and last 3 nodes
         margin = np.full(N - 2, LIMIT_MARGIN)
