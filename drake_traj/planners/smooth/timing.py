@@ -27,8 +27,8 @@ from dataclasses import dataclass
 from math import comb
 
 import numpy as np
-import scipy.optimize
 import scipy.sparse
+from scipy.optimize._highspy import _core as highs  # HiGHS's own bindings, as scipy ships them
 from pydrake.trajectories import PiecewisePolynomial, Trajectory
 
 from drake_traj.errors import Cause, DrakeTrajError, joint_label
@@ -203,7 +203,7 @@ def _check_corners(path: Trajectory, name: str) -> None:
 
 def _check_cusps(path: Trajectory, name: str) -> None:
     s = np.linspace(path.start_time(), path.end_time(), 2001)
-    speed = np.array([np.linalg.norm(path.EvalDerivative(v, 1)) for v in s])
+    speed = np.linalg.norm(path.MakeDerivative(1).vector_values(s), axis=0)
     typical = np.median(speed)
     if not typical > 0:
         raise InfeasibleTimingError(f"{name} does not move: |q'(s)| is 0 along it", field=(name,))
@@ -254,9 +254,10 @@ def _grid(path, velocity, acceleration, jerk, points: int) -> np.ndarray:
     return s
 
 
-def _path_derivatives(path, s):
-    """First, second and third derivatives of q(s) at ``s``, each (N, n)."""
-    return [np.array([path.EvalDerivative(v, k).ravel() for v in s]) for k in (1, 2, 3)]
+def _path_derivatives(derivatives, s):
+    """First, second and third derivatives of q(s) at ``s``, each (N, n), from ``derivatives``:
+    the trajectories of those derivatives (``_Program.derivatives``)."""
+    return [derivative.vector_values(s).T for derivative in derivatives]
 
 
 _GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(8)
@@ -287,11 +288,12 @@ class _Program:
         N, n = len(s), path.rows()
         h = np.diff(s)
         self.s, self.num_nodes, self.num_joints = s, N, n
-        d1, d2, _ = _path_derivatives(path, s)
+        self.derivatives = [path.MakeDerivative(k) for k in (1, 2, 3)]
+        d1, d2, _ = _path_derivatives(self.derivatives, s)
         # q''' on each side of the nodes (it jumps at the breaks of a cubic spline)
         offset = 1e-9 * (s[-1] - s[0])
-        after = _path_derivatives(path, np.minimum(s + offset, s[-1]))[2]
-        before = _path_derivatives(path, np.maximum(s - offset, s[0]))[2]
+        after = _path_derivatives(self.derivatives, np.minimum(s + offset, s[-1]))[2]
+        before = _path_derivatives(self.derivatives, np.maximum(s - offset, s[0]))[2]
         sp = scipy.sparse
         X = sp.hstack([sp.identity(N), sp.csr_matrix((N, N))], format="csr")
         P = sp.hstack([sp.csr_matrix((N, N)), sp.identity(N)], format="csr")
@@ -305,22 +307,23 @@ class _Program:
         self.equality = sp.vstack([continuity, P[1] - X[1] * (4 / (3 * h[0])), P[N - 2] + X[N - 2] * (4 / (3 * h[-1]))],
                                   format="csr")
         mid = 0.5 * (s[1:-2] + s[2:-1])  # interior intervals 1..N-3
-        m1, m2 = _path_derivatives(path, mid)[:2]
+        m1, m2 = _path_derivatives(self.derivatives, mid)[:2]
         hm = h[1:-1]
         x_mid = X[1:N - 2] + sp.diags(hm / 8) @ (3 * P[1:N - 2] + P[2:N - 1])
         p_mid = 0.5 * (P[1:N - 2] + P[2:N - 1])
-        accel, jerk_rows = [], []
-        for j in range(n):
-            accel.append(sp.diags(d2[inner, j]) @ X[inner] + sp.diags(0.5 * d1[inner, j]) @ P[inner])
-            accel.append(sp.diags(m2[:, j]) @ x_mid + sp.diags(0.5 * m1[:, j]) @ p_mid)
-            node = sp.diags(1.5 * d2[inner, j]) @ P[inner]
-            q1 = sp.diags(0.5 * d1[inner, j])
-            # node i on interval i (its left end), then on interval i - 1 (its right end)
-            jerk_rows.append(node + q1 @ curvature[1:] + sp.diags(after[inner, j]) @ X[inner])
-            jerk_rows.append(node + q1 @ curvature[:-1] + sp.diags(before[inner, j]) @ X[inner])
-        self.accel = sp.vstack(accel, format="csr")
+
+        def per_joint(coefficients, block):
+            """The rows diag(coefficients[:, j]) @ block for every joint j, joint after joint."""
+            return sp.diags(coefficients.T.ravel()) @ sp.vstack([block] * n, format="csr")
+
+        # per joint: the acceleration at the nodes, then mid-interval
+        self.accel = (per_joint(np.concatenate([d2[inner], m2]), sp.vstack([X[inner], x_mid]))
+                      + per_joint(0.5 * np.concatenate([d1[inner], m1]), sp.vstack([P[inner], p_mid]))).tocsr()
         self.accel_bound = LIMIT_MARGIN * np.concatenate([np.full(N - 2 + len(mid), acceleration[j]) for j in range(n)])
-        self.jerk = sp.vstack(jerk_rows, format="csr")
+        # per joint: node i on interval i (its left end), then on interval i - 1 (its right end)
+        self.jerk = (per_joint(1.5 * np.concatenate([d2[inner], d2[inner]]), sp.vstack([P[inner], P[inner]]))
+                     + per_joint(0.5 * np.concatenate([d1[inner], d1[inner]]), sp.vstack([curvature[1:], curvature[:-1]]))
+                     + per_joint(np.concatenate([after[inner], before[inner]]), sp.vstack([X[inner], X[inner]]))).tocsr()
         # the jerk ramps at the ends are where the pieces' jerk exceeds the nodes' most (by up to 8 %
         # on the seeded sweeps, through the frozen √x): aim lower on the first and last 3 nodes
         margin = np.full(N - 2, LIMIT_MARGIN)
@@ -340,47 +343,83 @@ class _Program:
         w[:-1] += 0.5 * h
         w[1:] += 0.5 * h
         self.weights = w
+        # every program has the same rows (the first with the jerk rows unbounded) and the jerk
+        # programs the same matrix (√x frozen divides the jerk rows' bounds), so HiGHS keeps its
+        # factorisation and basis from one jerk program to the next and only the bounds change:
+        # its dual simplex then takes tens of iterations, not thousands
+        self.matrix = sp.vstack([self.accel, self.mid, self.equality, self.jerk], format="csr")
+        self.num_fixed_rows = self.matrix.shape[0] - self.jerk.shape[0]
+        zeros = np.zeros(self.equality.shape[0])
+        self.row_low = np.concatenate([-self.accel_bound, self.mid_low, zeros, np.full(self.jerk.shape[0], -np.inf)])
+        self.row_high = np.concatenate([self.accel_bound, self.mid_bound, zeros, np.full(self.jerk.shape[0], np.inf)])
+        self.solver, self.scale, self.jerk_programs, self.status = None, np.ones(2 * N), 0, ""
 
     def solve(self, previous, growth: float) -> tuple[np.ndarray, np.ndarray]:
         """(x, p) of the LP; without ``previous`` (x, p) the jerk is left out (a bang-bang profile
         with continuous s̈); with it, x grows by at most the factor ``growth`` (the trust region)."""
         N = self.num_nodes
         upper = self.velocity_bound.copy()
-        rows = [self.accel, self.mid, self.equality]
-        lows = [-self.accel_bound, self.mid_low, np.zeros(self.equality.shape[0])]
-        highs = [self.accel_bound, self.mid_bound, np.zeros(self.equality.shape[0])]
-        cost = np.concatenate([-self.weights, np.zeros(N)])
         if previous is not None:
-            x_previous = previous[0]
-            root = np.sqrt(np.maximum(x_previous[1:-1], 0.0))
-            rows.append(scipy.sparse.diags(np.tile(root, 2 * self.num_joints)) @ self.jerk)
-            lows.append(-self.jerk_bound)
-            highs.append(self.jerk_bound)
-            upper = np.minimum(upper, growth * x_previous)
+            upper = np.minimum(upper, growth * previous[0])
         lower = np.concatenate([np.zeros(N), np.full(N, -np.inf)])
         high = np.concatenate([upper, np.full(N, np.inf)])
         lower[[N, 2 * N - 1]] = high[[N, 2 * N - 1]] = 0.0
-        if previous is not None:  # the nodes next to the ends weigh nothing in the sum but their time,
-            ends = [1, 2, N - 3, N - 2]  # 3 h / √x, is long: they may fall by the trust region's factor at most
-            lower[ends] = np.minimum(previous[0][ends] / growth, high[ends])
-        # columns scaled to the last iterate (x spans 1e-6 near the ends to 1 mid-path, beyond
-        # HiGHS's absolute tolerances), 1 for the first program
-        scale = np.ones(2 * N) if previous is None else self._scale(*previous)
-        matrix = scipy.sparse.vstack(rows, format="csr") @ scipy.sparse.diags(scale)
-        constraint = scipy.optimize.LinearConstraint(matrix, np.concatenate(lows), np.concatenate(highs))
-        result = scipy.optimize.milp(cost * scale, constraints=constraint,
-                                     bounds=scipy.optimize.Bounds(lower / scale, high / scale))
-        if result.status != 0 and previous is not None and lower[1] > 0:  # without the floor at the ends
+        if previous is None:
+            self._start(np.ones(2 * N))
+        else:
+            if not self.jerk_programs:
+                # columns scaled to the first program's solution (x spans 1e-6 near the ends to 1
+                # mid-path, beyond HiGHS's absolute tolerances)
+                self._start(self._scale(*previous))
+            self.jerk_programs += 1
+            ends = [1, 2, N - 3, N - 2]  # the nodes next to the ends weigh nothing in the sum but their time,
+            lower[ends] = np.minimum(previous[0][ends] / growth, high[ends])  # 3 h / √x, is long: they fall by the trust region's factor at most
+            with np.errstate(divide="ignore"):
+                bound = self.jerk_bound / np.tile(np.sqrt(np.maximum(previous[0][1:-1], 0.0)), 2 * self.num_joints)
+            rows = range(self.num_fixed_rows, self.matrix.shape[0])  # (scipy's HiGHS has no changeRowsBounds)
+            list(map(self.solver.changeRowBounds, rows, (-bound).tolist(), bound.tolist()))
+        z = self._run(lower, high)
+        if z is None and previous is not None and lower[1] > 0:  # without the floor at the ends
             lower[[1, 2, N - 3, N - 2]] = 0.0
-            result = scipy.optimize.milp(cost * scale, constraints=constraint,
-                                         bounds=scipy.optimize.Bounds(lower / scale, high / scale))
-        if result.status != 0:
-            raise InfeasibleTimingError(f"the timing's linear program failed: {result.message}", field=("path",))
-        z = result.x * scale
+            z = self._run(lower, high)
+        if z is None:
+            raise InfeasibleTimingError(f"the timing's linear program failed: {self.status}", field=("path",))
+        z = z * self.scale
         return np.maximum(z[:N], 0.0), z[N:]
 
+    def _start(self, scale: np.ndarray) -> None:
+        """A HiGHS model of the programs with columns scaled by ``scale``, from the last basis."""
+        basis = None if self.solver is None else self.solver.getBasis()
+        matrix = self.matrix @ scipy.sparse.diags(scale)
+        cost = np.concatenate([-self.weights, np.zeros(self.num_nodes)]) * scale
+        lp = highs.HighsLp()
+        lp.num_col_, lp.num_row_ = len(cost), matrix.shape[0]
+        lp.col_cost_, lp.col_lower_, lp.col_upper_ = cost, np.zeros(len(cost)), np.zeros(len(cost))
+        lp.row_lower_, lp.row_upper_ = self.row_low, self.row_high
+        lp.a_matrix_.format_ = highs.MatrixFormat.kRowwise
+        lp.a_matrix_.num_col_, lp.a_matrix_.num_row_ = matrix.shape[1], matrix.shape[0]
+        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = matrix.indptr, matrix.indices, matrix.data
+        self.solver = highs._Highs()
+        self.solver.setOptionValue("output_flag", False)
+        self.solver.passModel(lp)
+        if basis is not None:
+            self.solver.setBasis(basis)
+        self.scale, self.jerk_programs = scale, 0
+
+    def _run(self, lower: np.ndarray, upper: np.ndarray) -> np.ndarray | None:
+        """The solution (scaled columns) of the program with these column bounds, None if HiGHS
+        does not find it optimal (``status`` says why)."""
+        columns = np.arange(len(lower), dtype=np.int32)
+        self.solver.changeColsBounds(len(columns), columns, lower / self.scale, upper / self.scale)
+        self.solver.run()
+        status = self.solver.getModelStatus()
+        if status != highs.HighsModelStatus.kOptimal:
+            self.status = self.solver.modelStatusToString(status)
+            return None
+        return np.asarray(self.solver.getSolution().col_value)
+
     def _scale(self, x: np.ndarray, p: np.ndarray) -> np.ndarray:
-        """Column scales: x at the last iterate, p at the larger of its last value and x / h."""
+        """Column scales: x at the given iterate, p at the larger of its value and x / h."""
         h = np.diff(self.s)
         spacing = np.minimum(np.append(h, h[-1]), np.insert(h, 0, h[0]))
         x_scale = np.maximum(x, 1e-9 * x.max())
@@ -415,9 +454,9 @@ def _samples(path, program: _Program, x: np.ndarray, p: np.ndarray):
     x = np.concatenate([x, x_mid])[order]
     p = np.concatenate([p, p_mid])[order]
     t = np.concatenate([nodes, nodes[:-1] + dt_mid])[order]
-    d1, d2 = _path_derivatives(path, s)[:2]
+    d1, d2 = _path_derivatives(program.derivatives[:2], s)
     rate = np.sqrt(np.maximum(x, 0.0))
-    q = np.array([path.value(v).ravel() for v in s])
+    q = path.vector_values(s).T
     qd = d1 * rate[:, None]
     qdd = d1 * (0.5 * p)[:, None] + d2 * x[:, None]
     return t, np.stack([q, qd, qdd], axis=1), np.stack([s, rate, 0.5 * p], axis=1)
@@ -448,17 +487,11 @@ def _deviation(path, knots, joint_coefficients, path_samples) -> float:
     """Upper bound [rad] of the distance of the pieces from the path: at 4 points inside every
     piece, |q_piece(t) - q(s_piece(t))|, s_piece the quintic Hermite of (s, ṡ, s̈)."""
     s_coefficients = quintic_hermite_coefficients(knots, path_samples[:, :, None], path_samples[:, :, None])
-    worst = 0.0
-    fractions = np.array([0.2, 0.4, 0.6, 0.8])
-    h = np.diff(knots)
-    for k in range(len(h)):
-        tau = fractions * h[k]
-        powers = tau[:, None] ** np.arange(6)
-        q = powers @ joint_coefficients[k]
-        s = np.clip(powers @ s_coefficients[k, :, 0], path.start_time(), path.end_time())
-        on_path = np.array([path.value(v).ravel() for v in s])
-        worst = max(worst, float(np.abs(q - on_path).max()))
-    return worst
+    tau = np.array([0.2, 0.4, 0.6, 0.8])[None, :] * np.diff(knots)[:, None]  # (K, 4)
+    powers = tau[:, :, None] ** np.arange(6)  # (K, 4, 6)
+    q = np.einsum("kfp,kpn->kfn", powers, joint_coefficients).reshape(-1, joint_coefficients.shape[2])
+    s = np.clip(np.einsum("kfp,kp->kf", powers, s_coefficients[:, :, 0]).ravel(), path.start_time(), path.end_time())
+    return float(np.abs(q - path.vector_values(s).T).max())
 
 
 def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 250,
