@@ -116,3 +116,20 @@ def test_a_stall_names_the_singularity():
     assert min(value for value, _ in factors.values()) == pytest.approx(
         robot.singularity_measure(error.configuration), abs=1e-12)
     assert f"factor {factors['wrist'][0]:.3g}" in str(error)
+
+
+def test_a_motion_through_the_gimbal_lock_stops_naming_it():
+    # task 42 passed |cos φ_Y| = 1.6e-4 on the way to waypoint 3, where a = -J⁻¹J̇q̇ left the
+    # acceleration box and q̈ jumped by 1.93 rad/s² in 1 ms; it now stops 1e-3 rad (0.057°) from
+    # the lock with its cause and the waypoint, q̈ continuous up to there
+    law = P.PajakLaw(TASKS[42])
+    with pytest.raises(P.PlanningError) as info:
+        P.integrate(law, Q0)
+    error = info.value
+    assert error.cause == "singular" and error.field == ("waypoints", 3)
+    assert "the Euler angles' gimbal lock: φ_Y within 0.057° of ±90° on the way to waypoint 3" in str(error)
+    pitch = robot.ur10e_kinematics(error.configuration, np.zeros(6), law.tool)[3]
+    assert pitch < 1e-3
+    logged = np.abs(np.cos(error.partial["tcp"][:, 4]))
+    assert logged.min() >= 1e-3
+    assert largest_step(error.partial["qdd"]) <= STEP

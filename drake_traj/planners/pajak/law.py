@@ -26,6 +26,7 @@ import numpy as np
 from drake_traj.errors import Cause, PlanningError, SingularConfigurationError, joint_label
 from drake_traj.planners.pajak.kernel import (
     KINEMATICS,
+    GIMBAL_MARGIN,
     MIN_COS_PITCH,
     ORIENTATION_LENGTH,
     VIABILITY_MARGIN,
@@ -127,6 +128,9 @@ class PajakLaw:
             (Parameter.CONTINUOUS_SWITCHING, p.continuous_switching), (Parameter.BOUNDED_SCALING, p.bounded_scaling),
             (Parameter.DAMPED_INVERSE, p.damped_inverse), (Parameter.PRESERVE_DAMPING, p.preserve_damping),
             (Parameter.CONTINUOUS_ORIENTATION, p.continuous_orientation),
+            # improvement 6's orientation is continuous near the gimbal lock, but not through it:
+            # "ours" stops GIMBAL_MARGIN from it (kernel.GIMBAL_MARGIN), the paper's method at 1e-6
+            (Parameter.MIN_COS_PITCH, GIMBAL_MARGIN if p.continuous_orientation else MIN_COS_PITCH),
         ):
             v[slot] = float(value)
         self.vector = v
@@ -170,12 +174,14 @@ class PajakLaw:
         evaluation (not only at updates) and q̈ is continuous in t between updates.
 
         Raises:
-            PlanningError: at an Euler gimbal lock (cos φ_Y below 1e-6) or a non-finite q̈.
+            PlanningError: at the Euler angles' gimbal lock (cos φ_Y below 1e-3 with improvement 6,
+                1e-6 without) or a non-finite q̈.
         """
         out = self._evaluate(t, q, qd, discrete)
         qdd = out[Evaluation.QDD:Evaluation.QDD + 6]
-        if out[Evaluation.COS_PITCH] < MIN_COS_PITCH or not np.all(np.isfinite(qdd)):
-            raise self.failure(Status.SINGULAR if out[Evaluation.COS_PITCH] < MIN_COS_PITCH else Status.NON_FINITE,
+        locked = out[Evaluation.COS_PITCH] < self.vector[Parameter.MIN_COS_PITCH]
+        if locked or not np.all(np.isfinite(qdd)):
+            raise self.failure(Status.SINGULAR if locked else Status.NON_FINITE,
                                t, q, discrete, out)
         return qdd.copy(), float(out[Evaluation.C])
 
@@ -245,9 +251,13 @@ class PajakLaw:
         status = Status(status)
         q = np.array(q, dtype=float)
         if status == Status.SINGULAR:
-            message = (f"Z-Y-X Euler angles are singular: phi_Y = {out[Evaluation.POSE + 4]:.6f} rad is at +-pi/2 "
-                       "(gimbal lock), the analytic Jacobian has no inverse")
-            cause, field = Cause.SINGULAR, ()
+            margin = np.degrees(np.arcsin(self.vector[Parameter.MIN_COS_PITCH]))
+            waypoint = int(discrete[Discrete.WAYPOINT])
+            message = (f"the Euler angles' gimbal lock: φ_Y within {margin:.2g}° of ±90° on the way to waypoint "
+                       f"{waypoint} (phi_Y = {out[Evaluation.POSE + 4]:.6f} rad, cos phi_Y = "
+                       f"{out[Evaluation.COS_PITCH]:.2g}): the Z-Y-X Euler angles are singular there, the analytic "
+                       "Jacobian has no inverse")
+            cause, field = Cause.SINGULAR, ("waypoints", waypoint)
         elif status == Status.NON_FINITE:
             message = (f"non-finite state or acceleration {out[Evaluation.QDD:Evaluation.QDD + 6].tolist()} "
                        f"(singularity measure {out[Evaluation.MEASURE]:.2e})")
