@@ -127,7 +127,9 @@ def sample_path(samples, max_knots: int = 200, *, name: str = "path") -> tuple[P
     tight turn gets as many knots as a long straight stretch (a path from Pająk's law turns
     through tens of degrees within 0.1 mrad where it slows down). Repeated samples (closer than
     1e-9 rad) are dropped. Where the spline strays from a sample by more than half of
-    :data:`PATH_TOLERANCE`, the knots are doubled (up to 4 × ``max_knots``).
+    :data:`PATH_TOLERANCE`, the knot interval holding that sample is split at its middle (in the
+    same measure), round after round, up to 4 × ``max_knots`` knots: knots are added only where
+    the path needs them.
 
     Raises:
         InfeasibleTimingError: fewer than two distinct samples, or a spline that still strays.
@@ -145,18 +147,25 @@ def sample_path(samples, max_knots: int = 200, *, name: str = "path") -> tuple[P
     unit = steps / length[:, None]
     turn = np.arccos(np.clip(np.sum(unit[1:] * unit[:-1], axis=1), -1.0, 1.0))
     measure = arc + np.concatenate([[0.0], np.cumsum(turn), [turn.sum()]]) * (arc[-1] / max(turn.sum(), 1e-12))
-    knots = max_knots
+    index = np.unique(np.concatenate([[0, len(q) - 1],
+                                      np.searchsorted(measure, np.linspace(0, measure[-1], max_knots)).clip(0, len(q) - 1)]))
     while True:
-        index = np.unique(np.concatenate([[0, len(q) - 1],
-                                          np.searchsorted(measure, np.linspace(0, measure[-1], knots)).clip(0, len(q) - 1)]))
         chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(q[index], axis=0), axis=1))])
         path = (PiecewisePolynomial.FirstOrderHold(chord, q[index].T) if len(index) == 2 else
                 PiecewisePolynomial.CubicWithContinuousSecondDerivatives(chord, q[index].T, periodic_end_condition=False))
         at = np.interp(arc, arc[index], chord)  # each sample's parameter, by arc length between knots
-        deviation = float(np.abs(path.vector_values(at).T - q).max())
-        if deviation <= 0.5 * PATH_TOLERANCE or knots >= 4 * max_knots or len(index) == len(q):
+        error = np.abs(path.vector_values(at).T - q).max(axis=1)
+        deviation = float(error.max())
+        if deviation <= 0.5 * PATH_TOLERANCE or len(index) >= 4 * max_knots:
             break
-        knots *= 2
+        # a knot at the middle (in the measure) of every knot interval holding a sample that strays
+        stray = np.searchsorted(index, np.flatnonzero(error > 0.5 * PATH_TOLERANCE), side="right") - 1
+        stray = np.unique(stray.clip(0, len(index) - 2))
+        stray = stray[index[stray + 1] - index[stray] > 1]
+        if not len(stray):
+            break
+        middle = np.searchsorted(measure, 0.5 * (measure[index[stray]] + measure[index[stray + 1]]))
+        index = np.unique(np.concatenate([index, np.clip(middle, index[stray] + 1, index[stray + 1] - 1)]))
     if deviation > 0.5 * PATH_TOLERANCE:
         raise InfeasibleTimingError(f"{name}: no spline through {len(index)} of its samples stays within "
                                     f"{0.5 * PATH_TOLERANCE:g} rad of them ({deviation:.3g} rad): the samples are "
@@ -224,15 +233,17 @@ def _limits(path, velocity_limit, acceleration_limit, jerk_limit):
 
 
 def _grid(path, velocity, acceleration, jerk, points: int) -> np.ndarray:
-    """Grid nodes s: evenly spaced in the time of the bang-bang optimum (Drake's Toppra), so
-    the nodes crowd where the path is slow and near the ends (s ∝ t² there), plus the path's
-    breaks. Where Toppra finds no parameterisation (its reachability analysis fails on some
-    paths with tight turns), the bang-bang profile of our own first linear program on nodes
+    """Grid nodes s: evenly spaced in the time of the bang-bang optimum (Drake's Toppra, on
+    as many points evenly spaced in s plus the path's breaks: its default grid takes over a
+    thousand points on a tight turn, and 5 times longer), so the nodes crowd where the path is
+    slow and near the ends (s ∝ t² there), plus the path's breaks. Where Toppra finds no
+    parameterisation (its reachability analysis fails on some paths with tight turns), the bang-bang profile of our own first linear program on nodes
     evenly spaced in s takes its place."""
     breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
     points = max(points - len(breaks), points // 2)
     try:
-        optimal, trajectory = time_optimal_along_path(path, velocity, acceleration)
+        toppra_grid = np.unique(np.concatenate([np.linspace(path.start_time(), path.end_time(), points), breaks]))
+        optimal, trajectory = time_optimal_along_path(path, velocity, acceleration, grid_points=toppra_grid)
         s_of_t = trajectory.time_scaling()
         s = np.array([s_of_t.value(t)[0, 0] for t in np.linspace(0.0, optimal, points)])
     except ValueError:
