@@ -33,7 +33,7 @@ from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import instance_of, limit_or_default, positive_vector
 
-__all__ = ["DEFAULT_JERK_FACTOR", "RuckigPlanner", "RuckigStopLaw", "default_jerk_limit"]
+__all__ = ["DEFAULT_JERK_FACTOR", "RuckigPlanner", "RuckigStopLaw", "default_jerk_limit", "jerk_limited_limits"]
 
 DEFAULT_JERK_FACTOR = 10.0
 """Default jerk limit = DEFAULT_JERK_FACTOR [1/s] * acceleration limit (UR10e publishes none)."""
@@ -42,6 +42,17 @@ DEFAULT_JERK_FACTOR = 10.0
 def default_jerk_limit(acceleration_limit):
     """The default jerk limit [rad/s^3]: 10 [1/s] times ``acceleration_limit`` [rad/s^2]."""
     return DEFAULT_JERK_FACTOR * np.asarray(acceleration_limit, dtype=float)
+
+
+def jerk_limited_limits(robot: Robot, velocity_limit, acceleration_limit, jerk_limit):
+    """(velocity [rad/s], acceleration [rad/s^2], jerk [rad/s^3]) per joint from a config's
+    entries, each empty for its default: the robot's joint-move limits, and
+    :func:`default_jerk_limit` of the acceleration limit."""
+    n = robot.num_joints
+    default_velocity, default_acceleration = robot.joint_move_limits
+    velocity = limit_or_default(velocity_limit, default_velocity, "velocity_limit", n)
+    acceleration = limit_or_default(acceleration_limit, default_acceleration, "acceleration_limit", n)
+    return velocity, acceleration, limit_or_default(jerk_limit, default_jerk_limit(acceleration), "jerk_limit", n)
 
 
 class RuckigStopLaw:
@@ -262,13 +273,5 @@ class RuckigConfig:
 
 def make(config: RuckigConfig, robot: Robot, q_initial) -> RuckigPlanner:
     """The baseline of ``config`` on ``robot`` from ``q_initial``."""
-    default_velocity, default_acceleration = robot.joint_move_limits
-    n = robot.num_joints
-    acceleration = limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit", n)
-    law = RuckigStopLaw(
-        start_and_goals(q_initial, config.goals, n),
-        limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", n),
-        acceleration,
-        limit_or_default(config.jerk_limit, default_jerk_limit(acceleration), "jerk_limit", n),
-    )
-    return RuckigPlanner(law, robot=robot)
+    limits = jerk_limited_limits(robot, config.velocity_limit, config.acceleration_limit, config.jerk_limit)
+    return RuckigPlanner(RuckigStopLaw(start_and_goals(q_initial, config.goals, robot.num_joints), *limits), robot=robot)

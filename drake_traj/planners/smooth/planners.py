@@ -11,11 +11,11 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
-from drake_traj.planners.baselines.ruckig import default_jerk_limit
+from drake_traj.planners.baselines.ruckig import jerk_limited_limits
 from drake_traj.planners.pajak import PajakConfig, PajakPlanner
 from drake_traj.planners.smooth.timing import SmoothTiming, time_path
 from drake_traj.robots import Robot
-from drake_traj.validation import instance_of, limit_or_default, positive_vector, whole_number
+from drake_traj.validation import instance_of, positive_vector, whole_number
 
 __all__ = ["RetimedPajakConfig", "SmoothPlanner", "SmoothWaypointsConfig", "make_retimed_pajak",
            "make_smooth_waypoints", "waypoint_path"]
@@ -104,21 +104,11 @@ class SmoothWaypointsConfig:
     grid_points: int = 200
 
 
-def _limits(config, robot: Robot, velocity=None, acceleration=None):
-    n = robot.num_joints
-    default_velocity, default_acceleration = robot.joint_move_limits
-    velocity = limit_or_default(config.velocity_limit if velocity is None else velocity, default_velocity,
-                                "velocity_limit", n)
-    acceleration = limit_or_default(config.acceleration_limit if acceleration is None else acceleration,
-                                    default_acceleration, "acceleration_limit", n)
-    jerk = limit_or_default(config.jerk_limit, default_jerk_limit(acceleration), "jerk_limit", n)
-    return velocity, acceleration, jerk
-
-
 def make_smooth_waypoints(config: SmoothWaypointsConfig, robot: Robot, q_initial) -> SmoothPlanner:
     """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]."""
     q = start_and_goals(q_initial, config.goals, robot.num_joints)
-    velocity, acceleration, jerk = _limits(config, robot)
+    velocity, acceleration, jerk = jerk_limited_limits(robot, config.velocity_limit, config.acceleration_limit,
+                                                       config.jerk_limit)
     path = waypoint_path(q)
     _check_joint_range(path, robot, "goals")
     timing = _timed(path, "goals", velocity, acceleration, jerk,
@@ -156,8 +146,9 @@ def make_retimed_pajak(config: RetimedPajakConfig, robot: Robot, q_initial) -> S
     instance_of(config.pajak, PajakConfig, "pajak")
     samples = pajak_joint_path(config.pajak, robot, q_initial)
     n = robot.num_joints
-    velocity, acceleration, jerk = _limits(config, robot, np.broadcast_to(config.pajak.velocity_limit, (n,)),
-                                           np.broadcast_to(config.pajak.acceleration_limit, (n,)))
+    velocity, acceleration, jerk = jerk_limited_limits(robot, np.broadcast_to(config.pajak.velocity_limit, (n,)),
+                                                       np.broadcast_to(config.pajak.acceleration_limit, (n,)),
+                                                       config.jerk_limit)
     timing = _timed(samples, "pajak", velocity, acceleration, jerk,
                     whole_number(config.grid_points, "grid_points", minimum=20))
     return SmoothPlanner(timing, velocity, acceleration, jerk,
