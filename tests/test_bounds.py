@@ -21,7 +21,7 @@ from drake_traj import Cause, DrakeTrajError, PlanningError, SimulationResult, c
 from drake_traj import bench as bench_module
 from drake_traj.data import data_directory
 from drake_traj.meshcat import SPEED_SLIDER, SpeedSlider, start_meshcat
-from drake_traj.planners.pajak.system import MAX_PREFLIGHT_STEPS
+from drake_traj.planners.pajak.system import MAX_PREFLIGHT_STEPS, PajakPlanner
 from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
 from drake_traj.robots import UR10E
 from drake_traj.scenario import ScenarioError, SpeedOverride, find_scenario, preflight
@@ -208,6 +208,16 @@ def test_the_preflight_integrates_up_to_max_duration(tmp_path):
     with pytest.raises(PlanningError, match=r"takes \d+\.\d+ s, longer than 35 s, the preflight's horizon") as kept:
         planner.preflight(35.0)
     assert kept.value.cause is Cause.TIMEOUT
+
+
+def test_the_plan_keeps_the_preflight_of_the_runs_horizon(tmp_path, monkeypatch):
+    # plan() (the cell check's input) reuses the integration of the preflight with max_duration;
+    # it used to integrate again with the default horizon, refusing a task longer than that
+    monkeypatch.setattr(PajakPlanner.preflight, "__defaults__", (30.0,))  # a default below the task's 40 s
+    scenario = load_scenario(slow_pajak(tmp_path, 60.0), "sim3")
+    planner = make_planner(scenario)
+    preflight(scenario, planner)
+    assert 30.0 < planner.plan().end_time() < 60.0
 
 
 def test_a_task_longer_than_max_duration_is_refused_at_max_duration(tmp_path):

@@ -16,8 +16,8 @@ from drake_traj.validation import finite_array, invalid, run_duration
 
 __all__ = ["MAX_PREFLIGHT_STEPS", "PajakPlanner", "make"]
 
-# The preflight's integration steps at most: its log holds 45 values a step (360 MB at this bound;
-# 600 s, the longest run, at the default 1 ms update period is 6e5 steps)
+# The preflight's integration steps at most: its log holds Log.SIZE values a step (54: 432 MB at
+# this bound; 600 s, the longest run, at the default 1 ms update period is 6e5 steps)
 MAX_PREFLIGHT_STEPS = 1_000_000
 
 
@@ -112,8 +112,10 @@ class PajakPlanner(PlannerSystem):
     def _plan_pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The preflight's samples (t, q, q̇, q̈) up to the finish, one every update period,
         joined by quintic Hermite pieces (:func:`quintic_hermite_coefficients`; q̈ the law's
-        after each step's update on both sides of its sample)."""
-        self.preflight()
+        after each step's update on both sides of its sample). The preflight's own integration
+        when one was run (with the run's horizon), else one with the default horizon."""
+        if self._run is None:
+            self.preflight()
         end = self._run["finish_index"] + 1
         times = self._run["t"][:end]
         samples = np.stack([self._run[name][:end] for name in ("q", "qd", "qdd")], axis=1)
