@@ -61,7 +61,7 @@ from tqdm import tqdm
 
 from drake_traj.clearance import CellChecker
 from drake_traj.errors import DrakeTrajError
-from drake_traj.output import FOLDER_KINDS, OutputError, claim
+from drake_traj.output import OutputError, claim
 from drake_traj.station import simulate
 from drake_traj.planners import (
     MovejConfig,
@@ -452,7 +452,7 @@ def _connect(scheduler: str) -> Client:
     try:  # in a thread of its own: bench may be called where an event loop runs (a notebook)
         with concurrent.futures.ThreadPoolExecutor(1) as pool:
             pool.submit(asyncio.run, _dask_handshake(scheduler, SCHEDULER_TIMEOUT)).result()
-    except (asyncio.TimeoutError, TimeoutError):
+    except TimeoutError:  # asyncio's since Python 3.11
         raise BenchSetupError(f"--scheduler {scheduler}: something accepts connections there but did not answer as a "
                               f"Dask scheduler within {SCHEDULER_TIMEOUT:g} s. {advice}") from None
     except OSError as error:  # refused (Dask retries until the timeout), unreachable, closed at once
@@ -550,13 +550,8 @@ def _claim_output_directory(out_dir, overwrite: bool, command: str | None):
     not a run's folder, not an earlier bench's unless ``overwrite``, locked; BenchSetupError if
     not (if it is or lies below a file, say)."""
     out_dir = Path(out_dir)
-    for path in (out_dir, *out_dir.parents):
-        if path.exists() and not path.is_dir():
-            where = "is a file" if path == out_dir else f"lies below the file {path}"
-            raise BenchSetupError(f"--out {out_dir} {where}; give a directory (it is created if missing)")
     try:
-        return claim(out_dir, "bench", overwrite=overwrite, earlier_files=lambda directory: list(FOLDER_KINDS["bench"]),
-                     estimate=BENCH_SIZE, command=command)
+        return claim(out_dir, "bench", overwrite=overwrite, estimate=BENCH_SIZE, command=command)
     except OutputError as error:
         raise BenchSetupError(f"--out {out_dir}: {error}") from None
 

@@ -281,6 +281,7 @@ class SimulationResult:
         tcp_error = np.linalg.norm(self.tcp_ref[:, :3] - self.tcp[:, :3], axis=1)
         simulated = float(self.t[-1]) if len(self.t) else 0.0
         jerk = self.jerk()
+        peak_torque = _over_samples(np.max, np.abs(self.tau))
         final_position = final_orientation = float("nan")
         if len(self.t):
             goal = self.goal if np.all(np.isfinite(self.goal)) else self.tcp_ref[-1]
@@ -304,8 +305,8 @@ class SimulationResult:
             tracking_error_tcp_max_m=float(_over_samples(np.max, tcp_error)),
             final_position_error_m=final_position,
             final_orientation_error_rad=final_orientation,
-            peak_torque_nm=_over_samples(np.max, np.abs(self.tau)).tolist(),
-            peak_torque_over_limit=(_over_samples(np.max, np.abs(self.tau)) / self.effort_limit).tolist(),
+            peak_torque_nm=peak_torque.tolist(),
+            peak_torque_over_limit=(peak_torque / self.effort_limit).tolist(),
             time_at_effort_limit_s=(self._saturated().sum(axis=0) * self.log_period).tolist(),
             simulated_time_s=simulated,
             wall_time_s=self.wall_time,

@@ -12,32 +12,16 @@ other files, not a run (a bench, say), is never written into.
 import json
 from pathlib import Path
 
-from drake_traj.output import OutputError, check_folder, check_writable, claim, write_file
+from drake_traj.output import FOLDER_KINDS, OutputError, claim, write_file
 
-__all__ = ["MANIFEST", "OutputError", "add_to_manifest", "check_output", "check_writable", "claim_run_folder",
-           "estimated_size", "holds_a_run", "manifest_text", "run_files", "write_manifest"]
+__all__ = ["MANIFEST", "OutputError", "add_to_manifest", "claim_run_folder", "estimated_size", "manifest_text",
+           "run_files", "write_manifest"]
 
-MANIFEST = "run.json"
-_RUN_FILES = ("result.npz", "metrics.json")  # a run written before manifests is recognised by these
+# the manifest, and the files a run written before manifests is recognised by
+MANIFEST, *_RUN_FILES = FOLDER_KINDS["run"]
 # [bytes] a run's folder, measured on quintic_ptp (6678 samples at 1 ms): result.npz 340 B and
 # meshcat.html 380 B per sample, the figures 0.6 MiB; rounded up
 _FIXED_SIZE, _SIZE_PER_SAMPLE = 2 * 2**20, 1024
-
-
-def holds_a_run(directory: Path) -> bool:
-    """Whether ``directory`` holds the files of an earlier run."""
-    return any((directory / name).exists() for name in (MANIFEST,) + _RUN_FILES)
-
-
-def _earlier_run(directory: Path) -> list[str]:
-    return run_files(directory) + [MANIFEST]
-
-
-def check_output(directory, *, overwrite: bool = False) -> Path:
-    """Check ``directory`` before a run, creating and removing nothing: writable or creatable, not
-    a file, not a bench's folder, not holding files other than a run's, and not holding an earlier
-    run unless ``overwrite``. Raises :class:`OutputError`."""
-    return check_folder(directory, "run", overwrite=overwrite, earlier_files=_earlier_run)
 
 
 def estimated_size(samples: int) -> int:
@@ -48,9 +32,10 @@ def estimated_size(samples: int) -> int:
 def claim_run_folder(directory, *, overwrite: bool = False, samples: int = 0, command: str | None = None,
                      options=("--out", "--overwrite")):
     """Claim ``directory`` for a run before it starts (:func:`drake_traj.output.claim`): checked
-    (:func:`check_output`), locked against a second writer, with room for about ``samples``
+    (:func:`drake_traj.output.check_folder`: writable, not a bench's, not other files, no earlier
+    run unless ``overwrite``), locked against a second writer, with room for about ``samples``
     logged samples. Its ``replace()`` writes the run's files and replaces the earlier run."""
-    return claim(directory, "run", overwrite=overwrite, earlier_files=_earlier_run, estimate=estimated_size(samples),
+    return claim(directory, "run", overwrite=overwrite, earlier_files=run_files, estimate=estimated_size(samples),
                  command=command, options=options)
 
 
