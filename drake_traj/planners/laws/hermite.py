@@ -11,7 +11,7 @@ import numpy as np
 
 from drake_traj.planners.laws.polynomials import rate_peaks
 
-__all__ = ["HermiteLaw", "quintic_hermite_coefficients"]
+__all__ = ["HermiteLaw", "quintic_hermite_coefficients", "sigma_derivatives"]
 
 
 def quintic_hermite_coefficients(knots, right, left) -> np.ndarray:
@@ -38,6 +38,23 @@ def quintic_hermite_coefficients(knots, right, left) -> np.ndarray:
         (-30 * delta + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h**2) / (2 * h**4),
         (12 * delta - 6 * (v1 + v0) * h + (a1 - a0) * h**2) / (2 * h**5),
     ], axis=1)
+
+
+def sigma_derivatives(knots, coefficients, orders: int):
+    """Piecewise quintics (monomial ``coefficients`` (K-1, 6, n) in tau - knots[k]) on each knot
+    interval as polynomials in sigma in [-1, 1] (tau = mid + sigma half): (mid [s] (K-1,), half [s]
+    (K-1,), [first, ..., ``orders``-th derivative in tau], the j-th with coefficients (6 - j, K-1, n)),
+    for :mod:`~drake_traj.planners.laws.polynomials`'s peak finders."""
+    knots = np.asarray(knots, dtype=float)
+    half = 0.5 * np.diff(knots)
+    scale = half[:, None]
+    # q(sigma) = sum_k e_k sigma^k with tau - knot = half (1 + sigma): e_k = sum_j C(j, k) c_j half^j
+    polynomial = np.stack([sum(comb(j, k) * coefficients[:, j] * scale**j for j in range(k, 6)) for k in range(6)])
+    derivatives = []
+    for _ in range(orders):
+        polynomial = np.stack([(k + 1) * polynomial[k + 1] / scale for k in range(len(polynomial) - 1)])
+        derivatives.append(polynomial)
+    return knots[:-1] + half, half, derivatives
 
 
 class HermiteLaw:
@@ -79,14 +96,8 @@ class HermiteLaw:
         """q̇ and q̈ on each knot interval as polynomials in sigma in [-1, 1] (tau = mid + sigma
         half): (mid [s] (K-1,), half [s] (K-1,), q̇ coefficients (5, K-1, n), q̈ coefficients
         (4, K-1, n)), for :func:`~drake_traj.planners.laws.polynomials.rate_peaks`."""
-        half = 0.5 * np.diff(self.knots)
-        scale = half[:, None]
-        # q(sigma) = sum_k e_k sigma^k with s = half (1 + sigma): e_k = sum_j C(j, k) c_j half^j
-        position = np.stack([sum(comb(j, k) * self._coefficients[:, j] * scale**j for j in range(k, 6))
-                             for k in range(6)])
-        velocity = np.stack([(k + 1) * position[k + 1] / scale for k in range(5)])
-        acceleration = np.stack([(k + 1) * velocity[k + 1] / scale for k in range(4)])
-        return self.knots[:-1] + half, half, velocity, acceleration
+        mid, half, (velocity, acceleration) = sigma_derivatives(self.knots, self._coefficients, 2)
+        return mid, half, velocity, acceleration
 
     def peak_rates(self) -> tuple[np.ndarray, np.ndarray]:
         """(max |q̇|, max |q̈|) over the whole law per joint, exact to round-off (interval ends,

@@ -24,7 +24,6 @@ distance to the end), q̈ = 0 at the end and the end interval lasts 3 h / √x.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from math import comb
 
 import numpy as np
 import scipy.sparse
@@ -35,7 +34,7 @@ from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import piecewise_trajectory
 from drake_traj.planners.baselines.ruckig import default_jerk_limit
 from drake_traj.planners.baselines.toppra import time_optimal_along_path
-from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coefficients
+from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coefficients, sigma_derivatives
 from drake_traj.planners.laws.polynomials import rate_peaks
 from drake_traj.validation import positive_scalar, positive_vector, real_array, require_finite
 
@@ -241,13 +240,12 @@ def _grid(path, velocity, acceleration, jerk, points: int) -> np.ndarray:
     evenly spaced in s takes its place."""
     breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
     points = max(points - len(breaks), points // 2)
+    even = np.unique(np.concatenate([np.linspace(path.start_time(), path.end_time(), points), breaks]))
     try:
-        toppra_grid = np.unique(np.concatenate([np.linspace(path.start_time(), path.end_time(), points), breaks]))
-        optimal, trajectory = time_optimal_along_path(path, velocity, acceleration, grid_points=toppra_grid)
+        optimal, trajectory = time_optimal_along_path(path, velocity, acceleration, grid_points=even)
         s_of_t = trajectory.time_scaling()
         s = np.array([s_of_t.value(t)[0, 0] for t in np.linspace(0.0, optimal, points)])
     except ValueError:
-        even = np.unique(np.concatenate([np.linspace(path.start_time(), path.end_time(), points), breaks]))
         x, p = _Program(path, even, velocity, acceleration, jerk).solve(None, np.inf)
         times = _node_times(even, x, p)
         s = np.interp(np.linspace(0.0, times[-1], points), times, even)
@@ -476,14 +474,7 @@ def _samples(path, program: _Program, x: np.ndarray, p: np.ndarray):
 def exact_peaks(knots, coefficients) -> np.ndarray:
     """max |q̇|, |q̈|, |q⃛| per joint over piecewise quintics (monomial ``coefficients`` (K, 6, n)
     in t - knots[k]), exact to round-off: (3, n)."""
-    knots = np.asarray(knots, dtype=float)
-    half = 0.5 * np.diff(knots)[:, None]
-    c = np.moveaxis(np.asarray(coefficients, dtype=float), 1, 0)  # (6, K, n)
-    # q in sigma in [-1, 1], t - knot = half (1 + sigma): binomial expansion
-    position = np.stack([sum(comb(j, k) * c[j] * half**j for j in range(k, 6)) for k in range(6)])
-    velocity = np.stack([(k + 1) * position[k + 1] / half for k in range(5)])
-    acceleration = np.stack([(k + 1) * velocity[k + 1] / half for k in range(4)])
-    jerk = np.stack([(k + 1) * acceleration[k + 1] / half for k in range(3)])  # quadratic
+    _, _, (velocity, acceleration, jerk) = sigma_derivatives(knots, np.asarray(coefficients, dtype=float), 3)
     v_peak, _, a_peak, _ = rate_peaks(velocity, acceleration)
     with np.errstate(divide="ignore", invalid="ignore"):
         vertex = np.where(jerk[2] != 0, -jerk[1] / (2 * jerk[2]), np.nan)
