@@ -68,9 +68,11 @@ class TaskKinematics(NamedTuple):
     compiled kernels; the others are their Python faces.
 
     Attributes:
-        kinematics_into: ``(q, q̇, tool, pose, jac, bias) -> (cos φ_Y, singularity measure)``:
-            k(q) of the TCP ``tool`` (X_FT, 4x4) into ``pose`` (6,), the analytic Jacobian into
-            ``jac`` (6, 6) and J̇q̇ into ``bias`` (6,) [m/s², rad/s²]; q [rad], q̇ [rad/s].
+        kinematics_into: ``(model, q, q̇, tool, pose, jac, bias) -> (cos φ_Y, singularity
+            measure)``: k(q) of the TCP ``tool`` (X_FT, 4x4) of the arm described by ``model``
+            into ``pose`` (6,), the analytic Jacobian into ``jac`` (6, 6) and J̇q̇ into ``bias``
+            (6,) [m/s², rad/s²]; q [rad], q̇ [rad/s]. The same compiled function for every arm
+            (:func:`drake_traj.robots.compiled_kinematics.task_kinematics_into`): the arm is data.
         wrapped: an angle [rad] (float or array) wrapped into (-π, π].
         orientation_error: ``(φ, φ_goal) -> `` the angle of R_goalᵀ R [rad] for Euler angles (3,).
         wrap_angle: :attr:`wrapped` for any array-like.
@@ -83,6 +85,8 @@ class TaskKinematics(NamedTuple):
         singularity_factors: ``q (n,) -> {name: (factor, meaning)}``, the factors of det J at q,
             each in [0, 1] and 0 at its singularity (the singularity measure is the smallest),
             with what that singularity is (to name it in a message).
+        model: the arm's kinematic data (1-D float array), the ``model`` argument of
+            ``kinematics_into``.
     """
 
     kinematics_into: Callable
@@ -93,6 +97,7 @@ class TaskKinematics(NamedTuple):
     inverse_kinematics_all: Callable
     tool: np.ndarray
     singularity_factors: Callable
+    model: np.ndarray
 
 
 class Robot:

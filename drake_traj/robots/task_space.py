@@ -12,8 +12,8 @@ import numpy as np
 
 from drake_traj.compiled import compiled
 
-__all__ = ["euler_rate_matrix", "orientation_error", "pose_error", "rotation_from_zyx_euler", "task_pose_error",
-           "wrap_angle", "wrapped", "zyx_euler_from_rotation"]
+__all__ = ["euler_rate_matrix", "is_flange", "orientation_error", "pose_error", "rotation_from_zyx_euler", "task_pose_error",
+           "tcp_rows_into", "wrap_angle", "wrapped", "zyx_euler_from_rotation"]
 
 
 @compiled
@@ -119,3 +119,79 @@ def euler_rate_matrix(phi) -> np.ndarray:
     _, phi_y, phi_z = phi
     cy, sy, cz, sz = np.cos(phi_y), np.sin(phi_y), np.cos(phi_z), np.sin(phi_z)
     return np.array([[cy * cz, -sz, 0.0], [cy * sz, cz, 0.0], [-sy, 0.0, 1.0]])
+
+
+@compiled
+def is_flange(tool) -> bool:
+    """Whether the 4x4 ``tool`` offset X_FT is exactly the identity (the TCP is the flange)."""
+    for i in range(4):
+        for j in range(4):
+            if tool[i, j] != (1.0 if i == j else 0.0):
+                return False
+    return True
+
+
+@compiled
+def tcp_rows_into(rotation, axes, flange, omega, alpha, acceleration, tool, pose, jac, bias):
+    """The task kinematics of a 6-joint arm's TCP from its flange's: k(q) into ``pose`` (6), the
+    analytic J into ``jac`` (6, 6), J̇q̇ into ``bias`` (6); returns cos φ_Y (>= 0).
+
+    Given (base frame, q̈ = 0): ``rotation`` R_F (3, 3) of the flange (overwritten with R_T),
+    ``axes`` (6, 3) the joint axes z_j, ``flange`` (3,) the flange origin o_6 [m], ``omega`` (3,)
+    ω [rad/s], ``alpha`` (3,) J̇_ω q̇ [rad/s²], ``acceleration`` (3,) J̇_v q̇ of o_6 [m/s²], and
+    ``jac``'s rows 0-2 holding the flange's J_v (columns z_j x (o_6 - o_j)). ``tool`` (4, 4) is X_FT
+    with translation t [m] and rotation R_t (skipped for the identity, so the flange's numbers are
+    the same bit for bit): s = R_F t, p_T = o_6 + s, R_T = R_F R_t; the TCP's velocity v + ω x s,
+    so J_v gains the columns z_j x s, and its bias acceleration J̇_ω q̇ x s + ω x (ω x s). Then
+    J = diag(I, B⁻¹) J_g and the Euler part of the bias B⁻¹ (α - Ḃ φ̇) (Pająk 2024, with B's
+    columns in k(q)'s order), with the TCP's Euler angles (ω and α are the same for every point
+    of the last link). At gimbal lock (cos φ_Y = 0) B⁻¹ uses 1e300 for 1/cos φ_Y: callers check
+    the returned cos φ_Y.
+    """
+    p0, p1, p2 = flange[0], flange[1], flange[2]
+    w0, w1, w2 = omega[0], omega[1], omega[2]
+    al0, al1, al2 = alpha[0], alpha[1], alpha[2]
+    l0, l1, l2 = acceleration[0], acceleration[1], acceleration[2]
+    if not is_flange(tool):
+        s0 = rotation[0, 0] * tool[0, 3] + rotation[0, 1] * tool[1, 3] + rotation[0, 2] * tool[2, 3]  # s = R_F t
+        s1 = rotation[1, 0] * tool[0, 3] + rotation[1, 1] * tool[1, 3] + rotation[1, 2] * tool[2, 3]
+        s2 = rotation[2, 0] * tool[0, 3] + rotation[2, 1] * tool[1, 3] + rotation[2, 2] * tool[2, 3]
+        p0 += s0
+        p1 += s1
+        p2 += s2
+        for j in range(6):  # J_v column j + z_j x s
+            jac[0, j] += axes[j, 1] * s2 - axes[j, 2] * s1
+            jac[1, j] += axes[j, 2] * s0 - axes[j, 0] * s2
+            jac[2, j] += axes[j, 0] * s1 - axes[j, 1] * s0
+        u0, u1, u2 = w1 * s2 - w2 * s1, w2 * s0 - w0 * s2, w0 * s1 - w1 * s0  # ω x s
+        l0 += al1 * s2 - al2 * s1 + w1 * u2 - w2 * u1  # + J̇_ω q̇ x s + ω x (ω x s)
+        l1 += al2 * s0 - al0 * s2 + w2 * u0 - w0 * u2
+        l2 += al0 * s1 - al1 * s0 + w0 * u1 - w1 * u0
+        flange_rotation = rotation.copy()
+        for i in range(3):  # R_T = R_F R_t
+            for k in range(3):
+                rotation[i, k] = (flange_rotation[i, 0] * tool[0, k] + flange_rotation[i, 1] * tool[1, k]
+                                  + flange_rotation[i, 2] * tool[2, k])
+    r11, r21, r31, r32, r33 = rotation[0, 0], rotation[1, 0], rotation[2, 0], rotation[2, 1], rotation[2, 2]
+    # Z-Y-X Euler angles (k(q) rows 4-6) from R_T's first column, r32 and r33
+    cy = math.hypot(r32, r33)  # cos φ_Y >= 0
+    pose[0], pose[1], pose[2] = p0, p1, p2 + 0.0
+    pose[3], pose[4], pose[5] = math.atan2(r32, r33), math.atan2(-r31, cy), math.atan2(r21, r11)
+    sy, cz, sz = -r31, math.cos(pose[5]), math.sin(pose[5])
+    icy = 1.0 / cy if cy > 0.0 else 1e300
+    # B(φ)⁻¹ v for B of euler_rate_matrix: fx = (cz v0 + sz v1)/cy, fy = -sz v0 + cz v1, fz = v2 + sy fx
+    for j in range(6):
+        fx = (cz * axes[j, 0] + sz * axes[j, 1]) * icy
+        jac[3, j] = fx
+        jac[4, j] = -sz * axes[j, 0] + cz * axes[j, 1]
+        jac[5, j] = axes[j, 2] + sy * fx
+    fx = (cz * w0 + sz * w1) * icy  # Euler rates φ̇
+    fy = -sz * w0 + cz * w1
+    fz = w2 + sy * fx
+    v0 = al0 - (-sy * cz * fx * fy + fz * (-cy * sz * fx - cz * fy))  # α - Ḃ φ̇
+    v1 = al1 - (-sy * sz * fx * fy + fz * (cy * cz * fx - sz * fy))
+    v2 = al2 + cy * fx * fy
+    gx = (cz * v0 + sz * v1) * icy
+    bias[0], bias[1], bias[2] = l0, l1, l2
+    bias[3], bias[4], bias[5] = gx, -sz * v0 + cz * v1, v2 + sy * gx
+    return cy

@@ -22,8 +22,8 @@ import numpy as np
 from drake_traj.compiled import compiled
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError, joint_label
 from drake_traj.robots.base import FLANGE, Robot, TaskKinematics
-from drake_traj.robots.task_space import (orientation_error, pose_error, rotation_from_zyx_euler, wrap_angle, wrapped,
-                                          zyx_euler_from_rotation)
+from drake_traj.robots.task_space import (is_flange, orientation_error, pose_error, rotation_from_zyx_euler, tcp_rows_into,
+                                          wrap_angle, wrapped, zyx_euler_from_rotation)
 from drake_traj.validation import invalid, real_array
 
 __all__ = ["UR10E", "UR10e"]
@@ -61,6 +61,10 @@ BASE_MASS = 4.0  # [kg], approximate; the base is welded to the world.
 _D1, _D4, _D5, _D6 = (float(DH_D[k]) for k in (0, 3, 4, 5))
 _A2, _A3 = float(DH_A[1]), float(DH_A[2])
 FLANGE_FRAME = "tool0"
+# The closed form's data, the ``model`` argument of kinematics_into: [UR_CLOSED_FORM, d1, a2, a3, d4, d5, d6]
+UR_CLOSED_FORM = 0.0
+MODEL = np.array([UR_CLOSED_FORM, _D1, _A2, _A3, _D4, _D5, _D6])
+MODEL.flags.writeable = False
 BASE_FRAME = "base"
 
 
@@ -110,7 +114,7 @@ def task_pose(q, tool=FLANGE) -> np.ndarray:
     """k(q) of Pająk 2024: [x, y, z, phi_X, phi_Y, phi_Z] of the TCP in the base frame [m, rad];
     ``tool`` (4, 4) is X_FT, the TCP in the flange frame (default: the flange itself)."""
     pose = flange_pose(q)
-    if not _is_flange(tool):
+    if not is_flange(tool):
         pose = pose @ tool
     return np.concatenate([pose[:3, 3], zyx_euler_from_rotation(pose[:3, :3])])
 
@@ -161,37 +165,23 @@ def analytic_jacobian_and_bias(q, qd, *, min_cos_pitch: float = 1e-6,
 
 
 @compiled
-def _singularity_factors(s3, s5, c2, c23, s234):
+def _singularity_factors(model, s3, s5, c2, c23, s234):
     # det J_g = a2 a3 s3 s5 (a2 c2 + a3 c23 + d5 s234): elbow, wrist and shoulder factors.
-    shoulder = (_A2 * c2 + _A3 * c23 + _D5 * s234) / (abs(_A2) + abs(_A3))
+    a2, a3, d5 = model[2], model[3], model[5]
+    shoulder = (a2 * c2 + a3 * c23 + d5 * s234) / (abs(a2) + abs(a3))
     return min(abs(s3), abs(s5), abs(shoulder))
 
 
 @compiled
-def _is_flange(tool) -> bool:
-    """Whether the 4x4 ``tool`` offset is exactly the identity (the TCP is the flange)."""
-    for i in range(4):
-        for j in range(4):
-            if tool[i, j] != (1.0 if i == j else 0.0):
-                return False
-    return True
-
-
-@compiled
-def kinematics_into(q, qd, tool, pose, jac, bias):
+def kinematics_into(model, q, qd, tool, pose, jac, bias):
     """k(q) into ``pose`` (6), the analytic J into ``jac`` (6, 6) and J̇q̇ into ``bias`` (6) of the
     TCP; returns (cos φ_Y, singularity measure). Compiled; the kernel of :func:`ur10e_kinematics`.
 
-    ``tool`` (4, 4) is X_FT, the TCP in the flange frame F (``tool0``): translation t [m] and
-    rotation R_t. The standard-DH chain of :func:`dh_frames` written out: joint axes z_j at
-    origins o_j, flange o_6; J_g columns z_j x (o_6 - o_j) and z_j; the bias by the
-    velocity/acceleration recursion with q̈ = 0. The TCP (skipped for the identity, so the flange's
-    numbers are the same bit for bit): s = R_F t, p_T = o_6 + s, R_T = R_F R_t; its velocity
-    v + ω x s, so J_v gains the columns z_j x s (J_v - [s]x J_ω), and its bias acceleration
-    J̇_ω q̇ x s + ω x (ω x s). Then J = diag(I, B⁻¹) J_g and the Euler part of the bias
-    B⁻¹ (α - Ḃ φ̇) (Pająk 2024, with B's columns in k(q)'s order), with the TCP's Euler angles
-    (ω and α are the same for every point of the last link). At gimbal lock (cos φ_Y = 0) B⁻¹
-    uses 1e300 for 1/cos φ_Y: callers check the returned cos φ_Y.
+    ``model`` is the closed form's data [UR_CLOSED_FORM, d1, a2, a3, d4, d5, d6] [m] (:data:`MODEL`
+    for the UR10e); ``tool`` (4, 4) is X_FT, the TCP in the flange frame F (``tool0``). The
+    standard-DH chain of :func:`dh_frames` written out: joint axes z_j at origins o_j, flange o_6;
+    J_g columns z_j x (o_6 - o_j) and z_j; the bias by the velocity/acceleration recursion with
+    q̈ = 0; the TCP and the Euler-angle rows by :func:`~drake_traj.robots.task_space.tcp_rows_into`.
     """
     c1, s1 = math.cos(q[0]), math.sin(q[0])
     c2, s2 = math.cos(q[1]), math.sin(q[1])
@@ -211,13 +201,13 @@ def kinematics_into(q, qd, tool, pose, jac, bias):
     axes[4, 0], axes[4, 1], axes[4, 2] = c1 * s234, s1 * s234, -c234
     axes[5, 0], axes[5, 1], axes[5, 2] = c5 * s1 - s5 * x4[0], -c5 * c1 - s5 * x4[1], -s5 * s234
     x5 = (c5 * x4[0] + s5 * s1, c5 * x4[1] - s5 * c1, c5 * s234)
-    links[0, 0], links[0, 1], links[0, 2] = 0.0, 0.0, _D1
-    links[1, 0], links[1, 1], links[1, 2] = _A2 * c1 * c2, _A2 * s1 * c2, _A2 * s2
-    links[2, 0], links[2, 1], links[2, 2] = _A3 * c1 * c23, _A3 * s1 * c23, _A3 * s23
-    links[3, 0], links[3, 1], links[3, 2] = _D4 * s1, -_D4 * c1, 0.0
+    links[0, 0], links[0, 1], links[0, 2] = 0.0, 0.0, model[1]
+    links[1, 0], links[1, 1], links[1, 2] = model[2] * c1 * c2, model[2] * s1 * c2, model[2] * s2
+    links[2, 0], links[2, 1], links[2, 2] = model[3] * c1 * c23, model[3] * s1 * c23, model[3] * s23
+    links[3, 0], links[3, 1], links[3, 2] = model[4] * s1, -model[4] * c1, 0.0
     for k in range(3):
-        links[4, k] = _D5 * axes[4, k]
-        links[5, k] = _D6 * axes[5, k]
+        links[4, k] = model[5] * axes[4, k]
+        links[5, k] = model[6] * axes[5, k]
     # J_v column j = z_j x (o_6 - o_j), accumulating o_6 - o_j from the flange back
     p0 = p1 = p2 = 0.0
     for j in range(5, -1, -1):
@@ -251,54 +241,16 @@ def kinematics_into(q, qd, tool, pose, jac, bias):
         rotation[k, 0] = c6 * x5[k] - s6 * axes[4, k]
         rotation[k, 1] = -s6 * x5[k] - c6 * axes[4, k]
         rotation[k, 2] = axes[5, k]
-    if not _is_flange(tool):
-        s0 = rotation[0, 0] * tool[0, 3] + rotation[0, 1] * tool[1, 3] + rotation[0, 2] * tool[2, 3]  # s = R_F t
-        s1 = rotation[1, 0] * tool[0, 3] + rotation[1, 1] * tool[1, 3] + rotation[1, 2] * tool[2, 3]
-        s2 = rotation[2, 0] * tool[0, 3] + rotation[2, 1] * tool[1, 3] + rotation[2, 2] * tool[2, 3]
-        p0 += s0
-        p1 += s1
-        p2 += s2
-        for j in range(6):  # J_v column j + z_j x s
-            jac[0, j] += axes[j, 1] * s2 - axes[j, 2] * s1
-            jac[1, j] += axes[j, 2] * s0 - axes[j, 0] * s2
-            jac[2, j] += axes[j, 0] * s1 - axes[j, 1] * s0
-        u0, u1, u2 = w1 * s2 - w2 * s1, w2 * s0 - w0 * s2, w0 * s1 - w1 * s0  # ω x s
-        l0 += al1 * s2 - al2 * s1 + w1 * u2 - w2 * u1  # + J̇_ω q̇ x s + ω x (ω x s)
-        l1 += al2 * s0 - al0 * s2 + w2 * u0 - w0 * u2
-        l2 += al0 * s1 - al1 * s0 + w0 * u1 - w1 * u0
-        flange = rotation.copy()
-        for i in range(3):  # R_T = R_F R_t
-            for k in range(3):
-                rotation[i, k] = flange[i, 0] * tool[0, k] + flange[i, 1] * tool[1, k] + flange[i, 2] * tool[2, k]
-    r11, r21, r31, r32, r33 = rotation[0, 0], rotation[1, 0], rotation[2, 0], rotation[2, 1], rotation[2, 2]
-    # Z-Y-X Euler angles (k(q) rows 4-6) from R_T's first column, r32 and r33
-    cy = math.hypot(r32, r33)  # cos φ_Y >= 0
-    pose[0], pose[1], pose[2] = p0, p1, p2 + 0.0
-    pose[3], pose[4], pose[5] = math.atan2(r32, r33), math.atan2(-r31, cy), math.atan2(r21, r11)
-    sy, cz, sz = -r31, math.cos(pose[5]), math.sin(pose[5])
-    icy = 1.0 / cy if cy > 0.0 else 1e300
-    # B(φ)⁻¹ v for B of euler_rate_matrix: fx = (cz v0 + sz v1)/cy, fy = -sz v0 + cz v1, fz = v2 + sy fx
-    for j in range(6):
-        fx = (cz * axes[j, 0] + sz * axes[j, 1]) * icy
-        jac[3, j] = fx
-        jac[4, j] = -sz * axes[j, 0] + cz * axes[j, 1]
-        jac[5, j] = axes[j, 2] + sy * fx
-    fx = (cz * w0 + sz * w1) * icy  # Euler rates φ̇
-    fy = -sz * w0 + cz * w1
-    fz = w2 + sy * fx
-    v0 = al0 - (-sy * cz * fx * fy + fz * (-cy * sz * fx - cz * fy))  # α - Ḃ φ̇
-    v1 = al1 - (-sy * sz * fx * fy + fz * (cy * cz * fx - sz * fy))
-    v2 = al2 + cy * fx * fy
-    gx = (cz * v0 + sz * v1) * icy
-    bias[0], bias[1], bias[2] = l0, l1, l2
-    bias[3], bias[4], bias[5] = gx, -sz * v0 + cz * v1, v2 + sy * gx
-    return cy, _singularity_factors(math.sin(q[2]), s5, c2, c23, s234)
+    flange, omega, alpha, acceleration = np.array((p0, p1, p2)), np.array((w0, w1, w2)), np.array((al0, al1, al2)), \
+        np.array((l0, l1, l2))
+    cy = tcp_rows_into(rotation, axes, flange, omega, alpha, acceleration, tool, pose, jac, bias)
+    return cy, _singularity_factors(model, math.sin(q[2]), s5, c2, c23, s234)
 
 
 @compiled
-def _kinematics_many(q, qd, tool, pose, jac, bias, cos_pitch, measure):
+def _kinematics_many(model, q, qd, tool, pose, jac, bias, cos_pitch, measure):
     for k in range(q.shape[0]):
-        cos_pitch[k], measure[k] = kinematics_into(q[k], qd[k], tool, pose[k], jac[k], bias[k])
+        cos_pitch[k], measure[k] = kinematics_into(model, q[k], qd[k], tool, pose[k], jac[k], bias[k])
 
 
 def ur10e_kinematics(q, qd, tool=FLANGE):
@@ -317,7 +269,7 @@ def ur10e_kinematics(q, qd, tool=FLANGE):
     qd = np.asarray(qd, dtype=float)
     if q.shape == (6,) and qd.shape == (6,):
         pose, jac, bias = np.empty(6), np.empty((6, 6)), np.empty(6)
-        cos_pitch, measure = kinematics_into(q, qd, tool, pose, jac, bias)
+        cos_pitch, measure = kinematics_into(MODEL, q, qd, tool, pose, jac, bias)
         return pose, jac, bias, cos_pitch, measure
     shape = np.broadcast_shapes(q.shape, qd.shape)
     if shape[-1] != 6:
@@ -327,16 +279,16 @@ def ur10e_kinematics(q, qd, tool=FLANGE):
     count = q.shape[0]
     pose, jac, bias = np.empty((count, 6)), np.empty((count, 6, 6)), np.empty((count, 6))
     cos_pitch, measure = np.empty(count), np.empty(count)
-    _kinematics_many(q, qd, tool, pose, jac, bias, cos_pitch, measure)
+    _kinematics_many(MODEL, q, qd, tool, pose, jac, bias, cos_pitch, measure)
     lead = shape[:-1]
     return pose.reshape(lead + (6,)), jac.reshape(lead + (6, 6)), bias.reshape(lead + (6,)), \
         cos_pitch.reshape(lead), measure.reshape(lead)
 
 
 @compiled
-def _singularity_measure_many(q, out):
+def _singularity_measure_many(model, q, out):
     for k in range(q.shape[0]):
-        out[k] = _singularity_factors(math.sin(q[k, 2]), math.sin(q[k, 4]), math.cos(q[k, 1]),
+        out[k] = _singularity_factors(model, math.sin(q[k, 2]), math.sin(q[k, 4]), math.cos(q[k, 1]),
                                       math.cos(q[k, 1] + q[k, 2]), math.sin(q[k, 1] + q[k, 2] + q[k, 3]))
 
 
@@ -350,7 +302,7 @@ def singularity_measure(q):
     q = np.asarray(q, dtype=float)
     rows = np.ascontiguousarray(q.reshape(-1, 6))
     out = np.empty(rows.shape[0])
-    _singularity_measure_many(rows, out)
+    _singularity_measure_many(MODEL, rows, out)
     return float(out[0]) if q.ndim == 1 else out.reshape(q.shape[:-1])
 
 
@@ -441,7 +393,7 @@ def _flange_goal(pose, tool) -> np.ndarray:
     """The flange pose X_BF (4, 4) that puts the TCP ``tool`` (X_FT) at ``pose`` X_BT (a 4x4
     transform or a task pose [x, y, z, phi_X, phi_Y, phi_Z]): X_BF = X_BT X_FT⁻¹."""
     pose = _as_flange_pose(pose)
-    if _is_flange(tool):
+    if is_flange(tool):
         return pose
     inverse = np.eye(4)
     inverse[:3, :3] = tool[:3, :3].T
@@ -756,15 +708,22 @@ class UR10e(Robot):
         return qd, qdd
 
     def task_kinematics(self) -> TaskKinematics:
-        """This module's compiled k(q), analytic Jacobian and J̇q̇ (:func:`kinematics_into`), angle
-        wrapping, orientation error, pose errors and closed-form IK, of the TCP ``tcp_offset``."""
-        if _is_flange(self.tcp_offset):
-            return _TASK_KINEMATICS
-        return _TASK_KINEMATICS._replace(
-            inverse_kinematics_all=functools.partial(inverse_kinematics_all, tool=self.tcp_offset),
-            tool=self.tcp_offset)
+        """The compiled k(q), analytic Jacobian and J̇q̇ (:func:`kinematics_into` through
+        :func:`~drake_traj.robots.compiled_kinematics.task_kinematics_into`, ``model`` =
+        :data:`MODEL`), angle wrapping, orientation error, pose errors and closed-form IK, of the
+        TCP ``tcp_offset``."""
+        flange = _flange_task_kinematics()
+        if is_flange(self.tcp_offset):
+            return flange
+        return flange._replace(inverse_kinematics_all=functools.partial(inverse_kinematics_all, tool=self.tcp_offset),
+                               tool=self.tcp_offset)
 
 
-_TASK_KINEMATICS = TaskKinematics(kinematics_into, wrapped, orientation_error, wrap_angle, pose_error,
-                                  inverse_kinematics_all, FLANGE, singularity_factors)
+@functools.cache
+def _flange_task_kinematics() -> TaskKinematics:
+    from drake_traj.robots.compiled_kinematics import task_kinematics_into  # it imports this module
+
+    return TaskKinematics(task_kinematics_into, wrapped, orientation_error, wrap_angle, pose_error,
+                          inverse_kinematics_all, FLANGE, singularity_factors, MODEL)
+
 UR10E = UR10e()

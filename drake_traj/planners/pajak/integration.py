@@ -64,7 +64,7 @@ def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settl
     out = np.zeros(Evaluation.SIZE)
     final = np.zeros(12 + Discrete.SIZE)  # [q; q̇; discrete] at the last step
     count, status, finish = integrate_kernel(q0, law.initial_discrete(), float(dt), steps, settle_steps, law.vector,
-                                             law.tool, law.waypoints, law.remaining, log, peak, out, final)
+                                             law.model, law.tool, law.waypoints, law.remaining, log, peak, out, final)
     log = log[:count]
     result = {
         "t": log[:, Log.T], "q": log[:, Log.Q:Log.Q + 6], "qd": log[:, Log.QD:Log.QD + 6],

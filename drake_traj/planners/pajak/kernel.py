@@ -11,8 +11,9 @@ vectors whose layouts are the enums below, so that a call from Python costs no c
 - :class:`Evaluation`: what one evaluation computes (q̈, c, the pose, the target, ...);
 - :class:`Log`: one sample of :func:`integrate_kernel`'s log;
 
-and the robot's TCP, ``tool`` (4, 4): X_FT, the TCP in the flange frame
-(:attr:`~drake_traj.robots.Robot.tcp_offset`), an argument of every kernel that evaluates k(q).
+and the arm, ``model`` (its kinematic data, :attr:`~drake_traj.robots.base.TaskKinematics.model`),
+and its TCP, ``tool`` (4, 4): X_FT, the TCP in the flange frame
+(:attr:`~drake_traj.robots.Robot.tcp_offset`), arguments of every kernel that evaluates k(q).
 
 Equation numbers in comments are Pająk 2024's; docs/papers.md explains the corrections and our
 improvements (each a flag of the parameters).
@@ -33,7 +34,7 @@ from drake_traj.planners.laws.scaling import relaxed_scaling
 from drake_traj.planners.pajak import limits
 from drake_traj.planners.pajak.limits import (BRAKE_LAG, BRAKE_SLEW, brake, brake_weight, choose_scaling,
                                               holding_joint, keep_limits, scaling_interval, scaling_slew)
-from drake_traj.robots import UR10E
+from drake_traj.robots import UR10E, compiled_kinematics
 
 __all__ = [
     "Discrete", "Evaluation", "Log", "Parameter", "Status", "acceleration_box", "acceleration_terms",
@@ -159,14 +160,14 @@ VIABILITY_MARGIN = 1e-6
 # near 0 by the velocity limit's viability bound: a stall)
 PENALTY_SPAN = 1.0
 
-# The robot's compiled task kinematics (Robot.task_kinematics), bound once as module globals: numba
+# The compiled task kinematics (Robot.task_kinematics), bound once as module globals: numba
 # compiles the calls to them into the law and caches the law on disk. Passed in (a closure over
 # compiled functions, or an argument), they would miss numba's cache in every process (measured:
 # a closure over a compiled function recompiled in each new process), and the law takes 12-40 s
-# to compile. The law is therefore bound to one robot's kinematics, the UR10e's (the paper's
-# robot); PajakLaw refuses a robot whose task kinematics are other ones. The TCP offset is an
-# array argument (``tool``), which numba's cache keys by its type only: one compiled law for
-# every tool.
+# to compile. The law is therefore bound to one kinematics function for every arm
+# (compiled_kinematics.task_kinematics_into), and the arm is data: the ``model`` array argument
+# (the UR e-Series closed form's lengths, or a generic chain), as the TCP offset is (``tool``);
+# numba's cache keys arrays by their type only, so one compiled law serves every arm and tool.
 KINEMATICS = UR10E.task_kinematics()
 kinematics_into, orientation_error, wrapped = KINEMATICS.kinematics_into, KINEMATICS.orientation_error, KINEMATICS.wrapped
 
@@ -419,7 +420,7 @@ def _sources_digest(*files) -> str:
 
 _DEPENDENCIES = _sources_digest(
     *(inspect.getsourcefile(function.py_func) for function in (kinematics_into, orientation_error, wrapped)),
-    scaling.__file__, limits.__file__, compiled_module.__file__)
+    *compiled_kinematics.SOURCES, scaling.__file__, limits.__file__, compiled_module.__file__)
 
 
 @compiled
@@ -458,7 +459,7 @@ blended_target = _blended_target(_DEPENDENCIES)
 
 def _evaluate_kernel(dependencies):
     @compiled
-    def evaluate_kernel(t, q, qd, d, p, tool, waypoints, out):
+    def evaluate_kernel(t, q, qd, d, p, model, tool, waypoints, out):
         """One evaluation of the law at time t for (q, q̇) and the discrete state ``d`` into
         ``out`` (layout :class:`Evaluation`): q̈ of eq. 17 with c from eq. 18 and the limits,
         for the TCP ``tool`` (X_FT): the pose k(q) of eq. 6, J and J̇q̇ of eq. 13 are the TCP's.
@@ -471,7 +472,7 @@ def _evaluate_kernel(dependencies):
         target = out[Evaluation.TARGET:Evaluation.TARGET + 6]
         jac = np.empty((6, 6))
         bias = np.empty(6)
-        cos_pitch, measure = kinematics_into(q, qd, tool, pose, jac, bias)  # k(q), J, J̇q̇ (eq. 6, 13)
+        cos_pitch, measure = kinematics_into(model, q, qd, tool, pose, jac, bias)  # k(q), J, J̇q̇ (eq. 6, 13)
         out[Evaluation.COS_PITCH] = cos_pitch
         out[Evaluation.MEASURE] = measure
         out[Evaluation.SATURATED] = 0.0
@@ -654,7 +655,7 @@ pose_reached = _pose_reached(_DEPENDENCIES)
 
 def _update_kernel(dependencies):
     @compiled
-    def update_kernel(t, q, qd, d, p, tool, waypoints, remaining, out):
+    def update_kernel(t, q, qd, d, p, model, tool, waypoints, remaining, out):
         """The discrete update at time t, in place on ``d``; returns a :class:`Status`.
 
         Evaluates the law first (into ``out``, with the discrete state before the update);
@@ -664,7 +665,7 @@ def _update_kernel(dependencies):
         and reports a finish, a stall, gimbal lock or non-finite values.
         """
         dependencies  # noqa: B018 (numba's cache key, see above)
-        evaluate_kernel(t, q, qd, d, p, tool, waypoints, out)
+        evaluate_kernel(t, q, qd, d, p, model, tool, waypoints, out)
         pose = out[Evaluation.POSE:Evaluation.POSE + 6]
         bad = not (_finite(out[Evaluation.QDD:Evaluation.QDD + 6]) and _finite(q) and _finite(qd))
         c = out[Evaluation.C]
@@ -715,7 +716,7 @@ def _update_kernel(dependencies):
             # stop at each waypoint: the pose reached at low TCP speed, then the next task starts
             # from rest (with c from 0 again when the acceleration is limited)
             jac = np.empty((6, 6))
-            kinematics_into(q, qd, tool, np.empty(6), jac, np.empty(6))
+            kinematics_into(model, q, qd, tool, np.empty(6), jac, np.empty(6))
             speed = 0.0
             for k in range(3):
                 rate = 0.0
@@ -756,14 +757,14 @@ update_kernel = _update_kernel(_DEPENDENCIES)
 
 def _finished_kernel(dependencies):
     @compiled
-    def finished_kernel(q, d, p, tool, waypoints) -> bool:
+    def finished_kernel(q, d, p, model, tool, waypoints) -> bool:
         """True once p_w is the active target and the whole pose is within the accuracies of it."""
         dependencies  # noqa: B018 (numba's cache key, see above)
         i = int(d[Discrete.WAYPOINT])
         if i < int(p[Parameter.NUM_WAYPOINTS]) - 1:
             return False
         pose = np.empty(6)
-        kinematics_into(q, np.zeros(6), tool, pose, np.empty((6, 6)), np.empty(6))
+        kinematics_into(model, q, np.zeros(6), tool, pose, np.empty((6, 6)), np.empty(6))
         return pose_reached(pose, waypoints[i], p, np.empty(_EVALUATION_SIZE))
 
     return finished_kernel
@@ -774,7 +775,7 @@ finished_kernel = _finished_kernel(_DEPENDENCIES)
 
 def _integrate_kernel(dependencies):
     @compiled
-    def integrate_kernel(q0, d0, dt, steps, settle_steps, p, tool, waypoints, remaining, log, peak, out, final):
+    def integrate_kernel(q0, d0, dt, steps, settle_steps, p, model, tool, waypoints, remaining, log, peak, out, final):
         """Integrate one task from rest at ``q0`` with RK4 at a fixed step ``dt``, updating the
         discrete state (from ``d0``) every step.
 
@@ -799,7 +800,7 @@ def _integrate_kernel(dependencies):
         stage_qdd = np.empty((4, 6))
         for k in range(steps + settle_steps + 1):
             t = k * dt
-            status = update_kernel(t, q, qd, d, p, tool, waypoints, remaining, out)
+            status = update_kernel(t, q, qd, d, p, model, tool, waypoints, remaining, out)
             final[:6] = q
             final[6:12] = qd
             final[12:] = d
@@ -812,7 +813,7 @@ def _integrate_kernel(dependencies):
                 if s > 0:
                     stage_q[s] = q + h * stage_qd[s - 1]
                     stage_qd[s] = qd + h * stage_qdd[s - 1]
-                evaluate_kernel(t + h, stage_q[s], stage_qd[s], d, p, tool, waypoints, out)
+                evaluate_kernel(t + h, stage_q[s], stage_qd[s], d, p, model, tool, waypoints, out)
                 stage_qdd[s] = out[Evaluation.QDD:Evaluation.QDD + 6]
                 for j in range(6):
                     peak[0, j] = max(peak[0, j], abs(stage_qd[s, j]))

@@ -68,15 +68,16 @@ class PajakLaw:
     Args:
         parameters: the task and the law's settings (validated here; ValueError names the field).
         robot: the robot, reached through its :meth:`~drake_traj.robots.Robot.task_kinematics`
-            only; the compiled law is bound to the UR10e's (:data:`~.kernel.KINEMATICS`), so
-            another robot is refused with a ValueError naming it. Its TCP
+            only: a 6-axis arm whose kinematics are data (``model``) for the one compiled
+            kinematics function the law is bound to (:data:`~.kernel.KINEMATICS`); a robot
+            without them is refused with a ValueError naming it. Its TCP
             (:meth:`~drake_traj.robots.Robot.with_tcp`) is the tool the waypoints place.
     """
 
     def __init__(self, parameters: PajakConfig, robot: Robot = UR10E):
         if not isinstance(parameters, PajakConfig):
             raise ValueError(f"parameters must be a PajakConfig, got {type(parameters).__name__}")
-        refused = f"the Pająk planner runs on the UR10e (closed-form task kinematics), not on {robot.name!r}"
+        refused = f"the Pająk planner runs on a 6-axis arm with task-space kinematics, not on {robot.name!r}"
         try:
             kinematics = robot.task_kinematics()
         except ValueError as error:
@@ -86,6 +87,7 @@ class PajakLaw:
             raise ValueError(f"{refused}: its task kinematics are not the ones the compiled law is bound to")
         self.robot, self.kinematics = robot, kinematics
         self.tool = np.ascontiguousarray(kinematics.tool, dtype=float)  # X_FT, the kernels' ``tool``
+        self.model = np.ascontiguousarray(kinematics.model, dtype=float)  # the arm, the kernels' ``model``
         p = parameters.validate()
         self.parameters = p
         self.waypoints = np.ascontiguousarray(p.waypoints)
@@ -163,7 +165,7 @@ class PajakLaw:
         return q, qd, discrete
 
     def _evaluate(self, t, q, qd, discrete) -> np.ndarray:
-        evaluate_kernel(float(t), *self._state(q, qd, discrete), self.vector, self.tool, self.waypoints, self._out)
+        evaluate_kernel(float(t), *self._state(q, qd, discrete), self.vector, self.model, self.tool, self.waypoints, self._out)
         return self._out
 
     def acceleration(self, t: float, q, qd, discrete) -> tuple[np.ndarray, float]:
@@ -215,7 +217,7 @@ class PajakLaw:
         """
         q, qd, discrete = self._state(q, qd, discrete)
         updated = discrete.copy()
-        status = update_kernel(float(t), q, qd, updated, self.vector, self.tool, self.waypoints, self.remaining,
+        status = update_kernel(float(t), q, qd, updated, self.vector, self.model, self.tool, self.waypoints, self.remaining,
                                self._out)
         if status < 0:
             raise self.failure(status, t, q, updated, self._out)
@@ -243,7 +245,7 @@ class PajakLaw:
     def finished(self, q, qd, discrete) -> bool:
         """True once the TCP is within ε of the final waypoint p_w and p_w is the active target."""
         return bool(finished_kernel(np.asarray(q, dtype=float), np.asarray(discrete, dtype=float), self.vector,
-                                    self.tool, self.waypoints))
+                                    self.model, self.tool, self.waypoints))
 
     def failure(self, status: int, t: float, q, discrete, out) -> PlanningError:
         """The :class:`PlanningError` for a failure ``status`` of the kernel at time t, from the

@@ -1,0 +1,37 @@
+"""One compiled task-kinematics function for every 6-axis arm: the arm is data (``model``).
+
+The Pająk 2024 law is compiled once and cached on disk (:mod:`drake_traj.compiled`); it calls
+:func:`task_kinematics_into` with the arm's ``model`` array, so one compiled law serves every arm.
+``model[0]`` says which form the rest of the array feeds:
+
+- :data:`~drake_traj.robots.ur10e.UR_CLOSED_FORM`: the UR e-Series closed form,
+  [kind, d1, a2, a3, d4, d5, d6] (:func:`drake_traj.robots.ur10e.kinematics_into`).
+"""
+
+from __future__ import annotations
+
+import math
+
+from drake_traj.compiled import compiled
+from drake_traj.robots import task_space, ur10e
+from drake_traj.robots.ur10e import UR_CLOSED_FORM
+from drake_traj.robots.ur10e import kinematics_into as ur_kinematics_into
+
+__all__ = ["SOURCES", "task_kinematics_into"]
+
+# The source files of the compiled code behind task_kinematics_into: a compiled caller digests
+# them into its cache key (numba checks only the caller's own file; see pajak/kernel.py).
+SOURCES = (__file__, ur10e.__file__, task_space.__file__)
+
+
+@compiled
+def task_kinematics_into(model, q, qd, tool, pose, jac, bias):
+    """k(q), the analytic J and J̇q̇ of the TCP ``tool`` (X_FT, 4x4) of the arm ``model`` into
+    ``pose`` (6), ``jac`` (6, 6) and ``bias`` (6); returns (cos φ_Y, singularity measure in
+    [0, 1]). An unknown ``model[0]`` fills NaN (the callers treat a non-finite pose as a failure)."""
+    if model[0] == UR_CLOSED_FORM:
+        return ur_kinematics_into(model, q, qd, tool, pose, jac, bias)
+    pose[:] = math.nan
+    jac[:, :] = math.nan
+    bias[:] = math.nan
+    return math.nan, math.nan
