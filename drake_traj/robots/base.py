@@ -116,6 +116,8 @@ class Robot:
     base_frame: ClassVar[str] = "base"
     tool_frame: ClassVar[str] = "tool0"
     tcp_offset: np.ndarray = FLANGE  # X_FT (4, 4) [m]: the TCP in the flange frame, read-only
+    rated_payload: float | None = None  # [kg], the largest payload the maker rates; None: not rated
+    data_source: str = ""  # where the robot's numbers come from (a document in docs/, a paper, a file)
 
     def with_tcp(self, xyz, rpy) -> "Robot":
         """A robot equal to this one whose tool is the TCP at ``xyz`` [m] with orientation ``rpy``

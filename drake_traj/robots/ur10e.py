@@ -641,6 +641,8 @@ class UR10e(Robot):
     joint_names: ClassVar[tuple[str, ...]] = JOINT_NAMES
     joint_types: ClassVar[tuple[str, ...]] = ("revolute",) * NUM_JOINTS
     tool_frame: ClassVar[str] = FLANGE_FRAME
+    rated_payload: float = 12.5  # [kg] (UR e-Series data sheet)
+    data_source: str = "docs/ur10e.md (Universal Robots' DH and dynamics table, UR10e data sheet)"
 
     @property
     def lower_limits(self) -> np.ndarray:
