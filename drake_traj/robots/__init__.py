@@ -1,17 +1,20 @@
-"""Robots under one contract (:class:`Robot`): the UR10e, the three example robots of Boryga and
-the 4-DOF robot of Li et al. 2019. ``get_robot(name)`` returns one by its scenario name."""
+"""Robots under one contract (:class:`Robot`): the UR e-Series arms (UR3e, UR5e, UR10e, UR16e,
+UR20), the three example robots of Boryga and the 4-DOF robot of Li et al. 2019.
+``get_robot(name)`` returns one by its scenario name."""
 
 from drake_traj.robots.base import PointRobot, Robot
 from drake_traj.robots.boryga_robots import AnthropomorphicArm, CartesianRobot, ScaraArm
 from drake_traj.robots.li_4dof import LI_4DOF, Li4Dof
 from drake_traj.robots.ur10e import UR10E, UR10e
+from drake_traj.robots.ur_eseries import UR_ARMS, URArm
 
 __all__ = [
     "ROBOT_NAMES", "AnthropomorphicArm", "CartesianRobot", "LI_4DOF", "Li4Dof", "PointRobot", "Robot", "ScaraArm",
-    "UR10E", "UR10e", "get_robot",
+    "UR10E", "UR10e", "UR_ARMS", "URArm", "get_robot",
 ]
 
-_ROBOTS = {robot.name: robot for robot in (UR10E, LI_4DOF, AnthropomorphicArm(), ScaraArm(), CartesianRobot())}
+_ROBOTS = {robot.name: robot for robot in (UR10E, *(arm for arm in UR_ARMS if arm is not UR10E), LI_4DOF,
+                                           AnthropomorphicArm(), ScaraArm(), CartesianRobot())}
 ROBOT_NAMES = tuple(_ROBOTS)
 
 

@@ -4,8 +4,8 @@ The Pająk 2024 law is compiled once and cached on disk (:mod:`drake_traj.compil
 :func:`task_kinematics_into` with the arm's ``model`` array, so one compiled law serves every arm.
 ``model[0]`` says which form the rest of the array feeds:
 
-- :data:`~drake_traj.robots.ur10e.UR_CLOSED_FORM`: the UR e-Series closed form,
-  [kind, d1, a2, a3, d4, d5, d6] (:func:`drake_traj.robots.ur10e.kinematics_into`).
+- :data:`~drake_traj.robots.ur_closed_form.UR_CLOSED_FORM`: the UR e-Series closed form,
+  [kind, d1, a2, a3, d4, d5, d6] (:func:`drake_traj.robots.ur_closed_form.kinematics_into`).
 """
 
 from __future__ import annotations
@@ -13,15 +13,15 @@ from __future__ import annotations
 import math
 
 from drake_traj.compiled import compiled
-from drake_traj.robots import task_space, ur10e
-from drake_traj.robots.ur10e import UR_CLOSED_FORM
-from drake_traj.robots.ur10e import kinematics_into as ur_kinematics_into
+from drake_traj.robots import task_space, ur_closed_form
+from drake_traj.robots.ur_closed_form import UR_CLOSED_FORM
+from drake_traj.robots.ur_closed_form import kinematics_into as ur_kinematics_into
 
 __all__ = ["SOURCES", "task_kinematics_into"]
 
 # The source files of the compiled code behind task_kinematics_into: a compiled caller digests
 # them into its cache key (numba checks only the caller's own file; see pajak/kernel.py).
-SOURCES = (__file__, ur10e.__file__, task_space.__file__)
+SOURCES = (__file__, ur_closed_form.__file__, task_space.__file__)
 
 
 @compiled
