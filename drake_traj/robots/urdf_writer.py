@@ -1,0 +1,293 @@
+"""URDF text for a 6R arm from its standard-DH table, link inertias, limits and primitive shapes.
+
+:func:`dh_arm_urdf` writes a model with the frames of ``models/ur10e.urdf`` (``docs/ur10e.md``,
+"The model file"): ``base`` is DH frame 0 (welded to the world by ``Robot.add_to_plant``); link i's
+frame is DH frame i-1 turned by q_i about its z axis, so joint i+1 sits in link i at
+xyz = (a_i cos θ_i, a_i sin θ_i, d_i), rpy = (α_i, 0, θ_i) and every joint axis is the local z;
+``tool0`` is DH frame 6. Each joint J has an effort actuator ``J_actuator`` whose limit is the
+joint's torque limit (a transmission, which Drake's parser turns into a ``JointActuator``).
+Inertials are given as the DH convention has them (centre of mass and tensor about it in DH frame
+i, the frame at link i's distal joint) and moved into link i's frame. Collision shapes are also the
+visual shapes, so Meshcat shows what is checked.
+
+:func:`ur_shapes` gives the UR e-Series arms' shapes (the UR10e's of ``docs/ur10e.md`` scaled to
+each arm); :func:`dh_capsules` plain capsules along a DH chain for an arm without better data.
+``python -m drake_traj.robots.urdf_writer`` regenerates ``models/<arm>.urdf`` for every e-Series arm
+but the UR10e (whose hand-written file stays as it is).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from drake_traj.robots.ur_eseries import DH_ALPHA, JOINT_NAMES, UR10E_DATA, UR_ARMS, URData
+from drake_traj.validation import invalid
+
+__all__ = ["LINK_NAMES", "Shape", "capsule_between", "dh_arm_urdf", "dh_capsules", "main", "ur_shapes", "ur_urdf"]
+
+# The bodies, base first, as in models/ur10e.urdf (the station and the cell checks name them).
+LINK_NAMES = ("base", "shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link",
+              "wrist_3_link")
+MARGIN = 0.005  # [m] added to every estimated radius (docs/ur10e.md, "Collision geometry")
+
+
+@dataclass(frozen=True)
+class Shape:
+    """A collision (and visual) shape of one body, in that body's frame: a ``cylinder`` or a
+    ``capsule`` along its local z, or a ``sphere``; ``xyz`` [m], ``rpy`` [rad] (URDF's fixed-axis
+    roll-pitch-yaw), ``radius`` and ``length`` [m] (``length`` unused for a sphere)."""
+
+    name: str
+    kind: str
+    radius: float
+    length: float = 0.0
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    colour: str = "grey"  # "grey" or "blue"
+
+
+def capsule_between(name: str, start, end, radius: float, colour: str = "grey") -> Shape:
+    """A capsule of ``radius`` whose axis runs from ``start`` to ``end`` (points in the body frame [m])."""
+    start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    axis = end - start
+    length = float(np.linalg.norm(axis))
+    if length == 0.0:
+        return Shape(name, "sphere", radius, 0.0, tuple(start), colour=colour)
+    pitch = math.atan2(math.hypot(axis[0], axis[1]), axis[2])
+    yaw = math.atan2(axis[1], axis[0]) if math.hypot(axis[0], axis[1]) > 0.0 else 0.0
+    return Shape(name, "capsule", radius, length, tuple(0.5 * (start + end)), (0.0, pitch, yaw), colour)
+
+
+def _joint_origin(d: float, a: float, alpha: float, theta: float) -> tuple[np.ndarray, np.ndarray]:
+    """(xyz, R) of DH frame i in link i's frame: Rz(θ) Tz(d) Tx(a) Rx(α)."""
+    ct, st, ca, sa = math.cos(theta), math.sin(theta), math.cos(alpha), math.sin(alpha)
+    rotation = np.array([[ct, -st * ca, st * sa], [st, ct * ca, -ct * sa], [0.0, sa, ca]])
+    return np.array([a * ct, a * st, d]), rotation
+
+
+def dh_capsules(d, a, radii, *, theta=(0.0,) * 6) -> list[list[Shape]]:
+    """Plain shapes along a standard-DH chain: for each link i (1..6), a capsule of ``radii[i-1]``
+    [m] from joint i along its axis by d_i, and one from there along x by a_i to joint i+1 (a sphere
+    at the joint where both are zero). Returns the shapes of the base (none) and links 1..6, the
+    ``shapes`` of :func:`dh_arm_urdf`."""
+    shapes: list[list[Shape]] = [[]]
+    for i in range(6):
+        corner = np.array([0.0, 0.0, d[i]])
+        end = np.array([a[i] * math.cos(theta[i]), a[i] * math.sin(theta[i]), d[i]])
+        link = []
+        if d[i] != 0.0:
+            link.append(capsule_between(f"link{i + 1}_along_d", np.zeros(3), corner, radii[i]))
+        if a[i] != 0.0 or d[i] == 0.0:
+            link.append(capsule_between(f"link{i + 1}_along_a", corner, end, radii[i]))
+        shapes.append(link)
+    return shapes
+
+
+def _vector(values, name: str, size: int) -> np.ndarray:
+    array = np.asarray(values, dtype=float)
+    if array.shape != (size,) or not np.all(np.isfinite(array)):
+        raise invalid(name, f"{name} must be {size} finite numbers, got {values!r}")
+    return array
+
+
+def _numbers(values) -> str:
+    return " ".join(repr(float(v)) for v in values)
+
+
+def _size(value: float) -> str:
+    """A shape's dimension [m], to 1 µm (the shapes are estimates; the kinematics stay exact)."""
+    return repr(round(float(value), 6))
+
+
+def _geometry(shape: Shape) -> str:
+    if shape.kind == "cylinder":
+        return f'<cylinder radius="{_size(shape.radius)}" length="{_size(shape.length)}"/>'
+    if shape.kind == "capsule":
+        return f'<drake:capsule radius="{_size(shape.radius)}" length="{_size(shape.length)}"/>'
+    if shape.kind == "sphere":
+        return f'<sphere radius="{_size(shape.radius)}"/>'
+    raise invalid("shapes", f"shape {shape.name!r}: kind must be cylinder, capsule or sphere, got {shape.kind!r}")
+
+
+def _shape_xml(shape: Shape) -> str:
+    origin = f'<origin xyz="{" ".join(_size(v) for v in shape.xyz)}" rpy="{_numbers(shape.rpy)}"/>'
+    geometry = _geometry(shape)
+    return (f'    <visual name="{shape.name}">\n      {origin}\n      <geometry>{geometry}</geometry>\n'
+            f'      <material name="{shape.colour}"/>\n    </visual>\n'
+            f'    <collision name="{shape.name}">\n      {origin}\n      <geometry>{geometry}</geometry>\n'
+            '    </collision>\n')
+
+
+def _inertial_xml(mass: float, com, inertia, rpy=(0.0, 0.0, 0.0)) -> str:
+    ixx, ixy, ixz, iyy, iyz, izz = (repr(float(v)) for v in inertia)
+    return (f'    <inertial>\n      <origin xyz="{_numbers(com)}" rpy="{_numbers(rpy)}"/>\n'
+            f'      <mass value="{float(mass)!r}"/>\n'
+            f'      <inertia ixx="{ixx}" ixy="{ixy}" ixz="{ixz}" iyy="{iyy}" iyz="{iyz}" izz="{izz}"/>\n'
+            '    </inertial>\n')
+
+
+def dh_arm_urdf(name: str, d: Sequence[float], a: Sequence[float], alpha: Sequence[float], *,
+                masses: Sequence[float], centers_of_mass, inertias, lower: Sequence[float],
+                upper: Sequence[float], velocity: Sequence[float], effort: Sequence[float],
+                shapes: Sequence[Sequence[Shape]], theta: Sequence[float] = (0.0,) * 6,
+                base_inertial: tuple[float, Sequence[float], Sequence[float]] = (1.0, (0.0, 0.0, 0.0),
+                                                                               (1e-3, 0.0, 0.0, 1e-3, 0.0, 1e-3)),
+                filtered_pairs: Sequence[tuple[int, int, str]] = (), joint_names: Sequence[str] = JOINT_NAMES,
+                comment: str = "") -> str:
+    """URDF text of a 6R arm (frames and names as ``models/ur10e.urdf``; see the module docstring).
+
+    Args:
+        name: the robot's name.
+        d, a, alpha, theta: the standard-DH table, T_{i-1,i} = Rz(q_i + θ_i) Tz(d_i) Tx(a_i) Rx(α_i),
+            6 entries each [m, rad]; the joint variable q_i is the DH angle minus θ_i.
+        masses: links 1..6 [kg]. centers_of_mass: (6, 3) [m], link i's in DH frame i.
+        inertias: (6, 6) rows (ixx, ixy, ixz, iyy, iyz, izz) [kg m²] about the centre of mass, axes
+            of DH frame i.
+        lower, upper: joint position limits [rad]; velocity [rad/s], effort [N m]: rated speeds and
+            torque limits (the actuators saturate at ``effort``).
+        shapes: 7 lists of :class:`Shape`, for the base and links 1..6, each in its body's frame
+            (the base's is DH frame 0; link i's is DH frame i-1 turned by q_i).
+        base_inertial: (mass [kg], centre of mass [m], inertia (6,) [kg m²]) of the base in DH frame 0.
+        filtered_pairs: (body index, body index, reason) with 0 = base ... 6 = wrist 3: pairs of
+            bodies whose collisions Drake ignores (a ``drake:collision_filter_group`` each), for
+            shapes that are in contact, or at a constant distance, at every configuration. Bodies
+            joined by a joint are filtered by Drake already.
+        joint_names: the six joints' names (the actuators are ``{joint}_actuator``).
+        comment: text for the file's header comment.
+
+    Returns the URDF as a string. Raises DrakeTrajError (a ValueError) naming the argument when a
+    table or list has the wrong size or a non-finite entry.
+    """
+    d, a, alpha, theta = (_vector(v, n, 6) for v, n in ((d, "d"), (a, "a"), (alpha, "alpha"), (theta, "theta")))
+    masses = _vector(masses, "masses", 6)
+    coms = [_vector(c, f"centers_of_mass[{i}]", 3) for i, c in enumerate(centers_of_mass)]
+    tensors = [_vector(t, f"inertias[{i}]", 6) for i, t in enumerate(inertias)]
+    lower, upper, velocity, effort = (_vector(v, n, 6) for v, n in ((lower, "lower"), (upper, "upper"),
+                                                                     (velocity, "velocity"), (effort, "effort")))
+    if len(coms) != 6 or len(tensors) != 6:
+        raise invalid("centers_of_mass", "centers_of_mass and inertias must have 6 rows, one per link")
+    if len(shapes) != 7:
+        raise invalid("shapes", f"shapes must have 7 lists (the base and links 1..6), got {len(shapes)}")
+    if len(joint_names) != 6:
+        raise invalid("joint_names", f"joint_names must name 6 joints, got {len(joint_names)}")
+    parts = [f'<?xml version="1.0"?>\n<!--\n  {name}: written by drake_traj.robots.urdf_writer (do not edit; regenerate).\n'
+             f'  {comment}\n  Frames: base = DH frame 0; link i = DH frame i-1 turned by q_i; joint i+1 in link i at\n'
+             '  (a_i cos theta_i, a_i sin theta_i, d_i), rpy (alpha_i, 0, theta_i); tool0 = DH frame 6. Inertials: the\n'
+             '  DH frame i centre of mass and tensor, moved into link i\'s frame. Visual shapes = collision shapes.\n-->\n'
+             f'<robot name="{name}" xmlns:drake="http://drake.mit.edu">\n'
+             '  <material name="blue">\n    <color rgba="0.2 0.4 0.9 1"/>\n  </material>\n'
+             '  <material name="grey">\n    <color rgba="0.75 0.78 0.82 1"/>\n  </material>\n']
+    base_mass, base_com, base_inertia = base_inertial
+    parts.append(f'  <link name="{LINK_NAMES[0]}">\n' + _inertial_xml(base_mass, base_com, base_inertia)
+                 + "".join(_shape_xml(s) for s in shapes[0]) + '  </link>\n')
+    origins = [_joint_origin(d[i], a[i], alpha[i], theta[i]) for i in range(6)]  # DH frame i in link i
+    rpys = [(float(alpha[i]), 0.0, float(theta[i])) for i in range(6)]
+    for i in range(6):
+        xyz, rpy = (np.zeros(3), (0.0, 0.0, 0.0)) if i == 0 else (origins[i - 1][0], rpys[i - 1])
+        parts.append(f'  <joint name="{joint_names[i]}" type="revolute">\n'
+                     f'    <parent link="{LINK_NAMES[i]}"/>\n    <child link="{LINK_NAMES[i + 1]}"/>\n'
+                     f'    <origin xyz="{_numbers(xyz)}" rpy="{_numbers(rpy)}"/>\n    <axis xyz="0 0 1"/>\n'
+                     f'    <limit lower="{float(lower[i])!r}" upper="{float(upper[i])!r}" '
+                     f'velocity="{float(velocity[i])!r}" effort="{float(effort[i])!r}"/>\n  </joint>\n')
+        position, rotation = origins[i]
+        parts.append(f'  <link name="{LINK_NAMES[i + 1]}">\n'
+                     + _inertial_xml(masses[i], position + rotation @ coms[i], tensors[i], rpys[i])
+                     + "".join(_shape_xml(s) for s in shapes[i + 1]) + '  </link>\n')
+    parts.append(f'  <joint name="wrist_3-tool0_fixed_joint" type="fixed">\n    <parent link="{LINK_NAMES[6]}"/>\n'
+                 f'    <child link="tool0"/>\n    <origin xyz="{_numbers(origins[5][0])}" rpy="{_numbers(rpys[5])}"/>\n'
+                 '  </joint>\n  <link name="tool0"/>\n')
+    for joint in joint_names:
+        parts.append(f'  <transmission name="{joint}_transmission">\n'
+                     '    <type>transmission_interface/SimpleTransmission</type>\n'
+                     f'    <joint name="{joint}">\n'
+                     '      <hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>\n'
+                     f'    </joint>\n    <actuator name="{joint}_actuator">\n'
+                     '      <mechanicalReduction>1</mechanicalReduction>\n    </actuator>\n  </transmission>\n')
+    for first, second, reason in filtered_pairs:
+        group = f"{LINK_NAMES[first]}_{LINK_NAMES[second]}"
+        parts.append(f'  <!-- {reason} -->\n  <drake:collision_filter_group name="{group}">\n'
+                     f'    <drake:member link="{LINK_NAMES[first]}"/>\n    <drake:member link="{LINK_NAMES[second]}"/>\n'
+                     f'    <drake:ignored_collision_filter_group name="{group}"/>\n  </drake:collision_filter_group>\n')
+    parts.append("</robot>\n")
+    return "".join(parts)
+
+
+def ur_shapes(data: URData) -> list[list[Shape]]:
+    """The shapes of an e-Series arm: those of ``models/ur10e.urdf`` (``docs/ur10e.md``,
+    "Collision geometry": the real radii, estimated, plus :data:`MARGIN`) with every UR10e size
+    scaled by ``data.size`` (the arm's d5 over the UR10e's) and placed by the arm's own DH lengths
+    and tube planes. Base, links 1..6, as :func:`dh_arm_urdf` takes them."""
+    s, m = data.size, MARGIN
+    d1, d4, d5, d6 = data.d[0], data.d[3], data.d[4], data.d[5]
+    a2, a3 = data.a[1], data.a[2]
+    upper_plane, forearm_plane = data.tube_offsets
+    base_radius, base_height = 0.095 * s, 0.1 * s  # the UR10e's footprint (no margin) and height
+    upper_radius, forearm_radius = 0.075 * s + m, 0.058 * s + m  # tube radii at their thick end
+    wrist_radius, flange_radius, flange_length = 0.047 * s + m, 0.045 * s + m, 0.05 * s
+    turn = math.pi / 2
+
+    def cylinder(name, radius, start, end, *, at=(0.0, 0.0), axis="z", colour="blue"):
+        """A cylinder from ``start`` to ``end`` along the body's ``axis`` ("z" or "y") at ``at``
+        in the other two coordinates."""
+        centre = 0.5 * (start + end)
+        xyz = (at[0], at[1], centre) if axis == "z" else (at[0], centre, at[1])
+        return Shape(name, "cylinder", radius, abs(end - start), xyz, (0.0, 0.0, 0.0) if axis == "z" else (turn, 0.0, 0.0),
+                     colour)
+
+    upper_top = upper_plane + upper_radius
+    forearm_bottom = forearm_plane - forearm_radius
+    return [
+        [cylinder("base_foot", base_radius, 0.0, base_height, colour="grey")],
+        [cylinder("joint1_housing", 0.076 * s + m, base_height, d1 + 0.1 * s),
+         cylinder("joint2_housing", 0.077 * s + m, -0.03 * s, -upper_top, at=(0.0, d1), axis="y")],
+        [capsule_between("upper_arm_tube", (0.0, 0.0, upper_plane), (a2, 0.0, upper_plane), upper_radius),
+         cylinder("joint3_housing", 0.077 * s + m, forearm_bottom, upper_top, at=(a2, 0.0))],
+        [capsule_between("forearm_tube", (0.0, 0.0, forearm_plane), (a3, 0.0, forearm_plane), forearm_radius),
+         cylinder("joint4_housing", wrist_radius, forearm_bottom, d4 - 0.044 * s, at=(a3, 0.0))],
+        # about the joint-5 axis (-y here): 0.12 s long, from -0.047 s to 0.073 s along it, + m at each end
+        [cylinder("joint5_housing", wrist_radius, 0.047 * s + m, -0.073 * s - m, at=(0.0, d4), axis="y")],
+        # about the joint-6 axis (+y here): from behind the joint-5 housing to the flange
+        [cylinder("joint6_housing", flange_radius, -wrist_radius, d6 - flange_length, at=(0.0, d5), axis="y")],
+        [cylinder("flange", flange_radius, d6 - flange_length, d6, colour="grey")],
+    ]
+
+
+def ur_urdf(data: URData) -> str:
+    """The URDF of an e-Series arm from its :class:`URData` (:func:`dh_arm_urdf`, :func:`ur_shapes`)."""
+    radius, height = 0.095 * data.size, 0.1 * data.size
+    base_inertia = (data.base_mass * (3 * radius ** 2 + height ** 2) / 12, 0.0, 0.0,
+                    data.base_mass * (3 * radius ** 2 + height ** 2) / 12, 0.0, data.base_mass * radius ** 2 / 2)
+    gap = data.d[5] - 0.05 * data.size - (0.047 * data.size + MARGIN)
+    limit = np.array(data.position_limit)
+    return dh_arm_urdf(
+        data.name, data.d, data.a, DH_ALPHA, masses=data.link_masses, centers_of_mass=data.centers_of_mass,
+        inertias=data.inertias, lower=-limit, upper=limit, velocity=data.velocity_limit, effort=data.effort_limit,
+        shapes=ur_shapes(data), base_inertial=(data.base_mass, (0.0, 0.0, height / 2), base_inertia),
+        filtered_pairs=[(4, 6, f"the joint-5 housing and the flange: {gap * 1000:.2f} mm apart at every configuration "
+                               "(the flange turns about the joint-5 axis and its own), as in models/ur10e.urdf")],
+        comment=f"{data.title} from docs/ur_family.md (UR's DH table, masses, centres of mass, limits); primitive "
+                "shapes: the UR10e's of docs/ur10e.md scaled by d5 / d5(UR10e).")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Write ``models/<arm>.urdf`` for every e-Series arm but the UR10e into the folder given as
+    the one argument (default: the package's ``models``)."""
+    from drake_traj.data import data_directory
+
+    argv = sys.argv[1:] if argv is None else list(argv)
+    folder = Path(argv[0]) if argv else data_directory("models")
+    for data in (arm.data for arm in UR_ARMS if arm.data is not UR10E_DATA):
+        path = folder / f"{data.name}.urdf"
+        path.write_text(ur_urdf(data))
+        print(f"wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
