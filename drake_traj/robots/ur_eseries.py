@@ -357,7 +357,7 @@ class URArm(Robot):
         arm's torque limit over the UR10e's (kp to 1 N m/rad, kd to 0.1 N m s/rad): a joint then
         saturates at the same position error as the UR10e's."""
         ratio = [limit / reference for limit, reference in zip(self.data.effort_limit, UR10E_EFFORT_LIMIT)]
-        return (tuple(round(kp * r) for kp, r in zip(UR10E_KP, ratio)),
+        return (tuple(float(round(kp * r)) for kp, r in zip(UR10E_KP, ratio)),
                 tuple(round(kd * r, 1) for kd, r in zip(UR10E_KD, ratio)))
 
     @property

@@ -156,7 +156,8 @@ def test_each_arm_has_its_own_published_numbers():
 
 
 def test_default_gains_scale_the_ur10es_by_the_torque_limits():
-    assert UR10E.default_gains == ((4000, 4000, 2000, 500, 500, 300), (200, 200, 100, 20, 20, 10))
+    assert UR10E.default_gains == ((4000.0, 4000.0, 2000.0, 500.0, 500.0, 300.0), (200.0, 200.0, 100.0, 20.0, 20.0, 10.0))
+    assert all(isinstance(gain, float) for gains in UR10E.default_gains for gain in gains)
     kp, kd = ARMS["ur5e"].default_gains
     assert kp == (round(4000 * 150 / 330), round(4000 * 150 / 330), 2000, 250, 250, 150)
     assert kd == (90.9, 90.9, 100.0, 10.0, 10.0, 5.0)
