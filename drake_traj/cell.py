@@ -164,7 +164,9 @@ class Tool:
         tcp_xyz: the tool centre point in the flange frame [m]; every task pose is the TCP's.
         tcp_rpy: the TCP frame's roll-pitch-yaw in the flange frame [rad].
         shapes: the tool's collision shapes, posed in the flange frame.
-        mass: the payload [kg] (tool and workpiece), at most the UR10e's rated 12.5 kg.
+        mass: the payload [kg] (tool and workpiece), at most the robot's rated payload
+            (:attr:`~drake_traj.robots.base.Robot.rated_payload`; the UR10e's 12.5 kg where the
+            robot has none).
         center_of_mass: the payload's centre of mass in the flange frame [m].
         inertia: the payload's rotational inertia about its centre of mass, [Ixx, Iyy, Izz, Ixy,
             Ixz, Iyz] [kg m²] in the flange frame; empty: a point mass.
@@ -189,13 +191,17 @@ class Tool:
             reach.append(float(np.linalg.norm(shape.xyz)) + _bounding_radius(shape, ("cell", "tool", "shapes", index)))
         return max(reach)
 
-    def spatial_inertia(self) -> SpatialInertia | None:
-        """The payload about the flange origin, in the flange frame (None without a payload)."""
+    def spatial_inertia(self, robot=None) -> SpatialInertia | None:
+        """The payload about the flange origin, in the flange frame (None without a payload);
+        refused above ``robot``'s rated payload (default, or a robot without one: the UR10e's)."""
         mass = _vector([self.mass], ("cell", "tool", "mass"), 1, "kg")[0]
         if mass < 0:
             raise invalid("cell.tool.mass", f"cell.tool.mass must be >= 0 kg, got {self.mass}")
-        if mass > RATED_PAYLOAD:
-            raise DrakeTrajError(f"cell.tool.mass = {mass:g} kg is above the UR10e's rated payload of {RATED_PAYLOAD} kg",
+        rated, rated_by = RATED_PAYLOAD, "UR10e"
+        if robot is not None and robot.rated_payload is not None:
+            rated, rated_by = robot.rated_payload, robot.name
+        if mass > rated:
+            raise DrakeTrajError(f"cell.tool.mass = {mass:g} kg is above the {rated_by}'s rated payload of {rated:g} kg",
                                  field=("cell", "tool", "mass"), cause=Cause.INFEASIBLE)
         com = _vector(self.center_of_mass, ("cell", "tool", "center_of_mass"), 3, "m")
         if mass == 0:
@@ -239,9 +245,10 @@ class Cell:
     tool: Tool = field(default_factory=Tool)
     clearance: float = DEFAULT_CLEARANCE
 
-    def validate(self) -> None:
+    def validate(self, robot=None) -> None:
         """Raise DrakeTrajError naming the first field that is malformed (sizes, poses, the tool,
-        the payload, the clearance); directives are checked when they are loaded."""
+        the payload (above ``robot``'s rating: :meth:`Tool.spatial_inertia`), the clearance);
+        directives are checked when they are loaded."""
         clearance = _vector([self.clearance], ("cell", "clearance"), 1, "m")[0]
         if clearance < 0:
             raise invalid("cell.clearance", f"cell.clearance must be >= 0 m, got {self.clearance}")
@@ -254,7 +261,7 @@ class Cell:
         for index, shape in enumerate(self.tool.shapes):
             shape.shape(("cell", "tool", "shapes", index))
             _pose(shape.xyz, shape.rpy, ("cell", "tool", "shapes", index))
-        self.tool.spatial_inertia()
+        self.tool.spatial_inertia(robot)
 
     def obstacle_name(self, index: int) -> str:
         """The geometry name of obstacle ``index`` (its ``name``, or ``obstacle_<index>``)."""
@@ -302,19 +309,20 @@ def _register(plant: MultibodyPlant, body, pose: RigidTransform, shape, name: st
 
 
 def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, flange_frame: str = "tool0",
-             directory: Path | None = None) -> dict:
+             directory: Path | None = None, robot=None) -> dict:
     """Register ``cell`` in ``plant`` (not finalized) around the robot of ``robot_instance``.
 
     The mounting and the obstacles are geometry of the world body (collision and visual); the
     directives add the user's models (relative files from ``directory``, the scenario's folder;
     default the working directory); the tool is a body ``tool`` welded to ``flange_frame`` that
-    carries the payload's inertia and the tool's shapes (added only when there is either).
+    carries the payload's inertia and the tool's shapes (added only when there is either), its
+    mass at most ``robot``'s rated payload (:meth:`Tool.spatial_inertia`).
 
     Returns {geometry name: field path in the scenario} of the cell's own geometry, for errors
     that name an obstacle. Raises DrakeTrajError naming the field of a malformed part, a model
     file that is missing or cannot be parsed, or a directive naming an unknown frame or model.
     """
-    cell.validate()
+    cell.validate(robot)
     world = plant.world_body()
     fields = {}
     for name, shape, pose in _mounting_shapes(cell.mounting):
@@ -329,7 +337,7 @@ def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, flange_frame:
                   OBSTACLE_COLOUR)
         fields[name] = location
     _add_directives(plant, cell.directives, directory)
-    inertia = cell.tool.spatial_inertia()
+    inertia = cell.tool.spatial_inertia(robot)
     if inertia is not None or cell.tool.shapes:
         tool = plant.AddRigidBody(TOOL_BODY, robot_instance, inertia or SpatialInertia.Zero())
         plant.WeldFrames(plant.GetFrameByName(flange_frame, robot_instance), tool.body_frame())

@@ -169,7 +169,7 @@ class CellChecker:
         self.plant, self.scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
         self.instance = robot.add_to_plant(self.plant)
         self.cell_fields = add_cell(self.plant, self.cell, self.instance, flange_frame=robot.tool_frame,
-                                    directory=directory)
+                                    directory=directory, robot=robot)
         self.plant.Finalize()
         self._diagram = builder.Build()
         self._context = self._diagram.CreateDefaultContext()

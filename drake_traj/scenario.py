@@ -250,7 +250,7 @@ class Scenario:
             raise invalid("plant", f"plant: {error}") from None
         self.controller.for_robot(robot)
         self.speed_override.validate()
-        self.cell.validate()
+        self.cell.validate(robot)
         self.robot_with_tool()
 
     def station_arguments(self) -> dict:

@@ -169,7 +169,8 @@ def add_station(
         plant.GetJointActuatorByName(f"{joint_name}_actuator", instance).set_controller_gains(PdControllerGains(p=kp, d=kd))
     # the cell's geometry, the tool's body and payload: contact with them, and between the arm's
     # non-adjacent links, is simulated (and ends the run: run_station)
-    add_cell(plant, cell or Cell(), instance, flange_frame=robot.tool_frame, directory=cell_directory)
+    add_cell(plant, cell or Cell(), instance, flange_frame=robot.tool_frame, directory=cell_directory,
+             robot=robot)
     if before_finalize is not None:
         before_finalize(plant, scene_graph)
     plant.Finalize()

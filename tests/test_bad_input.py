@@ -319,7 +319,7 @@ API_CASES = [
                                                       get_robot("ur10e").home_configuration), ValueError,
      r"points must be a list of at least two \[x, y, z\] rows \[m\], got shape \(2, 2\)"),
     ("pajak on another robot", lambda: make_planner(paper_parameters(3), get_robot("li_4dof"), [0.0] * 4), ValueError,
-     r"the Pająk planner runs on the UR10e"),
+     r"the Pająk planner runs on a 6-axis arm with task-space kinematics, not on 'li_4dof'"),
     # numbers given as text or booleans are refused, not converted
     ("quintic goals as text", lambda: make_planner(QuinticConfig(goals=[[str(v) for v in GOAL[0]]]), get_robot("ur10e"), UR10E_HOME),
      ValueError, r"goals must be a real number or an array of real numbers .*found str '-0.9'"),

@@ -26,6 +26,7 @@ from typing import Sequence
 
 import numpy as np
 
+from drake_traj.data import data_directory
 from drake_traj.robots.ur_eseries import DH_ALPHA, JOINT_NAMES, UR10E_DATA, UR_ARMS, URData
 from drake_traj.validation import invalid
 
@@ -278,8 +279,6 @@ def ur_urdf(data: URData) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """Write ``models/<arm>.urdf`` for every e-Series arm but the UR10e into the folder given as
     the one argument (default: the package's ``models``)."""
-    from drake_traj.data import data_directory
-
     argv = sys.argv[1:] if argv is None else list(argv)
     folder = Path(argv[0]) if argv else data_directory("models")
     for data in (arm.data for arm in UR_ARMS if arm.data is not UR10E_DATA):

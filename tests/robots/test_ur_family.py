@@ -12,6 +12,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import JacobianWrtVariable, JointActuatorIndex
 from pydrake.systems.framework import DiagramBuilder
 
+from drake_traj.cell import Cell, Tool
 from drake_traj.clearance import CellChecker
 from drake_traj.errors import DrakeTrajError
 from drake_traj.robots import ROBOT_NAMES, UR10E, UR_ARMS, get_robot
@@ -153,6 +154,21 @@ def test_each_arm_has_its_own_published_numbers():
         assert np.array_equal(speed, np.minimum(1.05, arm.velocity_limits)) and np.all(acceleration == 1.40)
         assert np.array_equal(arm.task_kinematics().model, [0.0, arm.data.d[0], arm.data.a[1], arm.data.a[2],
                                                             *arm.data.d[3:]])
+
+
+def test_the_payload_is_checked_against_each_arms_rating():
+    tool = Cell(tool=Tool(mass=4.0, tcp_xyz=[0.0, 0.0, 0.1]))
+    tool.validate(ARMS["ur5e"])
+    assert CellChecker(ARMS["ur5e"], tool).plant.GetBodyByName("tool").default_mass() == 4.0
+    with pytest.raises(DrakeTrajError, match=r"cell.tool.mass = 4 kg is above the ur3e's rated payload of 3 kg") as info:
+        tool.validate(ARMS["ur3e"])
+    assert info.value.field == ("cell", "tool", "mass")
+    with pytest.raises(DrakeTrajError, match=r"above the ur3e's rated payload"):
+        CellChecker(ARMS["ur3e"], tool)
+    heavy = Cell(tool=Tool(mass=15.0, tcp_xyz=[0.0, 0.0, 0.1]))
+    heavy.validate(ARMS["ur16e"])
+    with pytest.raises(DrakeTrajError, match=r"above the ur10e's rated payload of 12.5 kg"):
+        heavy.validate(UR10E)
 
 
 def test_default_gains_scale_the_ur10es_by_the_torque_limits():
