@@ -88,6 +88,7 @@ class URData:
     size: float
     base_mass: float = 4.0  # approximate (the ROS description flags it); the base is welded
     position_limit: tuple[float, ...] = (_FULL_TURN,) * NUM_JOINTS  # symmetric
+    data_source: str = "docs/ur_family.md (Universal Robots' DH table and data sheets, UR's ROS 2 description)"
 
     @property
     def model(self) -> np.ndarray:
@@ -152,7 +153,8 @@ UR10E_DATA = URData(
               (0.0004, 0.0, 0.0, 0.00041, 0.0, 0.00034)),
     # docs/ur10e.md's rounded speeds and its 56 N m wrists (the ROS description: 54), kept as shipped
     velocity_limit=(2.094, 2.094, 3.1416, 3.1416, 3.1416, 3.1416), effort_limit=UR10E_EFFORT_LIMIT,
-    rated_payload=12.5, reach=1.3, tube_offsets=(0.176, 0.039), size=1.0)
+    rated_payload=12.5, reach=1.3, tube_offsets=(0.176, 0.039), size=1.0,
+    data_source="docs/ur10e.md (Universal Robots' DH and dynamics table, UR10e data sheet)")
 
 UR16E_DATA = URData(
     name="ur16e", title="UR16e",
@@ -315,10 +317,8 @@ class URArm(Robot):
         self.name = data.name
         self.model_file = f"{data.name}.urdf"
         self.rated_payload = data.rated_payload
-        self.data_source = ("docs/ur10e.md (Universal Robots' DH and dynamics table, UR10e data sheet)"
-                            if data.name == "ur10e" else
-                            f"docs/ur_family.md ({data.title}: Universal Robots' DH table, data sheet, ROS 2 description)")
-        self.model = data.model
+        self.data_source = data.data_source
+        self.model = data.model  # the closed form's data, TaskKinematics.model
         self._d = np.array(data.d)
         self._a = np.array(data.a)
         self._position_limit = np.array(data.position_limit)

@@ -117,6 +117,8 @@ def _geometry(shape: Shape) -> str:
 
 
 def _shape_xml(shape: Shape) -> str:
+    if shape.colour not in ("grey", "blue"):
+        raise invalid("shapes", f"shape {shape.name!r}: colour must be grey or blue, got {shape.colour!r}")
     origin = f'<origin xyz="{" ".join(_size(v) for v in shape.xyz)}" rpy="{_numbers(shape.rpy)}"/>'
     geometry = _geometry(shape)
     return (f'    <visual name="{shape.name}">\n      {origin}\n      <geometry>{geometry}</geometry>\n'

@@ -12,6 +12,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import JacobianWrtVariable, JointActuatorIndex
 from pydrake.systems.framework import DiagramBuilder
 
+from drake_traj import load_scenario, simulate
 from drake_traj.cell import Cell, Tool
 from drake_traj.clearance import CellChecker
 from drake_traj.errors import DrakeTrajError
@@ -238,3 +239,32 @@ def test_the_writer_takes_any_dh_arm_and_refuses_malformed_tables():
         dh_arm_urdf("bad", data.d, data.a, [0.0] * 6, **{**arguments, "effort": [np.nan] * 6})
     with pytest.raises(ValueError, match=r"shapes must have 7 lists"):
         dh_arm_urdf("bad", data.d, data.a, [0.0] * 6, **{**arguments, "shapes": [[Shape("s", "sphere", 0.1)]]})
+
+
+UR5E_PAJAK = """name: ur5e_pajak
+robot: ur5e
+planner: !PajakConfig
+  waypoints:
+    - [-0.134, -0.45, 0.45, 3.141592653589793, 0.0, 2.356194490192345]
+    - [{x}, -0.55, 0.45, 3.141592653589793, 0.0, 2.356194490192345]
+  velocity_limit: 1.05
+  acceleration_limit: 1.40
+plant:
+  time_step: 0.001
+settle_time: 0.3
+"""
+
+
+def test_the_pajak_law_runs_the_ur5e_with_its_own_kinematics_and_limits(tmp_path):
+    ur5e = ARMS["ur5e"]
+    path = tmp_path / "ur5e_pajak.yaml"
+    path.write_text(UR5E_PAJAK.format(x=0.1))
+    result = simulate(load_scenario(path))
+    assert result.succeeded and result.robot == "ur5e"
+    assert np.array_equal(result.effort_limit, ur5e.effort_limits)
+    assert np.linalg.norm(ur5e.tcp_pose(result.q_meas[-1])[:3] - [0.1, -0.55, 0.45]) < 1e-3  # accuracy 1 mm
+    assert np.max(np.abs(result.qd_ref)) <= 1.05 + 1e-9 and np.max(np.abs(result.qdd_ref)) <= 1.40 + 1e-9
+    assert np.all(np.abs(result.tau) <= ur5e.effort_limits + 1e-9)
+    path.write_text(UR5E_PAJAK.format(x=0.9))  # inside the UR10e's reach, beyond the UR5e's
+    with pytest.raises(ValueError, match=r"waypoint 1 cannot be reached: .*the UR5e reaches at most 0.926539 m"):
+        simulate(load_scenario(path))
