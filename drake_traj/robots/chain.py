@@ -241,38 +241,48 @@ def _plant_chain(plant, base_frame, tool_frame):
 
 @compiled
 def _chain_frames(model, q, axes, origins, rotation, flange):
-    """The joint axes z_j into ``axes`` (6, 3) and their origins o_j into ``origins`` (6, 3), the
+    """The joint axes z_j into ``axes`` (6, 3) and their origins o_j into ``origins`` (6+, 3), the
     flange's rotation R_BF into ``rotation`` (3, 3) and origin into ``flange`` (3), all in the
-    base frame [m], of the packed chain ``model`` at q [rad]."""
-    r = np.eye(3)  # R_B,M(i-1)
-    fixed_rotation = np.empty((3, 3))  # R_B,F(i)
+    base frame [m], of the packed chain ``model`` at q [rad]. Scalars throughout (no arrays
+    allocated: this is the hot path of the compiled law)."""
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0  # R_B,M(i-1)
     p0 = p1 = p2 = 0.0
     for i in range(NUM_JOINTS + 1):
         k = _TRANSFORMS + 12 * i
-        for a in range(3):
-            for b in range(3):
-                fixed_rotation[a, b] = (r[a, 0] * model[k + b] + r[a, 1] * model[k + 3 + b]
-                                        + r[a, 2] * model[k + 6 + b])
+        m00, m01, m02 = model[k], model[k + 1], model[k + 2]
+        m10, m11, m12 = model[k + 3], model[k + 4], model[k + 5]
+        m20, m21, m22 = model[k + 6], model[k + 7], model[k + 8]
         t0, t1, t2 = model[k + 9], model[k + 10], model[k + 11]
-        p0, p1, p2 = (p0 + r[0, 0] * t0 + r[0, 1] * t1 + r[0, 2] * t2, p1 + r[1, 0] * t0 + r[1, 1] * t1 + r[1, 2] * t2,
-                      p2 + r[2, 0] * t0 + r[2, 1] * t1 + r[2, 2] * t2)
+        p0, p1, p2 = (p0 + r00 * t0 + r01 * t1 + r02 * t2, p1 + r10 * t0 + r11 * t1 + r12 * t2,
+                      p2 + r20 * t0 + r21 * t1 + r22 * t2)
+        # R_B,F(i) = R_B,M(i-1) X_{M(i-1) F(i)}'s rotation
+        f00, f01, f02 = r00 * m00 + r01 * m10 + r02 * m20, r00 * m01 + r01 * m11 + r02 * m21, \
+            r00 * m02 + r01 * m12 + r02 * m22
+        f10, f11, f12 = r10 * m00 + r11 * m10 + r12 * m20, r10 * m01 + r11 * m11 + r12 * m21, \
+            r10 * m02 + r11 * m12 + r12 * m22
+        f20, f21, f22 = r20 * m00 + r21 * m10 + r22 * m20, r20 * m01 + r21 * m11 + r22 * m21, \
+            r20 * m02 + r21 * m12 + r22 * m22
         if i == NUM_JOINTS:
-            rotation[:, :] = fixed_rotation
+            rotation[0, 0], rotation[0, 1], rotation[0, 2] = f00, f01, f02
+            rotation[1, 0], rotation[1, 1], rotation[1, 2] = f10, f11, f12
+            rotation[2, 0], rotation[2, 1], rotation[2, 2] = f20, f21, f22
             break
         a0, a1, a2 = model[_AXES + 3 * i], model[_AXES + 3 * i + 1], model[_AXES + 3 * i + 2]
-        z0 = fixed_rotation[0, 0] * a0 + fixed_rotation[0, 1] * a1 + fixed_rotation[0, 2] * a2
-        z1 = fixed_rotation[1, 0] * a0 + fixed_rotation[1, 1] * a1 + fixed_rotation[1, 2] * a2
-        z2 = fixed_rotation[2, 0] * a0 + fixed_rotation[2, 1] * a1 + fixed_rotation[2, 2] * a2
+        z0, z1, z2 = f00 * a0 + f01 * a1 + f02 * a2, f10 * a0 + f11 * a1 + f12 * a2, f20 * a0 + f21 * a1 + f22 * a2
         axes[i, 0], axes[i, 1], axes[i, 2] = z0, z1, z2
         origins[i, 0], origins[i, 1], origins[i, 2] = p0, p1, p2
         # R_B,M(i) = R_B,F(i) Rot(a, q) = c R + s [z]x R + (1 - c) z aᵀ (Rodrigues, [Ra]x R = R [a]x)
         c, s = math.cos(q[i]), math.sin(q[i])
-        for b in range(3):
-            x0, x1, x2 = fixed_rotation[0, b], fixed_rotation[1, b], fixed_rotation[2, b]
-            ab = a0 if b == 0 else (a1 if b == 1 else a2)
-            r[0, b] = c * x0 + s * (z1 * x2 - z2 * x1) + (1.0 - c) * z0 * ab
-            r[1, b] = c * x1 + s * (z2 * x0 - z0 * x2) + (1.0 - c) * z1 * ab
-            r[2, b] = c * x2 + s * (z0 * x1 - z1 * x0) + (1.0 - c) * z2 * ab
+        v = 1.0 - c
+        r00 = c * f00 + s * (z1 * f20 - z2 * f10) + v * z0 * a0
+        r10 = c * f10 + s * (z2 * f00 - z0 * f20) + v * z1 * a0
+        r20 = c * f20 + s * (z0 * f10 - z1 * f00) + v * z2 * a0
+        r01 = c * f01 + s * (z1 * f21 - z2 * f11) + v * z0 * a1
+        r11 = c * f11 + s * (z2 * f01 - z0 * f21) + v * z1 * a1
+        r21 = c * f21 + s * (z0 * f11 - z1 * f01) + v * z2 * a1
+        r02 = c * f02 + s * (z1 * f22 - z2 * f12) + v * z0 * a2
+        r12 = c * f12 + s * (z2 * f02 - z0 * f22) + v * z1 * a2
+        r22 = c * f22 + s * (z0 * f12 - z1 * f02) + v * z2 * a2
     flange[0], flange[1], flange[2] = p0, p1, p2
 
 
