@@ -31,7 +31,7 @@ from drake_traj.planners.pajak import PajakLaw
 from drake_traj.planners.pajak.integration import integrate
 from drake_traj.planners.pajak.kernel import Discrete, Evaluation, Log, evaluate_kernel, integrate_kernel
 from drake_traj.robots import chain, ur10e
-from drake_traj.robots.chain import ChainArm
+from drake_traj.robots.chain_arm import ChainArm
 from drake_traj.scenario import load_scenario
 
 UR_DH = np.column_stack([ur10e.DH_D, ur10e.DH_A, ur10e.DH_ALPHA, np.zeros(6)])

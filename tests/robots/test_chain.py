@@ -11,8 +11,9 @@ from pydrake.multibody.tree import FixedOffsetFrame, PrismaticJoint, RevoluteJoi
 from drake_traj.errors import Cause, DrakeTrajError
 from drake_traj.planners.pajak import PajakLaw
 from drake_traj.robots import ur10e
-from drake_traj.robots.chain import (CHAIN, ChainArm, SerialChain, chain_kinematics, chain_singularity_factors,
+from drake_traj.robots.chain import (CHAIN, SerialChain, chain_kinematics, chain_singularity_factors,
                                      inverse_kinematics_all)
+from drake_traj.robots.chain_arm import ChainArm
 from drake_traj.robots.compiled_kinematics import task_kinematics_into
 from drake_traj.robots.task_space import wrap_angle, zyx_euler_from_rotation
 from drake_traj.scenario import load_scenario
