@@ -221,8 +221,9 @@ class ChainArm(Robot):
         file has none) with the arm's effort limit [N m]. Returns the model instance."""
         (instance,) = Parser(plant).AddModels(str(self.model_path()))
         plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(self.base_frame, instance))
-        actuated = {plant.get_joint_actuator(index).joint().name(): plant.get_joint_actuator(index)
-                    for index in plant.GetJointActuatorIndices(instance)}
+        actuators = (plant.get_joint_actuator(index) for index in plant.GetJointActuatorIndices())  # (instance): none
+        actuated = {actuator.joint().name(): actuator for actuator in actuators  # before Finalize
+                    if actuator.model_instance() == instance}
         for joint_name, effort in zip(self.joint_names, self._effort):
             actuator = actuated.get(joint_name)
             if actuator is None:

@@ -190,3 +190,45 @@ def test_bad_input():
         ChainArm.from_dh("puma", PUMA_DH)
     with pytest.raises(DrakeTrajError, match=r"the DH table and the model file disagree"):
         ChainArm.from_dh("puma", PUMA_DH, model_file=ur10e.model_path(), acceleration_limits=1.0)
+
+
+def test_add_to_plant_gives_every_joint_its_actuator(tmp_path):
+    """A model file without transmissions: the arm adds {joint}_actuator with its effort limits;
+    a plant-built arm plans but has no model to add."""
+    text = ur10e.model_path().read_text()
+    start, end = text.index("<transmission"), text.rindex("</transmission>") + len("</transmission>")
+    bare = tmp_path / "bare.urdf"
+    bare.write_text(text[:start] + text[end:])
+    with pytest.raises(DrakeTrajError, match=r"effort_limits missing for the custom arm 'bare'"):
+        ChainArm.from_model_file(bare, base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
+    efforts = np.array([300.0, 300.0, 140.0, 50.0, 50.0, 50.0])
+    arm = ChainArm.from_model_file(bare, base_frame="base", tool_frame="tool0", acceleration_limits=1.4,
+                                   effort_limits=efforts)
+    plant = MultibodyPlant(0.001)
+    instance = arm.add_to_plant(plant)
+    plant.Finalize()
+    for joint, effort in zip(ur10e.JOINT_NAMES, efforts):
+        actuator = plant.GetJointActuatorByName(f"{joint}_actuator", instance)
+        assert actuator.joint().name() == joint and actuator.effort_limit() == effort
+    planned = ChainArm.from_plant(plant, base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
+    np.testing.assert_array_equal(planned.effort_limits, efforts)
+    np.testing.assert_allclose(planned.tcp_pose(ur10e.HOME), ur10e.task_pose(ur10e.HOME), atol=1e-12, rtol=0)
+    with pytest.raises(DrakeTrajError, match=r"built from a plant without a model_file"):
+        planned.add_to_plant(MultibodyPlant(0.001))
+
+
+def test_robot_services_match_the_ur10e():
+    """tool_motion, joint_rates and point_ik of the UR10e's DH chain as a ChainArm equal the
+    UR10e's closed-form services."""
+    arm = ChainArm.from_dh("ur10e_dh", UR_DH, model_file=ur10e.model_path(), acceleration_limits=1.4,
+                           home=ur10e.HOME)
+    q, qd = states(8, 5)
+    qdd = np.random.default_rng(9).uniform(-1.0, 1.0, (5, 6))
+    for mine, theirs in zip(arm.tool_motion(q, qd, qdd), ur10e.UR10E.tool_motion(q, qd, qdd)):
+        np.testing.assert_allclose(mine, theirs, atol=1e-9, rtol=0)
+    v, a = np.array([0.1, -0.2, 0.05]), np.array([0.3, 0.1, -0.2])
+    for mine, theirs in zip(arm.joint_rates(ur10e.HOME, v, a), ur10e.UR10E.joint_rates(ur10e.HOME, v, a)):
+        np.testing.assert_allclose(mine, theirs, atol=1e-9, rtol=0)
+    points = ur10e.task_pose(ur10e.HOME)[:3] + np.array([[0.05, 0.0, 0.0], [0.0, -0.1, 0.05]])
+    np.testing.assert_allclose(arm.point_ik(points, ur10e.HOME), ur10e.UR10E.point_ik(points, ur10e.HOME),
+                               atol=1e-9, rtol=0)
