@@ -51,14 +51,15 @@ CHAIN = 1.0  # model[0] of a serial chain (compiled_kinematics.task_kinematics_i
 _LENGTH = 1
 _TRANSFORMS = 2
 _AXES = _TRANSFORMS + 12 * (NUM_JOINTS + 1)
-MODEL_SIZE = _AXES + 3 * NUM_JOINTS
 DH_COLUMNS = ("d", "a", "alpha", "theta_offset")
 CONVENTIONS = ("standard", "modified")
 
 IK_SEEDS = 256  # quasi-random Newton starts per pose (Sobol points within the joint limits)
 IK_ITERATIONS = 80  # Newton / Levenberg-Marquardt steps per start, at most
 IK_TOLERANCE = 1e-10  # [m and rad], a start has converged when its pose error is below this
-IK_SINGULAR_TOLERANCE = 1e-6  # singularity measure below which a solution is singular
+# singularity measure below which an IK solution is singular (a Hadamard ratio of 1e-9: the
+# solutions on a singular continuum converge to |sin q5| ~ 1e-12 on the UR10e, measure ~ 1e-4)
+IK_SINGULAR_TOLERANCE = 1e-3
 IK_DISTINCT = 1e-6  # [rad], solutions closer than this (modulo 2 pi, every joint) are one
 
 
@@ -99,6 +100,8 @@ class SerialChain:
     def __post_init__(self):
         fixed = finite_array(self.fixed, "fixed", "m", shape=(NUM_JOINTS + 1, 4, 4))
         axes = finite_array(self.axes, "axes", "unit vector", shape=(NUM_JOINTS, 3))
+        if not np.any(np.linalg.norm(fixed[:, :3, 3], axis=1) > 0.0):
+            raise invalid("fixed", "a chain needs at least one link of non-zero length (every translation is zero)")
         for i, transform in enumerate(fixed):
             rotation = transform[:3, :3]
             if (np.max(np.abs(rotation.T @ rotation - np.eye(3))) > 1e-9 or np.linalg.det(rotation) <= 0.0
@@ -591,6 +594,10 @@ def inverse_kinematics_all(model, pose, tool=FLANGE, lower=None, upper=None) -> 
             seed reaches the pose (the message gives the flange's distance from joint 1's origin
             and the arm's reach bound) or every solution is beyond the limits (naming the joint).
         SingularConfigurationError: the pose is reached only at singular configurations.
+
+    Singular solutions (measure below :data:`IK_SINGULAR_TOLERANCE`: a continuum, such as the
+    UR10e's q4 + q6 at sin q5 = 0) are left out where regular ones exist (the UR closed form
+    refuses such a pose; here the other branches' regular solutions are returned).
     """
     model = np.ascontiguousarray(model, dtype=float)
     pose = finite_array(pose, "pose", "m and rad", shape=(6,))
@@ -608,7 +615,7 @@ def inverse_kinematics_all(model, pose, tool=FLANGE, lower=None, upper=None) -> 
         inside = _into_limits(q, lower, upper)
         if inside is None:
             beyond = q
-        elif not any(np.max(np.abs(wrap_angle(inside - other))) < IK_DISTINCT for other in found):
+        elif not found or np.min(np.max(np.abs(wrap_angle(np.array(found) - inside)), axis=1)) >= IK_DISTINCT:
             found.append(inside)
     where = f"pose [x, y, z, phi_X, phi_Y, phi_Z] = {format_point(pose)} (m, rad)"
     if not found:

@@ -8,7 +8,7 @@ from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import FixedOffsetFrame, PrismaticJoint, RevoluteJoint, SpatialInertia
 
-from drake_traj.errors import Cause, DrakeTrajError
+from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
 from drake_traj.planners.pajak import PajakLaw
 from drake_traj.robots import ur10e
 from drake_traj.robots.chain import (CHAIN, SerialChain, chain_kinematics, chain_singularity_factors,
@@ -89,6 +89,21 @@ def test_numeric_ik_finds_every_closed_form_solution():
         assert len(found) == len(expected)
         for q in expected:
             assert min(np.max(np.abs(wrap_angle(q - other))) for other in found) < 1e-9
+    # a wrist singularity (sin q5 = 0) on one shoulder branch: the other branch's regular solutions
+    pose = ur10e.task_pose([0.3, -1.0, 1.2, 0.4, 0.0, 0.5])
+    regular = []
+    for branch in ur10e.IK_BRANCHES:
+        try:
+            regular.append(ur10e.inverse_kinematics(pose, branch=branch))
+        except SingularConfigurationError:
+            pass
+    found = inverse_kinematics_all(model, pose)
+    assert len(regular) == len(found) == 4
+    for q in regular:
+        assert min(np.max(np.abs(wrap_angle(q - other))) for other in found) < 1e-9
+    # shoulder, elbow and wrist singular at once: no regular solution
+    with pytest.raises(SingularConfigurationError, match=r"reached only at singular configurations"):
+        inverse_kinematics_all(model, ur10e.task_pose([0.3, -np.pi / 2, 0.0, np.pi / 2, 0.0, 0.5]))
     with pytest.raises(DrakeTrajError, match=r"out of reach: the flange would be 3.* m from joint 1's origin, the arm "
                                              r"reaches at most 1.7755 m") as error:
         inverse_kinematics_all(model, [3.0, 0.0, 0.2, np.pi, 0.0, 0.0])
