@@ -34,6 +34,8 @@ __all__ = ["ChainArm"]
 # and 200 N m s/rad); the inverse-dynamics feed-forward does most of the work.
 KP_PER_EFFORT = 4000.0 / 330.0  # [1/rad]
 KD_PER_KP = 0.05  # [s]
+LIMIT_ARGUMENTS = ("lower_limits", "upper_limits", "velocity_limits", "acceleration_limits", "effort_limits",
+                   "rated_payload", "home", "data_source")  # the **limits of the constructors
 FK_AGREEMENT = 1e-6  # [m and rad], a DH table and its model file must agree to this
 
 
@@ -133,6 +135,9 @@ class ChainArm(Robot):
         must agree with the plant's to 1e-6 m and rad: :meth:`from_dh`); ``name`` defaults to
         the tool body's model instance name.
         """
+        unknown = sorted(set(limits) - set(LIMIT_ARGUMENTS))
+        if unknown:
+            raise TypeError(f"unknown arguments {unknown}: the limits and data are {LIMIT_ARGUMENTS}")
         fixed, axes, joints = plant_chain(plant, base_frame, tool_frame)
         from_plant = SerialChain(fixed, axes)
         if chain is not None:
@@ -149,9 +154,7 @@ class ChainArm(Robot):
                 limits[key] = np.array(values)
         return cls(chain or from_plant, name=name or plant.GetModelInstanceName(tool.model_instance()),
                    model_file=model_file, base_frame=base.name(), tool_frame=tool.name(),
-                   joint_names=[j.name() for j in joints], **{key: limits.get(key) for key in (
-                       "lower_limits", "upper_limits", "velocity_limits", "acceleration_limits", "effort_limits")},
-                   **{key: value for key, value in limits.items() if key in ("rated_payload", "home", "data_source")})
+                   joint_names=[j.name() for j in joints], **{key: limits.get(key) for key in LIMIT_ARGUMENTS})
 
     @classmethod
     def from_dh(cls, name: str, table, convention: str = "standard", *, model_file=None, base_frame: str = "base",

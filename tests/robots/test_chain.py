@@ -201,6 +201,8 @@ def test_bad_input():
     with pytest.raises(DrakeTrajError, match=r"acceleration_limits missing for the custom arm 'ur10e'") as error:
         ChainArm.from_model_file(ur10e.model_path(), base_frame="base", tool_frame="tool0")
     assert error.value.field == ("acceleration_limits",)
+    with pytest.raises(TypeError, match=r"unknown arguments \['acceleration_limit'\]"):
+        ChainArm.from_model_file(ur10e.model_path(), base_frame="base", tool_frame="tool0", acceleration_limit=1.4)
     with pytest.raises(DrakeTrajError, match=r"needs a model_file \(URDF/SDF\)"):
         ChainArm.from_dh("puma", PUMA_DH)
     with pytest.raises(DrakeTrajError, match=r"the DH table and the model file disagree"):
