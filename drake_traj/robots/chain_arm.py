@@ -58,7 +58,8 @@ class ChainArm(Robot):
             :attr:`joint_move_limits`.
         effort_limits: [N m] (6,) or a scalar, > 0.
         rated_payload: [kg] or None.
-        home: the start configuration [rad] (6,); default zeros clipped into the limits.
+        home: the start configuration [rad] (6,); default zeros clipped into the limits (often a
+            singular configuration, the arm stretched: give one for a task-space planner).
         data_source: where the numbers come from.
     """
 
@@ -81,8 +82,8 @@ class ChainArm(Robot):
                      acceleration_limits=acceleration_limits, effort_limits=effort_limits)
         for key, value in given.items():
             if value is None:
-                raise DrakeTrajError(f"{key} missing for the custom arm {name!r}: the model gives none, pass "
-                                     f"{key}=", field=(key,))
+                raise DrakeTrajError(f"{key} missing for the custom arm {name!r}: neither its model nor the "
+                                     f"arguments give it (pass {key}=)", field=(key,))
         self._lower = joint_bound(lower_limits, "lower_limits", NUM_JOINTS, "rad")
         self._upper = joint_bound(upper_limits, "upper_limits", NUM_JOINTS, "rad")
         if np.any(self._lower >= self._upper):
