@@ -5,7 +5,10 @@ The Pająk 2024 law is compiled once and cached on disk (:mod:`drake_traj.compil
 ``model[0]`` says which form the rest of the array feeds:
 
 - :data:`~drake_traj.robots.ur_closed_form.UR_CLOSED_FORM`: the UR e-Series closed form,
-  [kind, d1, a2, a3, d4, d5, d6] (:func:`drake_traj.robots.ur_closed_form.kinematics_into`).
+  [kind, d1, a2, a3, d4, d5, d6] (:func:`drake_traj.robots.ur_closed_form.kinematics_into`);
+- :data:`~drake_traj.robots.chain.CHAIN`: any serial chain of six revolute joints (standard or
+  modified DH, a URDF/SDF read through MultibodyPlant), :meth:`~drake_traj.robots.chain.SerialChain.packed`
+  (:func:`drake_traj.robots.chain.chain_kinematics_into`).
 """
 
 from __future__ import annotations
@@ -13,7 +16,8 @@ from __future__ import annotations
 import math
 
 from drake_traj.compiled import compiled
-from drake_traj.robots import task_space, ur_closed_form
+from drake_traj.robots import chain, task_space, ur_closed_form
+from drake_traj.robots.chain import CHAIN, chain_kinematics_into
 from drake_traj.robots.ur_closed_form import UR_CLOSED_FORM
 from drake_traj.robots.ur_closed_form import kinematics_into as ur_kinematics_into
 
@@ -21,7 +25,7 @@ __all__ = ["SOURCES", "task_kinematics_into"]
 
 # The source files of the compiled code behind task_kinematics_into: a compiled caller digests
 # them into its cache key (numba checks only the caller's own file; see pajak/kernel.py).
-SOURCES = (__file__, ur_closed_form.__file__, task_space.__file__)
+SOURCES = (__file__, ur_closed_form.__file__, chain.__file__, task_space.__file__)
 
 
 @compiled
@@ -31,6 +35,8 @@ def task_kinematics_into(model, q, qd, tool, pose, jac, bias):
     [0, 1]). An unknown ``model[0]`` fills NaN (the callers treat a non-finite pose as a failure)."""
     if model[0] == UR_CLOSED_FORM:
         return ur_kinematics_into(model, q, qd, tool, pose, jac, bias)
+    if model[0] == CHAIN:
+        return chain_kinematics_into(model, q, qd, tool, pose, jac, bias)
     pose[:] = math.nan
     jac[:, :] = math.nan
     bias[:] = math.nan

@@ -1,0 +1,326 @@
+"""Any 6-axis arm of revolute joints under the :class:`~drake_traj.robots.base.Robot` contract:
+:class:`ChainArm`, a :class:`~drake_traj.robots.chain.SerialChain` (its compiled kinematics, the
+numerical IK) with its model file, joint names, limits and gains. A module of its own so that
+:mod:`drake_traj.robots.compiled_kinematics` (which imports :mod:`~drake_traj.robots.chain`) and
+this module import one way.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import numpy as np
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+
+from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_label
+from drake_traj.robots.base import Robot, TaskKinematics, format_point
+from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_kinematics, chain_singularity_factors,
+                                     inverse_kinematics_all, plant_chain, plant_frame)
+from drake_traj.robots.compiled_kinematics import task_kinematics_into
+from drake_traj.robots.task_space import orientation_error, pose_error, wrap_angle, wrapped
+from drake_traj.validation import finite_array, invalid, joint_bound, joint_limit, path_argument
+
+__all__ = ["ChainArm"]
+
+
+# --------------------------------------------------------------------------------------------
+# The Robot contract.
+# --------------------------------------------------------------------------------------------
+
+# Default PD gains: kp = KP_PER_EFFORT x the joint's effort limit, kd = KD_PER_KP x kp: the
+# UR10e's shoulder (4000 N m/rad for 330 N m: a 1 rad error asks about 12 times the peak torque,
+# and 200 N m s/rad); the inverse-dynamics feed-forward does most of the work.
+KP_PER_EFFORT = 4000.0 / 330.0  # [1/rad]
+KD_PER_KP = 0.05  # [s]
+LIMIT_ARGUMENTS = ("lower_limits", "upper_limits", "velocity_limits", "acceleration_limits", "effort_limits",
+                   "rated_payload", "home", "data_source")  # the **limits of the constructors
+FK_AGREEMENT = 1e-6  # [m and rad], a DH table and its model file must agree to this
+
+
+class ChainArm(Robot):
+    """A 6-axis arm of revolute joints under the :class:`~drake_traj.robots.base.Robot` contract:
+    a :class:`SerialChain` (its compiled kinematics, ``model`` = :meth:`SerialChain.packed`) plus
+    its data. Frames: the base frame ``base_frame`` (welded to the world), the flange
+    ``tool_frame``, the TCP at :attr:`tcp_offset` in it (:meth:`with_tcp`). Build one with
+    :meth:`from_model_file`, :meth:`from_plant` or :meth:`from_dh`.
+
+    Args:
+        chain: the kinematics.
+        name: the arm's name (messages, scenario output).
+        model_file: the URDF/SDF the simulation parses (:meth:`add_to_plant`); None for an arm
+            only planned for (built from a user's plant).
+        base_frame, tool_frame: frame names in the model file.
+        joint_names: the six joints, base to tool.
+        lower_limits, upper_limits: joint position limits [rad], (6,).
+        velocity_limits, acceleration_limits: [rad/s], [rad/s²] (6,) or a scalar, > 0: the
+            :attr:`joint_move_limits`.
+        effort_limits: [N m] (6,) or a scalar, > 0.
+        rated_payload: [kg] or None.
+        home: the start configuration [rad] (6,); default zeros clipped into the limits (often a
+            singular configuration, the arm stretched: give one for a task-space planner).
+        data_source: where the numbers come from.
+    """
+
+    joint_types = ("revolute",) * NUM_JOINTS
+
+    def __init__(self, chain: SerialChain, *, name: str, model_file, base_frame: str, tool_frame: str, joint_names,
+                 lower_limits, upper_limits, velocity_limits, acceleration_limits, effort_limits,
+                 rated_payload: float | None = None, home=None, data_source: str = ""):
+        if not isinstance(chain, SerialChain):
+            raise TypeError(f"chain must be a SerialChain, got {type(chain).__name__}")
+        if not isinstance(name, str) or not name:
+            raise invalid("name", f"name must be a non-empty text, got {name!r}")
+        names = tuple(joint_names)
+        if len(names) != NUM_JOINTS or not all(isinstance(n, str) and n for n in names):
+            raise invalid("joint_names", f"joint_names must be six non-empty texts, got {names!r}")
+        self.chain, self.name, self.joint_names = chain, name, names
+        self.model_file = None if model_file is None else path_argument(model_file, "model_file").resolve()
+        self.base_frame, self.tool_frame = str(base_frame), str(tool_frame)
+        given = dict(lower_limits=lower_limits, upper_limits=upper_limits, velocity_limits=velocity_limits,
+                     acceleration_limits=acceleration_limits, effort_limits=effort_limits)
+        for key, value in given.items():
+            if value is None:
+                raise DrakeTrajError(f"{key} missing for the custom arm {name!r}: neither its model nor the "
+                                     f"arguments give it (pass {key}=)", field=(key,))
+        self._lower = joint_bound(lower_limits, "lower_limits", NUM_JOINTS, "rad")
+        self._upper = joint_bound(upper_limits, "upper_limits", NUM_JOINTS, "rad")
+        if np.any(self._lower >= self._upper):
+            j = int(np.argmax(self._lower >= self._upper))
+            raise invalid("upper_limits", f"{joint_label(j, names)}: the upper limit {self._upper[j]:.6g} rad must be "
+                                          f"above the lower limit {self._lower[j]:.6g} rad", j)
+        self._velocity = joint_limit(velocity_limits, "velocity_limits", NUM_JOINTS, "rad/s")
+        self._acceleration = joint_limit(acceleration_limits, "acceleration_limits", NUM_JOINTS, "rad/s^2")
+        self._effort = joint_limit(effort_limits, "effort_limits", NUM_JOINTS, "N m")
+        self.rated_payload = None if rated_payload is None else float(rated_payload)
+        home = np.clip(np.zeros(NUM_JOINTS), self._lower, self._upper) if home is None else \
+            finite_array(home, "home", "rad", shape=(NUM_JOINTS,))
+        if np.any((home < self._lower) | (home > self._upper)):
+            j = int(np.argmax((home < self._lower) | (home > self._upper)))
+            raise invalid("home", f"home {joint_label(j, names)} = {home[j]:.6g} rad is beyond its limits "
+                                  f"[{self._lower[j]:.6g}, {self._upper[j]:.6g}] rad", j)
+        self._home = home
+        self.data_source = data_source or (f"the model file {self.model_file}" if self.model_file else "a user's plant")
+        self.model = chain.packed()
+
+    # ---- constructors ------------------------------------------------------------------------
+    @classmethod
+    def from_model_file(cls, path, *, base_frame: str, tool_frame: str, name: str | None = None,
+                        **limits) -> "ChainArm":
+        """The arm of a URDF/SDF file: the chain between ``base_frame`` and ``tool_frame`` read
+        through MultibodyPlant (:meth:`SerialChain.from_plant`), the joint names and the
+        position, velocity and effort limits from the file where it has them. ``limits`` (the
+        keyword arguments of :class:`ChainArm`: lower_limits, upper_limits, velocity_limits,
+        acceleration_limits, effort_limits, rated_payload, home, data_source) override the file;
+        acceleration_limits must be given (URDF has none).
+
+        Raises:
+            DrakeTrajError: the file unreadable, the chain not six revolute joints, a limit
+                neither in the file nor given (naming the field).
+        """
+        path = path_argument(path, "model_file")
+        plant = _parsed(path)
+        return cls.from_plant(plant, base_frame=base_frame, tool_frame=tool_frame, model_file=path,
+                              name=name or path.stem, **limits)
+
+    @classmethod
+    def from_plant(cls, plant: MultibodyPlant, *, base_frame, tool_frame, name: str | None = None, model_file=None,
+                   chain: SerialChain | None = None, **limits) -> "ChainArm":
+        """The arm of a finalized ``plant`` (a user's own, beside which a planner built from this
+        arm runs): the chain from ``base_frame`` to ``tool_frame`` (Frames or names), the joint
+        names, and the limits the plant has (position and velocity limits of the joints, effort
+        limits of their actuators) unless ``limits`` gives them (see :meth:`from_model_file`).
+        ``model_file``: the URDF/SDF of the arm for :meth:`add_to_plant` (None: the arm plans but
+        cannot add itself to a station); ``chain``: use this chain instead of the plant's (it
+        must agree with the plant's to 1e-6 m and rad: :meth:`from_dh`); ``name`` defaults to
+        the tool body's model instance name.
+        """
+        unknown = sorted(set(limits) - set(LIMIT_ARGUMENTS))
+        if unknown:
+            raise TypeError(f"unknown arguments {unknown}: the limits and data are {LIMIT_ARGUMENTS}")
+        fixed, axes, joints = plant_chain(plant, base_frame, tool_frame)
+        from_plant = SerialChain(fixed, axes)
+        if chain is not None:
+            _check_agreement(chain, from_plant)
+        base, tool = plant_frame(plant, base_frame, "base_frame"), plant_frame(plant, tool_frame, "tool_frame")
+        efforts = {plant.get_joint_actuator(index).joint().index(): plant.get_joint_actuator(index).effort_limit()
+                   for index in plant.GetJointActuatorIndices()}
+        found = dict(lower_limits=[j.position_lower_limits()[0] for j in joints],
+                     upper_limits=[j.position_upper_limits()[0] for j in joints],
+                     velocity_limits=[j.velocity_upper_limits()[0] for j in joints],
+                     effort_limits=[efforts.get(j.index(), np.inf) for j in joints])
+        for key, values in found.items():
+            if limits.get(key) is None and np.all(np.isfinite(values)):
+                limits[key] = np.array(values)
+        return cls(chain or from_plant, name=name or plant.GetModelInstanceName(tool.model_instance()),
+                   model_file=model_file, base_frame=base.name(), tool_frame=tool.name(),
+                   joint_names=[j.name() for j in joints], **{key: limits.get(key) for key in LIMIT_ARGUMENTS})
+
+    @classmethod
+    def from_dh(cls, name: str, table, convention: str = "standard", *, model_file=None, base_frame: str = "base",
+                tool_frame: str = "tool0", **limits) -> "ChainArm":
+        """The arm of a DH table (:meth:`SerialChain.from_dh`; rows [d, a, alpha, theta_offset]
+        in m and rad) simulated with ``model_file`` (URDF/SDF), whose chain between
+        ``base_frame`` and ``tool_frame`` must be the table's (checked to 1e-6 m and rad at a
+        few configurations); joint names and limits as :meth:`from_model_file`.
+
+        Raises:
+            DrakeTrajError: no ``model_file`` (writing one from a DH table is not available yet),
+                a table and a model file that disagree, and the errors of the other constructors.
+        """
+        chain = SerialChain.from_dh(table, convention)
+        if model_file is None:
+            raise invalid("model_file", f"the custom arm {name!r} from a DH table needs a model_file (URDF/SDF) for the "
+                                        "simulation: writing one from the table is not available yet")
+        path = path_argument(model_file, "model_file")
+        return cls.from_plant(_parsed(path), base_frame=base_frame, tool_frame=tool_frame, name=name,
+                              model_file=path, chain=chain, **limits)
+
+    # ---- description -------------------------------------------------------------------------
+    @property
+    def lower_limits(self) -> np.ndarray:
+        return self._lower.copy()
+
+    @property
+    def upper_limits(self) -> np.ndarray:
+        return self._upper.copy()
+
+    @property
+    def velocity_limits(self) -> np.ndarray:
+        return self._velocity.copy()
+
+    @property
+    def effort_limits(self) -> np.ndarray:
+        return self._effort.copy()
+
+    @property
+    def joint_move_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """(velocity_limits [rad/s], acceleration_limits [rad/s²])."""
+        return self._velocity.copy(), self._acceleration.copy()
+
+    @property
+    def default_gains(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """kp = :data:`KP_PER_EFFORT` x effort limit [N m/rad], kd = :data:`KD_PER_KP` x kp [N m s/rad]."""
+        kp = KP_PER_EFFORT * self._effort
+        return tuple(float(v) for v in kp), tuple(float(v) for v in KD_PER_KP * kp)
+
+    @property
+    def home_configuration(self) -> np.ndarray:
+        return self._home.copy()
+
+    # ---- model -------------------------------------------------------------------------------
+    def model_path(self) -> Path:
+        """The arm's model file (absolute); ValueError for an arm built without one."""
+        if self.model_file is None:
+            raise invalid("model_file", f"the custom arm {self.name!r} was built from a plant without a model_file: "
+                                        "give model_file= to add it to a simulation's plant")
+        if not self.model_file.is_file():
+            raise invalid("model_file", f"{self.name} model file not found: {self.model_file}")
+        return self.model_file
+
+    def add_to_plant(self, plant):
+        """Parse the model file into ``plant`` (not finalized), weld ``base_frame`` to the world,
+        and give each of the six joints an actuator named ``{joint}_actuator`` (added where the
+        file has none) with the arm's effort limit [N m]. Returns the model instance."""
+        (instance,) = Parser(plant).AddModels(str(self.model_path()))
+        plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(self.base_frame, instance))
+        actuators = (plant.get_joint_actuator(index) for index in plant.GetJointActuatorIndices())  # (instance): none
+        actuated = {actuator.joint().name(): actuator for actuator in actuators  # before Finalize
+                    if actuator.model_instance() == instance}
+        for joint_name, effort in zip(self.joint_names, self._effort):
+            actuator = actuated.get(joint_name)
+            if actuator is None:
+                actuator = plant.AddJointActuator(f"{joint_name}_actuator", plant.GetJointByName(joint_name, instance),
+                                                  float(effort))
+            elif actuator.name() != f"{joint_name}_actuator":
+                raise invalid("model_file", f"the actuator of {joint_name!r} in {self.model_file} is named "
+                                            f"{actuator.name()!r}; the simulation expects {joint_name}_actuator")
+            actuator.set_effort_limit(float(effort))
+            if actuator.effort_limit() != float(effort):
+                raise RuntimeError(f"the effort limit of {actuator.name()} did not take effect")
+        return instance
+
+    # ---- kinematics --------------------------------------------------------------------------
+    def _kinematics(self, q, qd):
+        return chain_kinematics(self.model, q, qd, self.tcp_offset)
+
+    def tcp_pose(self, q) -> np.ndarray:
+        q = self.joint_positions(q)
+        return self._kinematics(q, np.zeros_like(q))[0]
+
+    def tool_position(self, q) -> np.ndarray:
+        return self.tcp_pose(q)[..., :3]
+
+    def tool_motion(self, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
+        _, jacobian, bias, _, _ = self._kinematics(q, qd)
+        return (np.einsum("...ij,...j->...i", jacobian[..., :3, :], qd),
+                np.einsum("...ij,...j->...i", jacobian[..., :3, :], qdd) + bias[..., :3])
+
+    def inverse_kinematics_all(self, pose) -> np.ndarray:
+        """Every joint solution (k, 6) [rad] of the TCP pose [x, y, z, φ_X, φ_Y, φ_Z] within the
+        limits (:func:`inverse_kinematics_all`)."""
+        return inverse_kinematics_all(self.model, pose, self.tcp_offset, self._lower, self._upper)
+
+    def point_ik(self, points, reference) -> np.ndarray:
+        """IK of TCP positions (N, 3) [m] at the TCP orientation of ``reference``: for each, the
+        solution nearest ``reference`` (each joint moved by whole turns towards it within the limits)."""
+        reference = finite_array(reference, "reference", "rad", shape=(NUM_JOINTS,))
+        orientation = self.tcp_pose(reference)[3:]
+        out = []
+        for point in np.asarray(points, dtype=float).reshape(-1, 3):
+            candidates = []
+            for q in self.inverse_kinematics_all(np.concatenate([point, orientation])):
+                shifted = q + 2 * np.pi * np.round((reference - q) / (2 * np.pi))
+                candidates.append(np.where((shifted < self._lower) | (shifted > self._upper), q, shifted))
+            out.append(min(candidates, key=lambda q: float(np.sum((q - reference) ** 2))))
+        return np.array(out).reshape(-1, NUM_JOINTS)
+
+    def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
+        """qd = J⁻¹ [v; 0], qdd = J⁻¹ ([a; 0] - J̇q̇) with the TCP's analytic Jacobian (one q);
+        SingularConfigurationError at the Euler angles' gimbal lock."""
+        q = finite_array(q, "q", "rad", shape=(NUM_JOINTS,))
+        _, jacobian, _, cos_pitch, _ = self._kinematics(q, np.zeros(NUM_JOINTS))
+        if cos_pitch < 1e-6:
+            raise SingularConfigurationError(f"Z-Y-X Euler angles are singular at q={np.round(q, 6).tolist()}: "
+                                             "phi_Y is at +-pi/2 (gimbal lock)")
+        qd = np.linalg.solve(jacobian, np.concatenate([v, np.zeros(3)]))
+        bias = self._kinematics(q, qd)[2]
+        return qd, np.linalg.solve(jacobian, np.concatenate([a, np.zeros(3)]) - bias)
+
+    def task_kinematics(self) -> TaskKinematics:
+        """The compiled kinematics of the chain (:func:`chain_kinematics_into` through
+        :func:`~drake_traj.robots.compiled_kinematics.task_kinematics_into`, ``model`` =
+        :meth:`SerialChain.packed`), the numerical IK within the limits and the one-factor
+        singularity factors, of the TCP ``tcp_offset``."""
+        return TaskKinematics(task_kinematics_into, wrapped, orientation_error, wrap_angle, pose_error,
+                              self.inverse_kinematics_all, self.tcp_offset,
+                              functools.partial(chain_singularity_factors, self.model), self.model)
+
+
+def _parsed(path: Path) -> MultibodyPlant:
+    """A finalized plant of the model file ``path`` alone."""
+    if not path.is_file():
+        raise invalid("model_file", f"model file not found: {path}")
+    plant = MultibodyPlant(0.0)
+    try:
+        Parser(plant).AddModels(str(path))
+    except RuntimeError as error:
+        raise invalid("model_file", f"the model file {path} could not be read: {error}") from None
+    plant.Finalize()
+    return plant
+
+
+def _check_agreement(chain: SerialChain, other: SerialChain) -> None:
+    """DrakeTrajError unless the two chains' flange poses agree to :data:`FK_AGREEMENT` at a few
+    configurations (zeros and three fixed pseudo-random ones)."""
+    configurations = np.vstack([np.zeros(NUM_JOINTS), np.random.default_rng(0).uniform(-np.pi, np.pi, (3, 6))])
+    mine = chain_kinematics(chain.packed(), configurations, np.zeros(NUM_JOINTS))[0]
+    theirs = chain_kinematics(other.packed(), configurations, np.zeros(NUM_JOINTS))[0]
+    gap = np.abs(mine - theirs)
+    gap[:, 3:] = np.abs(wrap_angle(mine[:, 3:] - theirs[:, 3:]))
+    if np.max(gap) > FK_AGREEMENT:
+        k = int(np.argmax(np.max(gap, axis=1)))
+        raise invalid("table", f"the DH table and the model file disagree: at q = {format_point(configurations[k])} rad "
+                               f"the table puts the flange at {format_point(mine[k])} and the file at "
+                               f"{format_point(theirs[k])} (m, rad)")
