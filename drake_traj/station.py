@@ -48,6 +48,7 @@ from drake_traj.errors import Cause, Failure
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
 from drake_traj.robots import UR10E, Robot
+from drake_traj.robots.custom import robot_label
 from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, check_planned_duration, default_plant_config,
                                  default_simulator_config)
 from drake_traj.scenario import preflight as scenario_preflight
@@ -169,7 +170,7 @@ def add_station(
         plant.GetJointActuatorByName(f"{joint_name}_actuator", instance).set_controller_gains(PdControllerGains(p=kp, d=kd))
     # the cell's geometry, the tool's body and payload: contact with them, and between the arm's
     # non-adjacent links, is simulated (and ends the run: run_station)
-    add_cell(plant, cell or Cell(), instance, flange_frame=robot.tool_frame, directory=cell_directory)
+    add_cell(plant, cell or Cell(), instance, robot=robot, directory=cell_directory)
     if before_finalize is not None:
         before_finalize(plant, scene_graph)
     plant.Finalize()
@@ -440,7 +441,7 @@ def simulate(
         scenario = planner
         if robot is not _UNSET:
             raise TypeError(f"robot must not be given with a scenario: scenario {scenario.name!r} names its robot "
-                            f"({scenario.robot!r})")
+                            f"({robot_label(scenario.robot)})")
         defaults = scenario.station_arguments() | scenario.run_settings()
         planner = defaults.pop("planner")
     else:
