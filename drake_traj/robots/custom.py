@@ -56,7 +56,9 @@ def _joint_vector(value, name: str, unit: str, *, required: bool, positive: bool
 def _matrix(value, name: str, unit: str, columns: int, *, required: bool) -> np.ndarray | None:
     """``value`` as a finite (ARM_JOINTS, columns) array, None when empty and not ``required``."""
     rows = real_array(value, name, unit, "a list of rows of numbers")
-    if rows.size == 0 and not required:
+    if rows.size == 0:
+        if required:
+            raise invalid(name, f"{name} is missing: a custom arm needs {ARM_JOINTS} rows of {columns} numbers [{unit}]")
         return None
     if rows.shape != (ARM_JOINTS, columns):
         raise invalid(name, f"{name} must be {ARM_JOINTS} rows of {columns} numbers [{unit}], got shape {rows.shape}")
