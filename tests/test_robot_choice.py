@@ -6,13 +6,19 @@ import textwrap
 import numpy as np
 import pytest
 
-from drake_traj import load_scenario
+from pydrake.systems.framework import DiagramBuilder
+
+from drake_traj import QuinticConfig, RuckigConfig, load_scenario
 from drake_traj.cell import Cell, Tool
 from drake_traj.clearance import CellChecker
 from drake_traj.errors import Cause, DrakeTrajError
+from drake_traj.planners import make_planner
+from drake_traj.planners.pajak.parameters import paper_parameters
+from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
 from drake_traj.robots import ROBOT_NAMES, UR10e, get_robot
 from drake_traj.robots.custom import CustomArm, DhArm, resolve_robot
 from drake_traj.scenario import ScenarioError
+from drake_traj.station import add_station
 
 GOAL = "[[-1.2, -1.6, -2.0, -0.9, 1.57, 0.8]]"
 # a DH table of six rows [d, a, alpha, theta offset] (the UR10e's lengths) and complete joint data
@@ -129,3 +135,21 @@ def test_a_payload_above_the_scenario_robots_rating_is_refused_at_its_line(tmp_p
                                             r"robot's rated payload of 12.5 kg"):
         load_scenario(path)
     assert np.isclose(get_robot("ur10e").rated_payload, 12.5)
+
+
+@pytest.mark.parametrize("config", [QuinticConfig(goals=[[-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]]),
+                                    RuckigConfig(goals=[[-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]]), paper_parameters(3)])
+def test_a_station_runs_a_planner_on_the_robot_it_was_made_for(config):
+    arm = ThreeKiloArm()
+    planner = make_planner(config, arm, arm.home_configuration)
+    assert planner.robot is arm
+    assert add_station(DiagramBuilder(), planner).robot is arm  # no robot given: the planner's
+    with pytest.raises(DrakeTrajError, match=r"the planner was made for the three_kilo_arm robot, not for robot ur10e") as caught:
+        add_station(DiagramBuilder(), make_planner(config, arm, arm.home_configuration), robot=get_robot("ur10e"))
+    assert caught.value.field == ("robot",)
+
+
+def test_a_planner_refuses_a_robot_of_another_joint_count():
+    plan = plan_synchronized_quintic(get_robot("ur10e").home_configuration, [[-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]], 1.05, 1.4)
+    with pytest.raises(DrakeTrajError, match=r"the planner has 6 joints, robot scara has 3"):
+        QuinticPtpPlanner(plan, 1.05, 1.4, robot=get_robot("scara"))

@@ -42,6 +42,7 @@ class PajakPlanner(PlannerSystem):
 
     def __init__(self, parameters: PajakConfig, q_initial, *, robot: Robot = UR10E):
         self.law = PajakLaw(parameters, robot)
+        self.robot = self.law.robot
         update_period = self.law.parameters.update_period
         initial = self.law.initial_discrete()
         super().__init__(finite_array(q_initial, "q_initial", "rad", shape=(robot.num_joints,)),
