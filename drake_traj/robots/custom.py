@@ -243,17 +243,16 @@ def resolve_robot(choice: RobotChoice, directory: Path | None = None) -> Robot:
 def build_chain_arm(choice: CustomArm | DhArm, arguments: dict) -> Robot:
     """The one call into :class:`drake_traj.robots.chain.ChainArm`: ``arguments`` are the checked
     values of ``choice.validate()`` (numpy arrays [rad, rad/s, rad/s², N m, kg, m, kg m²], None
-    where not given), plus ``model_file`` (an existing Path) for a :class:`CustomArm`.
+    where not given; ``name``, frames, ``convention``, ``link_radius``, ``payload``), plus
+    ``model_file`` (an existing Path) for a :class:`CustomArm`.
 
-    TODO(merge): ChainArm is written in parallel; until it is in this package every custom arm
-    raises NotImplementedError here, and the two calls below are untested (adjust the argument
-    names to ChainArm's at the merge).
+    TODO(merge): ChainArm is written in parallel and is not in this package yet, so every custom
+    arm raises NotImplementedError here. At the merge this body becomes (with a module-level
+    ``from drake_traj.robots.chain import ChainArm`` and the argument names adjusted to ChainArm's)::
+
+        if isinstance(choice, CustomArm):
+            return ChainArm.from_model_file(arguments.pop("model_file"), **arguments)
+        return ChainArm.from_dh(**arguments)
     """
-    try:
-        from drake_traj.robots.chain import ChainArm
-    except ImportError:
-        raise NotImplementedError(f"robot: !{type(choice).__name__} needs drake_traj.robots.chain.ChainArm, which this "
-                                  "build does not have yet") from None
-    if isinstance(choice, CustomArm):
-        return ChainArm.from_model_file(arguments.pop("model_file"), **arguments)
-    return ChainArm.from_dh(**arguments)
+    raise NotImplementedError(f"robot: !{type(choice).__name__} needs drake_traj.robots.chain.ChainArm, which this build "
+                              "does not have yet")
