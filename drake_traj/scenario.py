@@ -191,7 +191,7 @@ class Scenario:
     def __post_init__(self) -> None:
         # where the scenario was read from (set by load_scenario; not a YAML field): locates errors
         self.source: ScenarioSource | None = None
-        self._robot: tuple[str, Robot] | None = None  # (repr of the robot field, the robot it resolved to)
+        self._robot: tuple | None = None  # ((repr of the robot field, folder), the robot it resolved to)
 
     def start_configuration(self) -> np.ndarray:
         """``q_initial``, or the robot's home configuration when it is empty."""
@@ -202,7 +202,7 @@ class Scenario:
         """The robot of the ``robot`` field with its flange as the tool (every use of the field goes
         through here: :func:`~drake_traj.robots.custom.resolve_robot`, a custom arm's model file
         taken from the scenario's folder); DrakeTrajError naming the field otherwise."""
-        key = repr(self.robot)
+        key = (repr(self.robot), self.directory())
         if self._robot is None or self._robot[0] != key:
             self._robot = (key, resolve_robot(self.robot, self.directory()))
         return self._robot[1]

@@ -35,7 +35,8 @@ class PajakPlanner(PlannerSystem):
     Args:
         parameters: the task and the law's settings.
         q_initial: joint positions at t = 0 [rad].
-        robot: the robot (:class:`PajakLaw`: the UR10e).
+        robot: the robot, a 6-axis arm with task-space kinematics (:class:`PajakLaw`; default the
+            UR10e); the planner's :attr:`robot`.
     """
 
     plans_online = True
@@ -144,6 +145,6 @@ class PajakPlanner(PlannerSystem):
 
 
 def make(config: PajakConfig, robot: Robot, q_initial) -> PajakPlanner:
-    """The planner of ``config`` on ``robot`` (one with the task kinematics the compiled law is
-    bound to: the UR10e), starting at rest at ``q_initial`` [rad]."""
+    """The planner of ``config`` on ``robot`` (a 6-axis arm with the task kinematics the compiled
+    law is bound to, :class:`PajakLaw`), starting at rest at ``q_initial`` [rad]."""
     return PajakPlanner(config, q_initial, robot=robot)
