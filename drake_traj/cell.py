@@ -39,14 +39,14 @@ from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import RotationalInertia, SpatialInertia
 
 from drake_traj.errors import Cause, DrakeTrajError, Field, field_text
+from drake_traj.robots import UR10E, PointRobot, Robot
 from drake_traj.validation import invalid, real_array
 
 __all__ = [
-    "Box", "Cell", "Cylinder", "DEFAULT_CLEARANCE", "NoMounting", "Obstacle", "Pedestal", "RATED_PAYLOAD", "Sphere",
+    "Box", "Cell", "Cylinder", "DEFAULT_CLEARANCE", "NoMounting", "Obstacle", "Pedestal", "Sphere",
     "Table", "Tool", "add_cell",
 ]
 
-RATED_PAYLOAD = 12.5  # [kg], UR10e (UR e-Series data sheet; docs/ur10e.md)
 # [m] The clearance a planned motion keeps from the cell and from the arm itself. The collision
 # shapes already contain the real links (docs/ur10e.md), the check samples the reference so that
 # no point moves more than half the clearance between samples (so at least 5 mm is guaranteed
@@ -165,8 +165,8 @@ class Tool:
         tcp_rpy: the TCP frame's roll-pitch-yaw in the flange frame [rad].
         shapes: the tool's collision shapes, posed in the flange frame.
         mass: the payload [kg] (tool and workpiece), at most the robot's rated payload
-            (:attr:`~drake_traj.robots.base.Robot.rated_payload`; the UR10e's 12.5 kg where the
-            robot has none).
+            (:attr:`Robot.rated_payload <drake_traj.robots.base.Robot.rated_payload>`: the
+            UR10e's 12.5 kg).
         center_of_mass: the payload's centre of mass in the flange frame [m].
         inertia: the payload's rotational inertia about its centre of mass, [Ixx, Iyy, Izz, Ixy,
             Ixz, Iyz] [kg m²] in the flange frame; empty: a point mass.
@@ -191,18 +191,11 @@ class Tool:
             reach.append(float(np.linalg.norm(shape.xyz)) + _bounding_radius(shape, ("cell", "tool", "shapes", index)))
         return max(reach)
 
-    def spatial_inertia(self, robot=None) -> SpatialInertia | None:
-        """The payload about the flange origin, in the flange frame (None without a payload);
-        refused above ``robot``'s rated payload (default, or a robot without one: the UR10e's)."""
+    def spatial_inertia(self) -> SpatialInertia | None:
+        """The payload about the flange origin, in the flange frame (None without a payload)."""
         mass = _vector([self.mass], ("cell", "tool", "mass"), 1, "kg")[0]
         if mass < 0:
             raise invalid("cell.tool.mass", f"cell.tool.mass must be >= 0 kg, got {self.mass}")
-        rated, rated_by = RATED_PAYLOAD, "UR10e"
-        if robot is not None and robot.rated_payload is not None:
-            rated, rated_by = robot.rated_payload, robot.name
-        if mass > rated:
-            raise DrakeTrajError(f"cell.tool.mass = {mass:g} kg is above the {rated_by}'s rated payload of {rated:g} kg",
-                                 field=("cell", "tool", "mass"), cause=Cause.INFEASIBLE)
         com = _vector(self.center_of_mass, ("cell", "tool", "center_of_mass"), 3, "m")
         if mass == 0:
             return None
@@ -221,6 +214,22 @@ class Tool:
                                  "must be positive and satisfy the triangle inequality)", field=("cell", "tool", "inertia"),
                                  cause=Cause.INVALID)
         return SpatialInertia.MakeFromCentralInertia(mass, com, rotational)
+
+    def check_payload(self, robot: Robot) -> None:
+        """Refuse a ``mass`` above ``robot``'s rated payload (field ``cell.tool.mass``, naming the
+        robot and its rating). A robot with no rating takes no payload unless it is a point
+        robot of the papers (no maker rates them; their tool is a point)."""
+        mass = _vector([self.mass], ("cell", "tool", "mass"), 1, "kg")[0]
+        rating = robot.rated_payload
+        if rating is None and (mass == 0 or isinstance(robot, PointRobot)):
+            return
+        if rating is None:
+            raise DrakeTrajError(f"cell.tool.mass = {mass:g} kg: the {robot.name} robot has no rated payload, so it takes "
+                                 "no tool mass (give the arm's rated payload)", field=("cell", "tool", "mass"),
+                                 cause=Cause.INFEASIBLE)
+        if mass > rating:
+            raise DrakeTrajError(f"cell.tool.mass = {mass:g} kg is above the {robot.name} robot's rated payload of "
+                                 f"{rating:g} kg", field=("cell", "tool", "mass"), cause=Cause.INFEASIBLE)
 
 
 @dataclass
@@ -245,10 +254,10 @@ class Cell:
     tool: Tool = field(default_factory=Tool)
     clearance: float = DEFAULT_CLEARANCE
 
-    def validate(self, robot=None) -> None:
+    def validate(self, robot: Robot = UR10E) -> None:
         """Raise DrakeTrajError naming the first field that is malformed (sizes, poses, the tool,
-        the payload (above ``robot``'s rating: :meth:`Tool.spatial_inertia`), the clearance);
-        directives are checked when they are loaded."""
+        the payload, the clearance), or a payload above ``robot``'s rating
+        (:meth:`Tool.check_payload`); directives are checked when they are loaded."""
         clearance = _vector([self.clearance], ("cell", "clearance"), 1, "m")[0]
         if clearance < 0:
             raise invalid("cell.clearance", f"cell.clearance must be >= 0 m, got {self.clearance}")
@@ -261,7 +270,8 @@ class Cell:
         for index, shape in enumerate(self.tool.shapes):
             shape.shape(("cell", "tool", "shapes", index))
             _pose(shape.xyz, shape.rpy, ("cell", "tool", "shapes", index))
-        self.tool.spatial_inertia(robot)
+        self.tool.spatial_inertia()
+        self.tool.check_payload(robot)
 
     def obstacle_name(self, index: int) -> str:
         """The geometry name of obstacle ``index`` (its ``name``, or ``obstacle_<index>``)."""
@@ -308,15 +318,16 @@ def _register(plant: MultibodyPlant, body, pose: RigidTransform, shape, name: st
     plant.RegisterVisualGeometry(body, pose, shape, name, colour.rgba)
 
 
-def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, flange_frame: str = "tool0",
-             directory: Path | None = None, robot=None) -> dict:
-    """Register ``cell`` in ``plant`` (not finalized) around the robot of ``robot_instance``.
+def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, robot: Robot = UR10E,
+             directory: Path | None = None) -> dict:
+    """Register ``cell`` in ``plant`` (not finalized) around ``robot`` (its model instance
+    ``robot_instance``; the tool goes on its flange ``robot.tool_frame``).
 
     The mounting and the obstacles are geometry of the world body (collision and visual); the
     directives add the user's models (relative files from ``directory``, the scenario's folder;
     default the working directory); the tool is a body ``tool`` welded to ``flange_frame`` that
-    carries the payload's inertia and the tool's shapes (added only when there is either), its
-    mass at most ``robot``'s rated payload (:meth:`Tool.spatial_inertia`).
+    carries the payload's inertia and the tool's shapes (added only when there is either); the
+    payload is checked against ``robot``'s rating.
 
     Returns {geometry name: field path in the scenario} of the cell's own geometry, for errors
     that name an obstacle. Raises DrakeTrajError naming the field of a malformed part, a model
@@ -337,10 +348,10 @@ def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, flange_frame:
                   OBSTACLE_COLOUR)
         fields[name] = location
     _add_directives(plant, cell.directives, directory)
-    inertia = cell.tool.spatial_inertia(robot)
+    inertia = cell.tool.spatial_inertia()
     if inertia is not None or cell.tool.shapes:
         tool = plant.AddRigidBody(TOOL_BODY, robot_instance, inertia or SpatialInertia.Zero())
-        plant.WeldFrames(plant.GetFrameByName(flange_frame, robot_instance), tool.body_frame())
+        plant.WeldFrames(plant.GetFrameByName(robot.tool_frame, robot_instance), tool.body_frame())
         for index, shape in enumerate(cell.tool.shapes):
             location = ("cell", "tool", "shapes", index)
             name = shape.name or f"tool_{index}"

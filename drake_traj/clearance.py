@@ -168,8 +168,8 @@ class CellChecker:
         builder = DiagramBuilder()
         self.plant, self.scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
         self.instance = robot.add_to_plant(self.plant)
-        self.cell_fields = add_cell(self.plant, self.cell, self.instance, flange_frame=robot.tool_frame,
-                                    directory=directory, robot=robot)
+        self.cell_fields = add_cell(self.plant, self.cell, self.instance, robot=robot,
+                                    directory=directory)
         self.plant.Finalize()
         self._diagram = builder.Build()
         self._context = self._diagram.CreateDefaultContext()

@@ -3,13 +3,16 @@
     drake-traj run [SCENARIO] [--variant NAME] [--out DIR] [--overwrite] [--no-preflight]
                    [--meshcat [--port P] [--rate R] [--no-wait] [--wait-timeout S] [--serve-after S]]
     drake-traj list
+    drake-traj robots
     drake-traj show [SCENARIO] [--variant NAME]
     drake-traj export RUN_DIR --format csv|urscript|ros2 [--period 0.002] [--out FILE]
     drake-traj bench [--out DIR] [--overwrite] [--count N] [--seed S] [--repeats R]
 
 ``run`` writes DIR/result.npz, metrics.json, *.png, meshcat.html and run.json (the manifest);
 SCENARIO is a YAML file or the name of a shipped scenario (``drake-traj list``: the shipped
-scenarios under their files' paths); ``show`` prints the file of one, to copy. ``export``
+scenarios under their files' paths, with their robots); ``robots`` tabulates the known robots
+(joints, reach, rated payload, speeds and torques, where the data come from); ``show`` prints the
+file of one scenario, to copy. ``export``
 writes a run's reference for a robot or another tool (drake_traj.export). ``bench`` runs
 every planner and baseline on Pająk 2024's task and N seeded tasks and writes DIR/bench.csv,
 bench.md and bench.png.
@@ -43,6 +46,7 @@ from drake_traj.export import FORMATS, UR_CYCLE, ExportError
 from drake_traj.meshcat import add_live_view, draw_refusal, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
 from drake_traj.refusal import refusal_figure
 from drake_traj.result import SimulationResult
+from drake_traj.robots import ROBOT_NAMES, get_robot
 from drake_traj.output import WriteError, locked, working_folder
 from drake_traj.rundir import MANIFEST, add_to_manifest, claim_run_folder, run_files, write_manifest
 from drake_traj.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
@@ -230,14 +234,46 @@ def serve_recording(url: str, seconds: float | None) -> None:
 
 
 def list_scenarios(args) -> int:
-    """``drake-traj list``: the shipped scenarios, a line each, under the path of their file."""
+    """``drake-traj list``: the shipped scenarios, a line each (name, robot, description), under
+    the path of their file."""
     entries = shipped_scenarios()
     width = max(len(entry.name) for entry in entries)
+    robot_width = max(len(entry.robot) for entry in entries)
     for path in dict.fromkeys(entry.path for entry in entries):
         print(path)
         for entry in entries:
             if entry.path == path:
-                print(f"  {entry.name:{width}}  {entry.description}")
+                print(f"  {entry.name:{width}}  {entry.robot:{robot_width}}  {entry.description}")
+    return EXIT_OK
+
+
+ROBOT_COLUMNS = ("robot", "joints", "reach [m]", "payload [kg]", "rated speeds [rad/s | m/s]", "torque limits [N m | N]",
+                 "data source")
+
+
+def robot_rows() -> list[tuple[str, ...]]:
+    """One row of :data:`ROBOT_COLUMNS` per known robot (``-``: not given)."""
+    def numbers(values) -> str:
+        return " ".join(f"{value:.4g}" for value in values)
+
+    rows = []
+    for name in ROBOT_NAMES:
+        robot = get_robot(name)
+        rows.append((name, str(robot.num_joints), "-" if robot.reach is None else f"{robot.reach:g}",
+                     "-" if robot.rated_payload is None else f"{robot.rated_payload:g}",
+                     numbers(robot.velocity_limits), numbers(robot.effort_limits), robot.data_source or "-"))
+    return rows
+
+
+def list_robots(args) -> int:
+    """``drake-traj robots``: a table of the known robots, the names a scenario's ``robot:`` takes
+    (an arm of one's own: ``robot: !CustomArm`` or ``!DhArm``)."""
+    rows = [ROBOT_COLUMNS] + robot_rows()
+    widths = [max(len(row[k]) for row in rows) for k in range(len(ROBOT_COLUMNS) - 1)]
+    for row in rows:
+        print("  ".join(f"{cell:{width}}" for cell, width in zip(row, widths)) + "  " + row[-1])
+    print("an arm of one's own in a scenario: robot: !CustomArm {model_file: ...} or robot: !DhArm {dh: ...} "
+          "(drake_traj.robots.custom)")
     return EXIT_OK
 
 
@@ -341,6 +377,8 @@ def build_parser() -> argparse.ArgumentParser:
                            f"{DEFAULT_SERVE_AFTER:g} s without one)")
     list_parser = commands.add_parser("list", help="list the shipped scenarios under their files' paths")
     list_parser.set_defaults(handler=list_scenarios)
+    robots_parser = commands.add_parser("robots", help="list the known robots: joints, reach, payload, limits, data source")
+    robots_parser.set_defaults(handler=list_robots)
     show_parser = commands.add_parser("show", help="print a shipped scenario's file, to copy and edit")
     show_parser.set_defaults(handler=show_scenario)
     _add_scenario_arguments(show_parser, "a shipped scenario's name", "show")

@@ -1,5 +1,5 @@
 """Take a planned motion out of the project: a Drake trajectory, CSV, a URScript program for a
-UR10e controller, a ROS 2 ``trajectory_msgs/JointTrajectory``.
+UR e-Series controller, a ROS 2 ``trajectory_msgs/JointTrajectory``. Each file names the robot.
 
 The exported motion is the run's reference (what the planner asked for, not what the simulated
 arm did), resampled every ``period`` [s] from t = 0 to the end of the log: q and q̇ from the cubic
@@ -19,7 +19,7 @@ from pydrake.trajectories import PiecewisePolynomial
 from drake_traj.version import __version__
 from drake_traj.errors import DrakeTrajError
 from drake_traj.output import write_file
-from drake_traj.robots import UR10E
+from drake_traj.robots import ROBOT_NAMES, Robot, get_robot
 
 __all__ = ["FORMATS", "ExportError", "export", "reference_trajectory", "resample"]
 
@@ -28,6 +28,9 @@ UR_CYCLE = 0.002  # [s], the UR controller's servo cycle (500 Hz)
 MIN_PERIOD = 1e-4  # [s], the finest resampling (10 kHz): the log itself is at 1 ms
 LOOKAHEAD_RANGE = (0.03, 0.2)  # [s], servoj lookahead_time (UR script manual)
 GAIN_RANGE = (100.0, 2000.0)  # servoj gain (UR script manual)
+# The arms a UR e-Series controller (PolyScope 5) drives, by their names in drake_traj.robots; the
+# URScript export serves those of them that are registered (ROBOT_NAMES)
+UR_CONTROLLER_ARMS = ("ur3e", "ur5e", "ur10e", "ur16e", "ur20", "ur30")
 
 
 class ExportError(DrakeTrajError):
@@ -76,25 +79,45 @@ def _csv(result, t, q, qd, qdd, period) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _check_ur10e(result, t, q, qd) -> None:
-    """Refuse a reference a UR10e controller would refuse: another robot, a joint outside its
-    position range or faster than its rated speed."""
-    if result.robot != UR10E.name:
-        raise ExportError(f"URScript runs on a UR10e controller; the run {result.name!r} is on "
+def ur_model(name: str) -> str:
+    """A UR arm's model as UR writes it: ``ur10e`` -> ``UR10e``."""
+    return "UR" + name[2:]
+
+
+def _ur_arm(result) -> Robot:
+    """The UR arm of ``result``'s run, or an ExportError naming the arms a UR controller drives."""
+    arms = [name for name in UR_CONTROLLER_ARMS if name in ROBOT_NAMES]
+    if result.robot not in arms:
+        models = [ur_model(name) for name in arms]
+        served = models[0] if len(models) == 1 else f"{', '.join(models[:-1])} or {models[-1]}"
+        raise ExportError(f"URScript runs on a {served} controller; the run {result.name!r} is on "
                           f"{result.robot or 'an unknown robot'}")
-    for values, limit, what, unit in ((q, UR10E.upper_limits, "position", "rad"), (qd, UR10E.velocity_limits, "speed", "rad/s")):
+    return get_robot(result.robot)
+
+
+def _check_ur_arm(result, t, q, qd) -> Robot:
+    """The UR arm of the run (:func:`_ur_arm`), or ExportError for a reference its controller would
+    refuse: a joint outside its position range or faster than its rated speed, or a logged torque
+    at its torque limit (the simulated drive saturated: the real one would stop the program)."""
+    robot = _ur_arm(result)
+    model = ur_model(robot.name)
+    for values, limit, what, unit, times in ((q, robot.upper_limits, "position", "rad", t),
+                                             (qd, robot.velocity_limits, "speed", "rad/s", t),
+                                             (result.tau, robot.effort_limits * (1 - 1e-9), "torque", "N m", result.t)):
         over = np.abs(values) > limit
         if over.any():
             k, j = np.argwhere(over)[0]
-            raise ExportError(f"joint {j + 1} ({UR10E.joint_names[j]}) {what} {values[k, j]:.4f} {unit} at t = {t[k]:.3f} s "
-                              f"is beyond the UR10e's {limit[j]:.4f} {unit}: the controller would stop the program")
+            raise ExportError(f"joint {j + 1} ({robot.joint_names[j]}) {what} {values[k, j]:.4f} {unit} at t = {times[k]:.3f} s "
+                              f"is beyond the {model}'s {limit[j]:.4f} {unit}: the controller would stop the program")
+    return robot
 
 
-def _urscript(result, t, q, period, lookahead_time, gain, approach_speed) -> str:
+def _urscript(result, robot, t, q, period, lookahead_time, gain, approach_speed) -> str:
     program = "drake_traj_" + "".join(c if c.isalnum() else "_" for c in result.name)
     lines = [
         f"def {program}():",
-        f"  # drake-traj {__version__}: the reference of the run {result.name!r}, {len(t)} points every {period:g} s",
+        f"  # drake-traj {__version__}: the reference of the run {result.name!r} for a {ur_model(robot.name)}, "
+        f"{len(t)} points every {period:g} s",
         "  # (q from the cubic Hermite spline through the logged reference). Try it at reduced speed first.",
         f"  movej({_ur_list(q[0])}, a={approach_speed:g}, v={approach_speed:g})  # to the start, slowly",
     ]
@@ -119,7 +142,8 @@ def _ros2(result, t, q, qd, qdd, joint_names) -> str:
                        "time_from_start": {"sec": sec, "nanosec": nanosec}})
     message = {"header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}, "joint_names": list(joint_names),
                "points": points}
-    comment = (f"# trajectory_msgs/JointTrajectory from drake-traj {__version__}: the reference of the run {result.name!r}\n"
+    comment = (f"# trajectory_msgs/JointTrajectory from drake-traj {__version__}: the reference of the run {result.name!r} "
+               f"on the {result.robot or 'robot'}\n"
                "# (ros2 topic pub --once /scaled_joint_trajectory_controller/joint_trajectory "
                "trajectory_msgs/msg/JointTrajectory \"$(cat FILE)\")\n")
     return comment + yaml.safe_dump(message, sort_keys=False, default_flow_style=None, width=1000)
@@ -162,11 +186,10 @@ def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_tim
     if format == "csv":
         text = _csv(result, t, q, qd, qdd, period)
     elif format == "urscript":
-        _check_ur10e(result, t, q, qd)
-        text = _urscript(result, t, q, period, lookahead_time, gain, approach_speed)
+        robot = _check_ur_arm(result, t, q, qd)
+        text = _urscript(result, robot, t, q, period, lookahead_time, gain, approach_speed)
     else:
-        names = UR10E.joint_names if result.robot == UR10E.name else [f"joint_{j + 1}" for j in range(q.shape[1])]
-        text = _ros2(result, t, q, qd, qdd, names)
+        text = _ros2(result, t, q, qd, qdd, result.joint_names or [f"joint_{j + 1}" for j in range(q.shape[1])])
     if result.failure is not None:  # allowed: the first line says so (a comment in all three formats)
         text = f"# FAILED RUN: {' '.join(str(result.failure).split())}\n" + text
     return write_file(path, text, own_folder=run_folder)

@@ -36,7 +36,8 @@ from drake_traj.errors import Cause, DrakeTrajError, Field, field_text, joint_la
 from drake_traj.planners import PLANNER_CONFIGS, PlannerConfig, PlannerSystem, QuinticConfig
 from drake_traj.planners import make_planner as make_planner_from_config
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE
-from drake_traj.robots import Robot, get_robot
+from drake_traj.robots import Robot
+from drake_traj.robots.custom import RobotChoice, resolve_robot, robot_label
 from drake_traj.validation import (MAX_RUN_DURATION, flag, instance_of, invalid, log_period_check, path_argument,
                                    real_array, realtime_rate, run_duration, settle_duration, step_size)
 from drake_traj.yaml_schema import ScenarioError, checked_document, locate
@@ -146,7 +147,9 @@ class Scenario:
         name: a plain name (letters, digits, ``_``, ``-``, ``.``): the default output folder.
         description: one line on what the scenario runs.
         robot: a name of :data:`drake_traj.robots.ROBOT_NAMES` ("ur10e", "li_4dof" of Li et al.
-            2019, or Boryga's "anthropomorphic", "scara", "cartesian").
+            2019, or Boryga's "anthropomorphic", "scara", "cartesian"), or an arm of one's own:
+            ``!CustomArm`` (a model file) or ``!DhArm`` (a DH table), see
+            :mod:`drake_traj.robots.custom`.
         q_initial: the robot's start [rad or m]; empty: its home configuration (the UR10e's is the
             start of Pająk 2024's task). Planners that follow a tool path on the papers' robots
             start from the inverse kinematics of the path instead.
@@ -172,7 +175,7 @@ class Scenario:
 
     name: str = "unnamed"
     description: str = ""
-    robot: str = "ur10e"
+    robot: RobotChoice = "ur10e"
     q_initial: list[float] = field(default_factory=list)
     planner: PlannerConfig = field(default_factory=QuinticConfig)
     cell: Cell = field(default_factory=Cell)
@@ -188,11 +191,21 @@ class Scenario:
     def __post_init__(self) -> None:
         # where the scenario was read from (set by load_scenario; not a YAML field): locates errors
         self.source: ScenarioSource | None = None
+        self._robot: tuple | None = None  # ((repr of the robot field, folder), the robot it resolved to)
 
     def start_configuration(self) -> np.ndarray:
         """``q_initial``, or the robot's home configuration when it is empty."""
         q = real_array(self.q_initial, "q_initial", "rad or m")
-        return get_robot(self.robot).home_configuration if q.size == 0 else q
+        return self.base_robot().home_configuration if q.size == 0 else q
+
+    def base_robot(self) -> Robot:
+        """The robot of the ``robot`` field with its flange as the tool (every use of the field goes
+        through here: :func:`~drake_traj.robots.custom.resolve_robot`, a custom arm's model file
+        taken from the scenario's folder); DrakeTrajError naming the field otherwise."""
+        key = (repr(self.robot), self.directory())
+        if self._robot is None or self._robot[0] != key:
+            self._robot = (key, resolve_robot(self.robot, self.directory()))
+        return self._robot[1]
 
     def validate(self) -> None:
         """Raise ValueError naming the first field that is malformed (the message starts with
@@ -200,10 +213,7 @@ class Scenario:
         if not _PLAIN_NAME.fullmatch(self.name) or ".." in self.name:
             raise invalid("name", f"name must be a plain name (letters, digits, _ . -; no path; at most 100 characters), "
                              f"got {self.name[:120]!r}: it names the default output folder out/<name>")
-        try:
-            robot = get_robot(self.robot)
-        except ValueError as error:
-            raise invalid("robot", f"robot: {error}") from None
+        robot = self.base_robot()
         n = robot.num_joints
         q = self.start_configuration()
         if q.shape != (n,):
@@ -266,7 +276,7 @@ class Scenario:
         refusal (a point robot given an offset) names ``cell.tool.tcp_xyz``."""
         tool = self.cell.tool
         try:
-            return get_robot(self.robot).with_tcp(tool.tcp_xyz, tool.tcp_rpy)
+            return self.base_robot().with_tcp(tool.tcp_xyz, tool.tcp_rpy)
         except DrakeTrajError as error:
             field = ("cell", "tool", "tcp_" + str(error.field[0])) if error.field else ("cell", "tool", "tcp_xyz")
             raise error.relocated(field, f"{field_text(field)}: {error}") from None
@@ -321,12 +331,13 @@ def default_scenario_path() -> Path:
 @dataclass(frozen=True)
 class ShippedScenario:
     """A scenario shipped with the package: its name, file, variant (None for a file of one
-    scenario) and one-line description."""
+    scenario), one-line description and robot (:func:`~drake_traj.robots.custom.robot_label`)."""
 
     name: str
     path: Path
     variant: str | None
     description: str
+    robot: str
 
 
 def shipped_scenarios() -> list[ShippedScenario]:
@@ -335,7 +346,7 @@ def shipped_scenarios() -> list[ShippedScenario]:
     for path in sorted(shipped_directory().glob("*.yaml")):
         for variant in scenario_variants(path) or [None]:
             scenario = load_scenario(path, variant)
-            entries.append(ShippedScenario(scenario.name, path, variant, scenario.description))
+            entries.append(ShippedScenario(scenario.name, path, variant, scenario.description, robot_label(scenario.robot)))
     return entries
 
 
@@ -417,12 +428,12 @@ def load_scenario(name_or_path, variant: str | None = None) -> Scenario:
         scenario = yaml_load_typed(schema=Scenario, data=path.read_text(), child_name=variant)
     except RuntimeError as error:  # not expected after the check above; still one clear message
         raise ScenarioError(f"{path}: {error}") from None
+    scenario.source = ScenarioSource(path, variant, marks)  # before validate(): a custom arm's file is found from it
     try:
         scenario.validate()
     except ValueError as error:
         field = error.field if isinstance(error, DrakeTrajError) else ()
         raise ScenarioError(locate(marks, path, field, str(error)), field=field) from None
-    scenario.source = ScenarioSource(path, variant, marks)
     return scenario
 
 

@@ -48,6 +48,7 @@ from drake_traj.errors import Cause, Failure
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
 from drake_traj.robots import UR10E, Robot
+from drake_traj.robots.custom import robot_label
 from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, check_planned_duration, default_plant_config,
                                  default_simulator_config)
 from drake_traj.scenario import preflight as scenario_preflight
@@ -108,11 +109,26 @@ class Station:
     visualizer: MeshcatVisualizer | None
 
 
+def station_robot(planner: PlannerSystem, robot: Robot | None = None) -> Robot:
+    """The robot a station runs ``planner`` on: ``robot``, or where None the one the planner was
+    made for (:attr:`PlannerSystem.robot`), else the UR10e. TypeError or ValueError naming
+    ``robot`` when it is not a Robot, has another joint count than the planner, or is another
+    robot than the one the planner was made for (its motion is that robot's)."""
+    made_for = planner.robot
+    robot = made_for or UR10E if robot is None else instance_of(robot, Robot, "robot")
+    if planner.num_joints != robot.num_joints:
+        raise invalid("robot", f"the planner has {planner.num_joints} joints, robot {robot.name} has {robot.num_joints}")
+    if made_for is not None and made_for.name != robot.name:
+        raise invalid("robot", f"the planner was made for the {made_for.name} robot, not for robot {robot.name}: make it "
+                               f"for {robot.name} (make_planner(config, robot, q_initial)) or run it on {made_for.name}")
+    return robot
+
+
 def add_station(
     builder: DiagramBuilder,
     planner: PlannerSystem,
     *,
-    robot: Robot = UR10E,
+    robot: Robot | None = None,
     gains: ControllerGains | None = None,
     plant_config: MultibodyPlantConfig | None = None,
     log_period: float = 1e-3,
@@ -128,7 +144,8 @@ def add_station(
 
     Args:
         planner: any system under the planner contract, with n = ``robot.num_joints`` joints.
-        robot: the robot (default the UR10e).
+        robot: the robot (default: the one the planner was made for, else the UR10e;
+            :func:`station_robot`).
         gains: PD gains and feed-forward choice (default: the robot's gains, with feed-forward).
         plant_config: the plant's configuration (default :func:`default_plant_config`).
         log_period: the loggers' period [s]: they sample at k * log_period from t = 0.
@@ -147,7 +164,7 @@ def add_station(
     if planner.GetSystemPathname().count("::") > 1:  # "::parent::planner" once built into a diagram
         raise invalid("planner", f"planner is already part of a diagram ({planner.GetSystemPathname()}): a planner system "
                          "can be used in one diagram (one run) only; make a new one for this run (make_planner again)")
-    instance_of(robot, Robot, "robot")
+    robot = station_robot(planner, robot)
     if meshcat is not None:
         instance_of(meshcat, Meshcat, "meshcat")
     if cell is not None:
@@ -157,8 +174,6 @@ def add_station(
     gains = (gains or ControllerGains()).for_robot(robot)
     plant_config = instance_of(plant_config or default_plant_config(), MultibodyPlantConfig, "plant_config")
     n = robot.num_joints
-    if planner.num_joints != n:
-        raise invalid("robot", f"the planner has {planner.num_joints} joints, robot {robot.name} has {n}")
     time_step = step_size(plant_config.time_step, "plant.time_step")
     log_period = positive_scalar(log_period, "log_period", "s")
     log_period_check(log_period, time_step)
@@ -169,8 +184,7 @@ def add_station(
         plant.GetJointActuatorByName(f"{joint_name}_actuator", instance).set_controller_gains(PdControllerGains(p=kp, d=kd))
     # the cell's geometry, the tool's body and payload: contact with them, and between the arm's
     # non-adjacent links, is simulated (and ends the run: run_station)
-    add_cell(plant, cell or Cell(), instance, flange_frame=robot.tool_frame, directory=cell_directory,
-             robot=robot)
+    add_cell(plant, cell or Cell(), instance, robot=robot, directory=cell_directory)
     if before_finalize is not None:
         before_finalize(plant, scene_graph)
     plant.Finalize()
@@ -397,9 +411,9 @@ def simulate(
     log period, integrator, speed override, tolerance and times, each replaced by an argument
     given here (except ``robot``: the scenario names its own), and a ``max_duration`` shorter
     than the planned motion refused before the run as the command line refuses it. Given a
-    planner system, the defaults are the UR10e, the robot's gains, our plant and integrator
-    (None: the same), 1 ms logs, 0.5 s settle time, 120 s at most, no speed override and a 5 mm
-    tracking tolerance.
+    planner system, the defaults are the robot it was made for (else the UR10e;
+    :func:`station_robot`), the robot's gains, our plant and integrator (None: the same), 1 ms
+    logs, 0.5 s settle time, 120 s at most, no speed override and a 5 mm tracking tolerance.
 
     The run stops at ``max_duration`` [s] (at most 600 s; the preflight looks as far ahead) if
     the planner has not finished; ``settle_time`` is at most 60 s. Whatever stops the run
@@ -441,18 +455,19 @@ def simulate(
         scenario = planner
         if robot is not _UNSET:
             raise TypeError(f"robot must not be given with a scenario: scenario {scenario.name!r} names its robot "
-                            f"({scenario.robot!r})")
+                            f"({robot_label(scenario.robot)})")
         defaults = scenario.station_arguments() | scenario.run_settings()
         planner = defaults.pop("planner")
     else:
         scenario = None
-        defaults = dict(name="run", robot=UR10E, gains=None, plant_config=None, simulator_config=None, log_period=1e-3,
+        defaults = dict(name="run", robot=None, gains=None, plant_config=None, simulator_config=None, log_period=1e-3,
                         settle_time=0.5, max_duration=120.0, speed_override=None,
                         tracking_tolerance=DEFAULT_TRACKING_TOLERANCE, cell=None, cell_directory=None)
         instance_of(planner, PlannerSystem, "planner", hint=" or a Scenario")
     (name, robot, gains, plant_config, simulator_config, log_period, settle_time, max_duration, speed_override,
      tracking_tolerance, cell, cell_directory) = (defaults[key] if value is _UNSET else value
                                                   for key, value in given.items())
+    robot = station_robot(planner, robot)
     if cell is not None:
         instance_of(cell, Cell, "cell")
     # checked before the planner goes into a diagram (a planner is used in one diagram only)

@@ -171,10 +171,20 @@ class _Checker:
         raise TypeError(f"no YAML check for the type {schema!r} of {field_text(field)}")  # a schema we did not foresee
 
     def check_union(self, node, options, field: Field) -> None:
-        names = {option.__name__: option for option in options}
+        """A union of records chosen by a YAML tag (``planner: !PajakConfig``), one of which may be
+        text (``robot: ur10e`` or ``robot: !DhArm {...}``): pydrake reads an untagged value as
+        the first type."""
+        text = str in options
+        names = {option.__name__: option for option in options if option is not str}
+        if text and isinstance(node, yaml.ScalarNode) and not node.tag.startswith("!"):
+            return self.check(node, str, field)
         if not isinstance(node, yaml.MappingNode):
-            self.fail(node, field, f"expected a mapping tagged with one of !{', !'.join(names)}, found {_describe(node)}")
+            either = "a name or " if text else ""
+            self.fail(node, field, f"expected {either}a mapping tagged with one of !{', !'.join(names)}, found {_describe(node)}")
         tag = node.tag[1:] if node.tag.startswith("!") and not node.tag.startswith("!!") else None
+        if tag is None and text:
+            self.fail(node, field, f"a mapping needs a tag naming its type, one of !{', !'.join(names)} (e.g. "
+                                   f"{field_text(field)}: !{next(iter(names))})")
         if tag is None:  # untagged: pydrake reads the first type
             keys = {key.value for key, _ in node.value}
             if not keys <= set(_fields(options[0])) | {"<<"}:

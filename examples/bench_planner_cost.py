@@ -45,7 +45,6 @@ from pydrake.systems.framework import DiagramBuilder, TriggerType
 from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput, MatrixGain, TrajectorySource
 
 from drake_traj.planners import pajak
-from drake_traj.robots import get_robot
 from drake_traj.scenario import default_scenario_path, load_scenario
 from drake_traj.station import build_station, run_station, simulate
 
@@ -60,7 +59,7 @@ def floor_real_time_factor(scenario, duration: float = FLOOR_DURATION, reference
     gravity compensation; or, given ``reference`` (a PiecewisePolynomial of q), moving along it:
     Drake's C++ ``TrajectorySource`` gives q, q̇, q̈, one step ahead, with inverse dynamics, as
     the station does (the arm's motion costs the plant's solver too)."""
-    robot = get_robot(scenario.robot)
+    robot = scenario.base_robot()
     gains = scenario.controller.for_robot(robot)
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlant(scenario.plant, builder)

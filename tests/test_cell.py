@@ -9,7 +9,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj import load_scenario
-from drake_traj.cell import RATED_PAYLOAD, Box, Cell, Cylinder, Pedestal, Sphere, Tool, add_cell
+from drake_traj.cell import Box, Cell, Cylinder, Pedestal, Sphere, Tool, add_cell
 from drake_traj.errors import Cause, DrakeTrajError
 from drake_traj.robots import UR10E
 from drake_traj.robots.ur10e import dh_frames
@@ -59,7 +59,7 @@ def test_the_payload_changes_the_static_shoulder_torque_by_m_g_r():
     (Cell(obstacles=[Cylinder(radius=0.1, length=0.2, rpy=[0, float("inf"), 0])]), ("cell", "obstacles", 0, "rpy"),
      "finite"),
     (Cell(mounting=Pedestal(radius=0.0)), ("cell", "mounting", "radius"), "must be positive"),
-    (Cell(tool=Tool(mass=RATED_PAYLOAD + 0.5, tcp_xyz=[0, 0, 0.2])), ("cell", "tool", "mass"), "rated payload"),
+    (Cell(tool=Tool(mass=UR10E.rated_payload + 0.5, tcp_xyz=[0, 0, 0.2])), ("cell", "tool", "mass"), "rated payload"),
     (Cell(tool=Tool(mass=-1.0)), ("cell", "tool", "mass"), ">= 0"),
     (Cell(tool=Tool(mass=2.0, tcp_xyz=[0, 0, 0.1], center_of_mass=[0, 0, 0.4])), ("cell", "tool", "center_of_mass"),
      "beyond the tool"),

@@ -7,10 +7,12 @@ import sys
 import time
 import urllib.request
 
+import numpy as np
 import pytest
 
 import browser
 from drake_traj import cli
+from drake_traj.robots import ROBOT_NAMES, get_robot
 from drake_traj.scenario import load_scenario, shipped_scenarios
 
 
@@ -94,3 +96,31 @@ def test_a_live_run_without_a_terminal_serves_its_recording_then_exits(tmp_path)
         assert time.monotonic() - start > 0.5
     finally:
         process.kill()
+
+
+def test_list_shows_each_shipped_scenarios_robot(capsys):
+    assert cli.main(["list"]) == cli.EXIT_OK
+    rows = {line.split()[0]: line.split()[1] for line in capsys.readouterr().out.splitlines() if line.startswith("  ")}
+    for entry in shipped_scenarios():
+        assert rows[entry.name] == load_scenario(entry.path, entry.variant).robot
+    assert rows["li_closed_path_4dof"] == "li_4dof" and rows["pajak_sim3"] == "ur10e"
+
+
+def test_robots_tabulates_every_known_robot_with_its_ratings(capsys):
+    assert cli.main(["robots"]) == cli.EXIT_OK
+    header, *lines = capsys.readouterr().out.splitlines()
+    assert header.split()[:2] == ["robot", "joints"] and "data source" in header
+    rows = {line.split()[0]: line for line in lines}
+    assert set(ROBOT_NAMES) <= set(rows)
+    for name in ROBOT_NAMES:
+        robot = get_robot(name)
+        n = robot.num_joints
+        fields = rows[name].split()
+        assert fields[1] == str(n)
+        assert fields[2] == ("-" if robot.reach is None else f"{robot.reach:g}")
+        assert fields[3] == ("-" if robot.rated_payload is None else f"{robot.rated_payload:g}")
+        np.testing.assert_allclose(np.array(fields[4:4 + n], dtype=float), robot.velocity_limits, rtol=5e-4)
+        np.testing.assert_allclose(np.array(fields[4 + n:4 + 2 * n], dtype=float), robot.effort_limits, rtol=5e-4)
+        assert rows[name].endswith(robot.data_source)
+    ur10e = rows["ur10e"].split()
+    assert ur10e[1:4] == ["6", "1.3", "12.5"] and ur10e[4:6] == ["2.094", "2.094"] and ur10e[10:16] == ["330", "330", "150", "56", "56", "56"]

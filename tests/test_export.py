@@ -13,7 +13,8 @@ import yaml
 
 from drake_traj import SimulationResult, cli
 from drake_traj.errors import Failure
-from drake_traj.export import ExportError, resample
+from drake_traj.export import UR_CONTROLLER_ARMS, ExportError, resample
+from drake_traj.robots import ROBOT_NAMES, get_robot
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -157,3 +158,40 @@ def test_a_failed_or_non_finite_reference_is_not_exported(result, tmp_path):
     with pytest.raises(ExportError, match=r"not finite: q_ref at sample 100 is nan"):
         broken.export(tmp_path / "y.script", "urscript")
     assert not (tmp_path / "x.csv").exists() and not (tmp_path / "y.script").exists()
+
+
+def test_every_export_names_the_robot(result, tmp_path):
+    headers = {format: result.export(tmp_path / f"x{suffix}", format, period=0.01).read_text().splitlines()[:2]
+               for format, suffix in (("csv", ".csv"), ("urscript", ".script"), ("ros2", ".yaml"))}
+    assert "on the ur10e," in headers["csv"][0]
+    assert "for a UR10e," in headers["urscript"][1]
+    assert headers["ros2"][0].endswith("on the ur10e")
+
+
+UR_ARMS = [name for name in UR_CONTROLLER_ARMS if name in ROBOT_NAMES]
+
+
+@pytest.mark.parametrize("name", UR_ARMS)
+def test_urscript_checks_each_ur_arm_against_its_own_ratings(result, tmp_path, name):
+    robot = get_robot(name)
+    model = "UR" + name[2:]
+    speed, k = result.qd_ref.copy(), 2 * (len(result.t) // 4)  # an exported sample (every 2 ms of the 1 ms log)
+    speed[k, 2] = 1.001 * robot.velocity_limits[2]  # joint 3, just above that arm's rated speed
+    with pytest.raises(ExportError, match=rf"joint 3 \(elbow_joint\) speed {speed[k, 2]:.4f} rad/s at t = {result.t[k]:.3f} "
+                                          rf"s is beyond the {model}'s {robot.velocity_limits[2]:.4f} rad/s"):
+        SimulationResult(**{**vars(result), "robot": name, "qd_ref": speed}).export(tmp_path / "x.script", "urscript")
+    torque = result.tau.copy()
+    torque[7, 0] = -robot.effort_limits[0]  # the simulated drive saturated
+    with pytest.raises(ExportError, match=rf"joint 1 \(shoulder_pan_joint\) torque -{robot.effort_limits[0]:.4f} N m "
+                                          rf"at t = {result.t[7]:.3f} s is beyond the {model}'s"):
+        SimulationResult(**{**vars(result), "robot": name, "tau": torque}).export(tmp_path / "x.script", "urscript")
+    assert not (tmp_path / "x.script").exists()
+
+
+@pytest.mark.parametrize("robot", ["li_4dof", "my_own_arm", ""])
+def test_urscript_refuses_an_arm_no_ur_controller_drives(result, tmp_path, robot):
+    served = "(UR[0-9e]+(, | or )?)+"
+    with pytest.raises(ExportError, match=rf"URScript runs on a {served} controller; the run 'quintic_ptp' is on "
+                                          rf"{robot or 'an unknown robot'}$"):
+        SimulationResult(**{**vars(result), "robot": robot}).export(tmp_path / "x.script", "urscript")
+    assert not (tmp_path / "x.script").exists()

@@ -35,7 +35,8 @@ from drake_traj.errors import Cause, PlanningError
 from drake_traj.planners.laws.contract import MEMBERS, missing_members
 from drake_traj.planners.laws.pieces import law_pieces
 from drake_traj.planners.laws.scaling import admissible_clock_rate, clock_at, next_clock_rate
-from drake_traj.validation import finite_array, invalid, run_duration
+from drake_traj.robots import Robot
+from drake_traj.validation import finite_array, instance_of, invalid, run_duration
 
 _DID_NOTHING = EventStatus.DidNothing()  # returned by the time-law update in the common case
 # [s] how far ahead :meth:`PlannerSystem.preflight` looks when not told: a run's default max_duration
@@ -63,6 +64,7 @@ class PlannerSystem(LeafSystem):
     """
 
     plans_online = False
+    robot: Robot | None = None  # the robot the planner was made for, where it knows one (a station runs it there)
 
     def __init__(self, q_initial, *, initial_scaling: float = 1.0):
         super().__init__()
@@ -417,6 +419,15 @@ class TimeLawPlanner(PlannerSystem):
         q_law, qd_law, _ = self.law.sample(tau)
         state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(np.concatenate([q_law, qd_law * c]))
         return EventStatus.Succeeded()
+
+
+def planner_robot(robot: Robot, num_joints: int) -> Robot:
+    """``robot``, the robot a planner of ``num_joints`` joints runs on; TypeError or ValueError
+    naming ``robot`` when it is not a Robot or has another number of joints."""
+    instance_of(robot, Robot, "robot")
+    if robot.num_joints != num_joints:
+        raise invalid("robot", f"the planner has {num_joints} joints, robot {robot.name} has {robot.num_joints}")
+    return robot
 
 
 def start_and_goals(q_initial, goals, num_joints: int) -> np.ndarray:

@@ -19,8 +19,16 @@ ROBOT_NAMES = tuple(_ROBOTS)
 
 
 def get_robot(name: str) -> Robot:
-    """The robot called ``name`` (one of :data:`ROBOT_NAMES`)."""
+    """The robot called ``name`` (one of :data:`ROBOT_NAMES`); a ValueError listing the known
+    robots with their reach and rated payload for any other name."""
     try:
         return _ROBOTS[name]
     except (KeyError, TypeError):
-        raise ValueError(f"robot must be one of {ROBOT_NAMES}, got {name!r}") from None
+        known = "; ".join(f"{robot.name} ({_ratings(robot)})" for robot in _ROBOTS.values())
+        raise ValueError(f"robot must be one of the known robots, got {name!r:.80}; known: {known}") from None
+
+
+def _ratings(robot: Robot) -> str:
+    reach = "reach not given" if robot.reach is None else f"reach {robot.reach:g} m"
+    payload = "no rated payload" if robot.rated_payload is None else f"payload {robot.rated_payload:g} kg"
+    return f"{robot.num_joints} joints, {reach}, {payload}"

@@ -118,6 +118,7 @@ class Robot:
     tcp_offset: np.ndarray = FLANGE  # X_FT (4, 4) [m]: the TCP in the flange frame, read-only
     rated_payload: float | None = None  # [kg], the largest payload the maker rates; None: not rated
     data_source: str = ""  # where the robot's numbers come from (a document in docs/, a paper, a file)
+    reach: float | None = None  # [m], the radius of the tool's workspace (a maker's rated reach); None: not given
 
     def with_tcp(self, xyz, rpy) -> "Robot":
         """A robot equal to this one whose tool is the TCP at ``xyz`` [m] with orientation ``rpy``

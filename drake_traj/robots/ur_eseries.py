@@ -318,6 +318,7 @@ class URArm(Robot):
         self.model_file = f"{data.name}.urdf"
         self.rated_payload = data.rated_payload
         self.data_source = data.data_source
+        self.reach = data.reach
         self.model = data.model  # the closed form's data, TaskKinematics.model
         self._d = np.array(data.d)
         self._a = np.array(data.a)

@@ -46,7 +46,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from drake_traj.planners.base import TimeLawPlanner, start_and_goals
+from drake_traj.planners.base import TimeLawPlanner, planner_robot, start_and_goals
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import instance_of, invalid, limit_or_default, positive_vector
 
@@ -314,7 +314,7 @@ class MovejPlanner(TimeLawPlanner):
                  robot: Robot = UR10E):
         instance_of(law, MovejBlendLaw, "law")
         super().__init__(law, law.velocity_limit, law.acceleration_limit, speed_cap=speed_cap, update_period=update_period)
-        self.robot = robot
+        self.robot = planner_robot(robot, self.num_joints)
 
     def task_waypoints(self) -> np.ndarray:
         """Tool positions at the goal waypoints q_1..q_m [m], shape (m, 3)."""

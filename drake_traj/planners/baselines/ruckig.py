@@ -29,7 +29,7 @@ import numpy as np
 import ruckig
 
 from drake_traj.errors import Cause, DrakeTrajError, joint_label
-from drake_traj.planners.base import TimeLawPlanner, start_and_goals
+from drake_traj.planners.base import TimeLawPlanner, planner_robot, start_and_goals
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import instance_of, limit_or_default, positive_vector
 
@@ -247,7 +247,7 @@ class RuckigPlanner(TimeLawPlanner):
             speed_cap=speed_cap,
             update_period=update_period,
         )
-        self.robot = robot
+        self.robot = planner_robot(robot, self.num_joints)
 
     def task_waypoints(self) -> np.ndarray:
         """Tool positions [m] at the waypoints q_1..q_m (the goals), shape (m, 3)."""

@@ -23,6 +23,7 @@ class BorygaLoopPlanner(TimeLawPlanner):
     def __init__(self, law, velocity_limit, acceleration_limit, *, update_period: float = 0.001):
         cap, self.peaks = joint_speed_cap(law, velocity_limit, acceleration_limit)
         super().__init__(law, velocity_limit, acceleration_limit, speed_cap=cap, update_period=update_period)
+        self.robot = law.robot
 
     def figures(self) -> dict:
         return {"loop_path": loop_path_figure(self.law.plan, clock_rate=self.speed_cap)}

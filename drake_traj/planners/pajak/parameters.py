@@ -5,11 +5,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from drake_traj.robots import ur10e as robot
+from drake_traj.robots import ur10e  # the paper's arm: its task, start and joint-move limits
 from drake_traj.validation import flag, invalid, positive_vector, real_array, step_size
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
 
-__all__ = ["PAPER_METHOD", "PajakConfig", "paper_initial_configuration", "paper_parameters"]
+__all__ = ["PAPER_METHOD", "PajakConfig", "TASK_JOINTS", "paper_initial_configuration", "paper_parameters"]
+
+TASK_JOINTS = 6  # the planner drives six joints, one per task coordinate [x, y, z, φ_X, φ_Y, φ_Z]
 
 # The improvement flags of PajakConfig switched off: the paper's method as printed, with the
 # corrections of docs/papers.md (used for the Table 2 reproduction and to show what each improvement fixes).
@@ -80,8 +82,8 @@ class PajakConfig:
     waypoints: list[list[float]] = field(default_factory=list)
     position_gain: float = 20.0
     velocity_gain: float = 9.392
-    velocity_limit: float = robot.DEFAULT_JOINT_MOVE_VELOCITY
-    acceleration_limit: float = robot.DEFAULT_JOINT_MOVE_ACCELERATION
+    velocity_limit: float = ur10e.DEFAULT_JOINT_MOVE_VELOCITY
+    acceleration_limit: float = ur10e.DEFAULT_JOINT_MOVE_ACCELERATION
     vartheta: float = 0.1
     rho: float = 0.03
     accuracy: float = 0.001
@@ -109,7 +111,7 @@ class PajakConfig:
     def validate(self) -> "PajakConfig":
         """Check every field; return a copy with arrays normalised ((w, 6) waypoints, (6,) gains
         and limits). Raises ValueError naming the field."""
-        n = robot.NUM_JOINTS
+        n = TASK_JOINTS
         waypoints = real_array(self.waypoints, "waypoints", "m and rad, shape (w, 6)")
         if waypoints.ndim == 1 and waypoints.shape == (6,):
             waypoints = waypoints[None, :]
@@ -166,7 +168,7 @@ class PajakConfig:
 
 def paper_initial_configuration() -> np.ndarray:
     """q(0) of the paper's task: [-π/2, -π/2, -3π/4, -π/4, π/2, π/4] [rad] (the UR10e's home)."""
-    return np.array(robot.HOME)
+    return np.array(ur10e.HOME)
 
 
 def paper_parameters(simulation: int = 3, **overrides) -> PajakConfig:

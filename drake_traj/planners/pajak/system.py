@@ -35,13 +35,15 @@ class PajakPlanner(PlannerSystem):
     Args:
         parameters: the task and the law's settings.
         q_initial: joint positions at t = 0 [rad].
-        robot: the robot (:class:`PajakLaw`: the UR10e).
+        robot: the robot, a 6-axis arm with task-space kinematics (:class:`PajakLaw`; default the
+            UR10e); the planner's :attr:`robot`.
     """
 
     plans_online = True
 
     def __init__(self, parameters: PajakConfig, q_initial, *, robot: Robot = UR10E):
         self.law = PajakLaw(parameters, robot)
+        self.robot = self.law.robot
         update_period = self.law.parameters.update_period
         initial = self.law.initial_discrete()
         super().__init__(finite_array(q_initial, "q_initial", "rad", shape=(robot.num_joints,)),
@@ -143,6 +145,6 @@ class PajakPlanner(PlannerSystem):
 
 
 def make(config: PajakConfig, robot: Robot, q_initial) -> PajakPlanner:
-    """The planner of ``config`` on ``robot`` (one with the task kinematics the compiled law is
-    bound to: the UR10e), starting at rest at ``q_initial`` [rad]."""
+    """The planner of ``config`` on ``robot`` (a 6-axis arm with the task kinematics the compiled
+    law is bound to, :class:`PajakLaw`), starting at rest at ``q_initial`` [rad]."""
     return PajakPlanner(config, q_initial, robot=robot)

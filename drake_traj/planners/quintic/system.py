@@ -3,7 +3,7 @@
 
 import numpy as np
 
-from drake_traj.planners.base import TimeLawPlanner
+from drake_traj.planners.base import TimeLawPlanner, planner_robot
 from drake_traj.planners.quintic.law import QuinticLaw
 from drake_traj.planners.quintic.profile import UNITS
 from drake_traj.robots import UR10E, Robot
@@ -32,7 +32,7 @@ class QuinticPtpPlanner(TimeLawPlanner):
             joint_limit(acceleration_limit, "acceleration_limit", plan.num_joints, UNITS),
             update_period=update_period,
         )
-        self.robot = robot
+        self.robot = planner_robot(robot, self.num_joints)
 
     def task_waypoints(self) -> np.ndarray:
         """Tool positions at the joint goals [m]."""
