@@ -31,8 +31,9 @@ DH_ARM = {"name": "six_axis", "dh": [[0.1807, 0, 1.5708, 0], [0, -0.6127, 0, 0],
 class ThreeKiloArm(UR10e):
     """The UR10e's kinematics rated for 3 kg (a test robot: a second 6-axis arm with its own rating)."""
 
-    name = "three_kilo_arm"
-    rated_payload = 3.0
+    def __init__(self):
+        super().__init__()
+        self.name, self.rated_payload = "three_kilo_arm", 3.0
 
 
 def scenario(tmp_path, robot_yaml: str, cell_yaml: str = "") -> object:

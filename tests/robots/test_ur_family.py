@@ -48,7 +48,7 @@ def test_the_family_is_registered_and_an_unknown_name_lists_the_known_ones():
     for arm in UR_ARMS:
         assert get_robot(arm.name) is arm and arm.name in ROBOT_NAMES
     assert get_robot("ur10e") is UR10E
-    with pytest.raises(ValueError, match=r"robot must be one of .*'ur3e', 'ur5e', 'ur16e', 'ur20'.* got 'ur7e'"):
+    with pytest.raises(ValueError, match=r"robot must be one of the known robots, got 'ur7e'; known: .*ur3e .*ur5e .*ur16e .*ur20 "):
         get_robot("ur7e")
 
 
