@@ -39,7 +39,7 @@ from pydrake.multibody.tree import Frame, RevoluteJoint, WeldJoint
 from drake_traj.compiled import compiled
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError, joint_label
 from drake_traj.robots.base import FLANGE, format_point
-from drake_traj.robots.task_space import rotation_from_zyx_euler, tcp_rows_into, wrap_angle
+from drake_traj.robots.task_space import rotation_from_zyx_euler, tcp_rows_into, velocity_product_terms, wrap_angle
 from drake_traj.validation import finite_array, invalid, real_array
 
 __all__ = ["CHAIN", "SerialChain", "chain_kinematics", "chain_kinematics_into", "chain_reach",
@@ -337,12 +337,11 @@ def chain_kinematics_into(model, q, qd, tool, pose, jac, bias):
     """k(q) into ``pose`` (6), the analytic J into ``jac`` (6, 6) and J̇q̇ into ``bias`` (6) of the
     TCP ``tool`` (X_FT, 4x4) of the packed chain ``model`` (:meth:`SerialChain.packed`) at q
     [rad], q̇ [rad/s]; returns (cos φ_Y, singularity measure) — the contract of
-    :func:`drake_traj.robots.ur10e.kinematics_into`, base frame, metres and radians.
+    :func:`drake_traj.robots.ur_closed_form.kinematics_into`, base frame, metres and radians.
 
     Joint axes z_j at origins o_j and the flange by the chain product; J_v columns
-    z_j x (o_F - o_j); the bias by the velocity/acceleration recursion with q̈ = 0
-    (α_{j+1} = α_j + ω_j x z_j q̇_j, ω_{j+1} = ω_j + z_j q̇_j, a_{j+1} = a_j + α_{j+1} x r_j +
-    ω_{j+1} x (ω_{j+1} x r_j) along r_j = o_{j+1} - o_j, o_6 the flange); the measure (the Hadamard
+    z_j x (o_F - o_j); the bias by :func:`~drake_traj.robots.task_space.velocity_product_terms`
+    along r_j = o_{j+1} - o_j (o_6 the flange); the measure (the Hadamard
     ratio's cube root, module docstring) from the flange's columns; the TCP and Euler rows by
     :func:`~drake_traj.robots.task_space.tcp_rows_into`.
     """
@@ -355,25 +354,13 @@ def chain_kinematics_into(model, q, qd, tool, pose, jac, bias):
         jac[0, j] = axes[j, 1] * d2 - axes[j, 2] * d1
         jac[1, j] = axes[j, 2] * d0 - axes[j, 0] * d2
         jac[2, j] = axes[j, 0] * d1 - axes[j, 1] * d0
-    w0 = w1 = w2 = 0.0
-    al0 = al1 = al2 = 0.0
-    l0 = l1 = l2 = 0.0
+    links = np.empty((6, 3))
     for j in range(6):
-        z0, z1, z2 = axes[j, 0] * qd[j], axes[j, 1] * qd[j], axes[j, 2] * qd[j]
-        al0 += w1 * z2 - w2 * z1
-        al1 += w2 * z0 - w0 * z2
-        al2 += w0 * z1 - w1 * z0
-        w0 += z0
-        w1 += z1
-        w2 += z2
-        r0, r1, r2 = origins[j + 1, 0] - origins[j, 0], origins[j + 1, 1] - origins[j, 1], \
-            origins[j + 1, 2] - origins[j, 2]
-        u0, u1, u2 = w1 * r2 - w2 * r1, w2 * r0 - w0 * r2, w0 * r1 - w1 * r0
-        l0 += al1 * r2 - al2 * r1 + w1 * u2 - w2 * u1
-        l1 += al2 * r0 - al0 * r2 + w2 * u0 - w0 * u2
-        l2 += al0 * r1 - al1 * r0 + w0 * u1 - w1 * u0
+        for k in range(3):
+            links[j, k] = origins[j + 1, k] - origins[j, k]
+    omega, alpha, acceleration = np.empty(3), np.empty(3), np.empty(3)
+    velocity_product_terms(axes, links, qd, omega, alpha, acceleration)  # the bias (q̈ = 0)
     measure = _hadamard_ratio(jac, axes, model[_LENGTH])
-    omega, alpha, acceleration = np.array((w0, w1, w2)), np.array((al0, al1, al2)), np.array((l0, l1, l2))
     cy = tcp_rows_into(rotation, axes, flange, omega, alpha, acceleration, tool, pose, jac, bias)
     return cy, measure
 

@@ -13,7 +13,7 @@ import numpy as np
 from drake_traj.compiled import compiled
 
 __all__ = ["euler_rate_matrix", "is_flange", "orientation_error", "pose_error", "rotation_from_zyx_euler", "task_pose_error",
-           "tcp_rows_into", "wrap_angle", "wrapped", "zyx_euler_from_rotation"]
+           "tcp_rows_into", "velocity_product_terms", "wrap_angle", "wrapped", "zyx_euler_from_rotation"]
 
 
 @compiled
@@ -129,6 +129,35 @@ def is_flange(tool) -> bool:
             if tool[i, j] != (1.0 if i == j else 0.0):
                 return False
     return True
+
+
+@compiled
+def velocity_product_terms(axes, links, qd, omega, alpha, acceleration):
+    """The flange's angular velocity ω into ``omega`` (3) [rad/s] and its velocity-product
+    accelerations (those at q̈ = 0) J̇_ω q̇ into ``alpha`` (3) [rad/s²] and J̇_v q̇ of its origin
+    into ``acceleration`` (3) [m/s²], for a chain of six revolute joints with axes z_j (``axes``
+    (6, 3), unit, base frame) and link vectors r_j = o_{j+1} - o_j (``links`` (6, 3) [m]; o_6 the
+    flange) at joint rates ``qd`` (6) [rad/s]. The recursion: α_{j+1} = α_j + ω_j x z_j q̇_j,
+    ω_{j+1} = ω_j + z_j q̇_j, a_{j+1} = a_j + α_{j+1} x r_j + ω_{j+1} x (ω_{j+1} x r_j)."""
+    w0 = w1 = w2 = 0.0
+    al0 = al1 = al2 = 0.0
+    l0 = l1 = l2 = 0.0
+    for j in range(6):
+        z0, z1, z2 = axes[j, 0] * qd[j], axes[j, 1] * qd[j], axes[j, 2] * qd[j]
+        al0 += w1 * z2 - w2 * z1
+        al1 += w2 * z0 - w0 * z2
+        al2 += w0 * z1 - w1 * z0
+        w0 += z0
+        w1 += z1
+        w2 += z2
+        r0, r1, r2 = links[j, 0], links[j, 1], links[j, 2]
+        u0, u1, u2 = w1 * r2 - w2 * r1, w2 * r0 - w0 * r2, w0 * r1 - w1 * r0
+        l0 += al1 * r2 - al2 * r1 + w1 * u2 - w2 * u1
+        l1 += al2 * r0 - al0 * r2 + w2 * u0 - w0 * u2
+        l2 += al0 * r1 - al1 * r0 + w0 * u1 - w1 * u0
+    omega[0], omega[1], omega[2] = w0, w1, w2
+    alpha[0], alpha[1], alpha[2] = al0, al1, al2
+    acceleration[0], acceleration[1], acceleration[2] = l0, l1, l2
 
 
 @compiled

@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from drake_traj.compiled import compiled
-from drake_traj.robots.task_space import tcp_rows_into
+from drake_traj.robots.task_space import tcp_rows_into, velocity_product_terms
 
 __all__ = ["UR_CLOSED_FORM", "kinematics_into", "kinematics_many", "singularity_measure_many"]
 
@@ -38,8 +38,8 @@ def kinematics_into(model, q, qd, tool, pose, jac, bias):
     ``model`` is the closed form's data [UR_CLOSED_FORM, d1, a2, a3, d4, d5, d6] [m] (an arm's
     :attr:`URData.model`); ``tool`` (4, 4) is X_FT, the TCP in the flange frame F (``tool0``). The
     standard-DH chain of :meth:`URArm.dh_frames` written out: joint axes z_j at origins o_j, flange o_6;
-    J_g columns z_j x (o_6 - o_j) and z_j; the bias by the velocity/acceleration recursion with
-    q̈ = 0; the TCP and the Euler-angle rows by :func:`~drake_traj.robots.task_space.tcp_rows_into`.
+    J_g columns z_j x (o_6 - o_j) and z_j; the bias (q̈ = 0) by
+    :func:`~drake_traj.robots.task_space.velocity_product_terms`; the TCP and the Euler-angle rows by :func:`~drake_traj.robots.task_space.tcp_rows_into`.
     """
     c1, s1 = math.cos(q[0]), math.sin(q[0])
     c2, s2 = math.cos(q[1]), math.sin(q[1])
@@ -75,33 +75,15 @@ def kinematics_into(model, q, qd, tool, pose, jac, bias):
         jac[0, j] = axes[j, 1] * p2 - axes[j, 2] * p1
         jac[1, j] = axes[j, 2] * p0 - axes[j, 0] * p2
         jac[2, j] = axes[j, 0] * p1 - axes[j, 1] * p0
-    # bias recursion (q̈ = 0): α_{j+1} = α_j + ω_j x z_j q̇_j, ω_{j+1} = ω_j + z_j q̇_j,
-    # a_{j+1} = a_j + α_{j+1} x r_j + ω_{j+1} x (ω_{j+1} x r_j)
-    w0 = w1 = w2 = 0.0
-    al0 = al1 = al2 = 0.0
-    l0 = l1 = l2 = 0.0
-    for j in range(6):
-        z0, z1, z2 = axes[j, 0] * qd[j], axes[j, 1] * qd[j], axes[j, 2] * qd[j]
-        al0 += w1 * z2 - w2 * z1
-        al1 += w2 * z0 - w0 * z2
-        al2 += w0 * z1 - w1 * z0
-        w0 += z0
-        w1 += z1
-        w2 += z2
-        r0, r1, r2 = links[j, 0], links[j, 1], links[j, 2]
-        u0, u1, u2 = w1 * r2 - w2 * r1, w2 * r0 - w0 * r2, w0 * r1 - w1 * r0
-        l0 += al1 * r2 - al2 * r1 + w1 * u2 - w2 * u1
-        l1 += al2 * r0 - al0 * r2 + w2 * u0 - w0 * u2
-        l2 += al0 * r1 - al1 * r0 + w0 * u1 - w1 * u0
+    omega, alpha, acceleration = np.empty(3), np.empty(3), np.empty(3)
+    velocity_product_terms(axes, links, qd, omega, alpha, acceleration)  # the bias (q̈ = 0)
     # the flange's rotation R_F = [x6 y6 z6]: x6 = c6 x5 - s6 z4, y6 = -s6 x5 - c6 z4, z6 = z5
     rotation = np.empty((3, 3))
     for k in range(3):
         rotation[k, 0] = c6 * x5[k] - s6 * axes[4, k]
         rotation[k, 1] = -s6 * x5[k] - c6 * axes[4, k]
         rotation[k, 2] = axes[5, k]
-    flange, omega, alpha, acceleration = np.array((p0, p1, p2)), np.array((w0, w1, w2)), np.array((al0, al1, al2)), \
-        np.array((l0, l1, l2))
-    cy = tcp_rows_into(rotation, axes, flange, omega, alpha, acceleration, tool, pose, jac, bias)
+    cy = tcp_rows_into(rotation, axes, np.array((p0, p1, p2)), omega, alpha, acceleration, tool, pose, jac, bias)
     return cy, _singularity_factors(model, math.sin(q[2]), s5, c2, c23, s234)
 
 

@@ -161,14 +161,14 @@ def test_the_payload_is_checked_against_each_arms_rating():
     tool = Cell(tool=Tool(mass=4.0, tcp_xyz=[0.0, 0.0, 0.1]))
     tool.validate(ARMS["ur5e"])
     assert CellChecker(ARMS["ur5e"], tool).plant.GetBodyByName("tool").default_mass() == 4.0
-    with pytest.raises(DrakeTrajError, match=r"cell.tool.mass = 4 kg is above the ur3e's rated payload of 3 kg") as info:
+    with pytest.raises(DrakeTrajError, match=r"cell.tool.mass = 4 kg is above the ur3e robot's rated payload of 3 kg") as info:
         tool.validate(ARMS["ur3e"])
     assert info.value.field == ("cell", "tool", "mass")
-    with pytest.raises(DrakeTrajError, match=r"above the ur3e's rated payload"):
+    with pytest.raises(DrakeTrajError, match=r"above the ur3e robot's rated payload"):
         CellChecker(ARMS["ur3e"], tool)
     heavy = Cell(tool=Tool(mass=15.0, tcp_xyz=[0.0, 0.0, 0.1]))
     heavy.validate(ARMS["ur16e"])
-    with pytest.raises(DrakeTrajError, match=r"above the ur10e's rated payload of 12.5 kg"):
+    with pytest.raises(DrakeTrajError, match=r"above the ur10e robot's rated payload of 12.5 kg"):
         heavy.validate(UR10E)
 
 
