@@ -231,7 +231,7 @@ CLI_CASES = [
     ("unknown scenario name", ["run", "nosuch"], r"no scenario file 'nosuch' and no shipped scenario"),
     ("missing scenario file", ["run", "nowhere/x.yaml"], r"scenario file nowhere/x.yaml not found"),
     ("scenario is a folder", ["run", "{dir}.yaml"], r"is a folder, not a scenario file"),
-    ("no variant", ["run", str(DIAGRAMS / "pajak.yaml")], r"no variant was given; its variants are \['sim1', 'sim2', 'sim3'\]"),
+    ("no variant", ["run", str(DIAGRAMS / "pajak.yaml")], r"no variant was given; its variants are \['sim1', 'sim2', 'sim3', 'ur3e',"),
     ("unknown variant", ["run", str(DIAGRAMS / "pajak.yaml"), "--variant", "sim4"], r"there is no variant 'sim4'"),
     ("variant of a single file", ["run", "quintic_ptp", "--variant", "sim3"], r"holds one scenario, not variants"),
     ("rate without meshcat", ["run", "quintic_ptp", "--rate", "2"], r"--rate sets up the live view; add --meshcat"),
