@@ -14,9 +14,11 @@ from pydrake.systems.framework import DiagramBuilder
 from drake_traj import QuinticConfig, cli, load_scenario, simulate
 from drake_traj.clearance import CellChecker
 from drake_traj.planners import make_planner
+from drake_traj.robots.chain import SerialChain
 from drake_traj.robots.chain_arm import ChainArm
 from drake_traj.robots.custom import DhArm
 from drake_traj.robots.task_space import orientation_error
+from drake_traj.robots.urdf_writer import touching_pairs
 from drake_traj.scenario import ScenarioError
 from drake_traj.scenario import make_planner as make_scenario_planner
 
@@ -147,6 +149,20 @@ def test_only_the_spherical_wrists_always_touching_links_are_filtered():
                     apart.add(contact.bodies)
     assert len(seen) == 14  # the 15 non-adjacent pairs of the 7 bodies but wrist 1 - wrist 3
     assert apart == seen  # each checked pair is apart somewhere: none is in contact everywhere
+
+
+def test_the_filtered_pairs_follow_from_the_geometry():
+    # the UR10e's table: its short column (d1 = 0.1807 m) puts the pedestal's top (d1 / 2) 0.0903 m
+    # below the shoulder, where axes 1 and 2 meet and the upper arm starts; its offset wrist's axes
+    # 4 and 5 meet 0.174 m (d4) from the forearm's capsule axis, 5 and 6 0.120 m (d5) from wrist 1's
+    ur10e = SerialChain.from_dh([[0.1807, 0, np.pi / 2, 0], [0, -0.6127, 0, 0], [0, -0.57155, 0, 0],
+                                 [0.17415, 0, np.pi / 2, 0], [0.11985, 0, -np.pi / 2, 0], [0.11655, 0, 0, 0]])
+    assert [pair[:2] for pair in touching_pairs(ur10e, 0.04)] == []  # 0.0903 m > 2 x 0.04 m
+    assert [pair[:2] for pair in touching_pairs(ur10e, 0.05)] == [(0, 2)]
+    assert [pair[:2] for pair in touching_pairs(ur10e, 0.07)] == [(0, 2), (4, 6)]  # 0.11985 m <= 2 x 0.07 m
+    assert [pair[:2] for pair in touching_pairs(ur10e, 0.09)] == [(0, 2), (3, 5), (4, 6)]  # 0.17415 m <= 2 x 0.09 m
+    puma = SerialChain.from_dh(puma_arm().dh)
+    assert [pair[:2] for pair in touching_pairs(puma, 0.05)] == [(4, 6)]
 
 
 @pytest.mark.parametrize("variant", ["pajak", "quintic"])
