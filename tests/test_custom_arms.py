@@ -97,40 +97,68 @@ def arm_from(dh: DhArm, convention: str, table, centres_of_mass, inertias) -> Ch
                             effort_limits=dh.effort_limits)
 
 
+def model_flanges(arm: ChainArm, convention: str, table, masses, coms, inertias, configurations) -> list:
+    """The flange poses of the arm's written model at ``configurations``, each checked against the
+    table: the model's FK (MultibodyPlant) and the SerialChain's equal the DH product to 1e-9, and
+    every link's mass, centre of mass and inertia in the world are the table's."""
+    plant = MultibodyPlant(0.0)
+    arm.add_to_plant(plant)
+    plant.Finalize()
+    context = plant.CreateDefaultContext()
+    bodies = [plant.GetBodyByName(name) for name in ("shoulder_link", "upper_arm_link", "forearm_link",
+                                                      "wrist_1_link", "wrist_2_link", "wrist_3_link")]
+    flanges = []
+    for q in configurations:
+        plant.SetPositions(context, q)
+        frames = dh_frames(table, convention, q)
+        flange = plant.GetFrameByName("tool0").CalcPoseInWorld(context).GetAsMatrix4()
+        assert np.max(np.abs(flange - frames[5])) < 1e-9  # the model's FK is the table's
+        assert np.max(np.abs(chain_pose(arm.chain, q) - flange)) < 1e-9  # and the SerialChain's
+        flanges.append(flange)
+        for body, frame, mass, com, (ixx, iyy, izz, ixy, ixz, iyz) in zip(bodies, frames, masses, coms, inertias):
+            inertia = body.CalcSpatialInertiaInBodyFrame(context)
+            X = body.EvalPoseInWorld(context).GetAsMatrix4()
+            assert inertia.get_mass() == pytest.approx(mass, abs=1e-12)
+            centre = X[:3, :3] @ inertia.get_com() + X[:3, 3]
+            assert np.max(np.abs(centre - (frame @ np.r_[com, 1.0])[:3])) < 1e-9
+            about_com = inertia.Shift(inertia.get_com()).CalcRotationalInertia().CopyToFullMatrix3()
+            table_tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+            assert np.max(np.abs(X[:3, :3] @ about_com @ X[:3, :3].T - frame[:3, :3] @ table_tensor @ frame[:3, :3].T)) < 1e-9
+    return flanges
+
+
 def test_the_written_model_is_the_table_in_both_conventions():
     dh = puma_arm()
     modified = modified_from_standard(dh)
-    arms = {"standard": (arm_from(dh, "standard", dh.dh, dh.centres_of_mass, dh.inertias), np.array(dh.dh),
-                         np.array(dh.centres_of_mass), np.array(dh.inertias)),
-            "modified": (arm_from(dh, "modified", modified["table"], modified["centres_of_mass"], modified["inertias"]),
-                         modified["table"], modified["centres_of_mass"], modified["inertias"])}
     configurations = np.random.default_rng(5).uniform(dh.lower, dh.upper, (8, 6))
     flanges = {}
-    for convention, (arm, table, coms, inertias) in arms.items():
-        plant = MultibodyPlant(0.0)
-        arm.add_to_plant(plant)
-        plant.Finalize()
-        context = plant.CreateDefaultContext()
-        bodies = [plant.GetBodyByName(name) for name in ("shoulder_link", "upper_arm_link", "forearm_link",
-                                                          "wrist_1_link", "wrist_2_link", "wrist_3_link")]
-        for q in configurations:
-            plant.SetPositions(context, q)
-            frames = dh_frames(table, convention, q)
-            flange = plant.GetFrameByName("tool0").CalcPoseInWorld(context).GetAsMatrix4()
-            assert np.max(np.abs(flange - frames[5])) < 1e-9  # the model's FK is the table's
-            assert np.max(np.abs(chain_pose(arm.chain, q) - flange)) < 1e-9  # and the SerialChain's
-            flanges.setdefault(convention, []).append(flange)
-            for body, frame, mass, com, (ixx, iyy, izz, ixy, ixz, iyz) in zip(bodies, frames, dh.masses, coms, inertias):
-                inertia = body.CalcSpatialInertiaInBodyFrame(context)
-                X = body.EvalPoseInWorld(context).GetAsMatrix4()
-                assert inertia.get_mass() == pytest.approx(mass, abs=1e-12)
-                centre = X[:3, :3] @ inertia.get_com() + X[:3, 3]
-                assert np.max(np.abs(centre - (frame @ np.r_[com, 1.0])[:3])) < 1e-9
-                about_com = inertia.Shift(inertia.get_com()).CalcRotationalInertia().CopyToFullMatrix3()
-                in_world = X[:3, :3] @ about_com @ X[:3, :3].T
-                table_tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-                assert np.max(np.abs(in_world - frame[:3, :3] @ table_tensor @ frame[:3, :3].T)) < 1e-9
-    np.testing.assert_allclose(flanges["standard"], flanges["modified"], atol=1e-9)
+    for convention, table, coms, inertias in (("standard", dh.dh, dh.centres_of_mass, dh.inertias),
+                                              ("modified", modified["table"], modified["centres_of_mass"],
+                                               modified["inertias"])):
+        arm = arm_from(dh, convention, table, coms, inertias)
+        flanges[convention] = model_flanges(arm, convention, np.array(table), dh.masses, coms, inertias, configurations)
+    np.testing.assert_allclose(flanges["standard"], flanges["modified"], atol=1e-9)  # one arm, two tables
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_random_tables_are_written_exactly(seed, convention):
+    """Seeded random tables (lengths to 0.5 m, any angles and offsets), masses, centres of mass and
+    rigid-body inertias with products: the written model is the table in either convention."""
+    rng = np.random.default_rng(seed)
+    table = np.column_stack([rng.uniform(-0.5, 0.5, (6, 2)), rng.uniform(-np.pi, np.pi, (6, 2))])
+    masses, coms = rng.uniform(0.5, 10.0, 6), rng.uniform(-0.2, 0.2, (6, 3))
+    inertias = []
+    for _ in range(6):  # principal moments of a box, turned by a random rotation
+        x, y, z = rng.uniform(0.05, 0.5, 3) ** 2
+        moments = np.diag([y + z, x + z, x + y]) / 12
+        rotation = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+        tensor = rotation @ moments @ rotation.T
+        inertias.append([tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2]])
+    arm = ChainArm.from_dh("random_arm", table, convention, masses=masses, centres_of_mass=coms, inertias=inertias,
+                           lower_limits=[-np.pi] * 6, upper_limits=[np.pi] * 6, velocity_limits=1.0,
+                           acceleration_limits=1.0, effort_limits=10.0)
+    model_flanges(arm, convention, table, masses, coms, inertias, rng.uniform(-np.pi, np.pi, (5, 6)))
 
 
 def test_only_the_spherical_wrists_always_touching_links_are_filtered():

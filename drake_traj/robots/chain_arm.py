@@ -201,9 +201,12 @@ class ChainArm(Robot):
                 raise DrakeTrajError(f"{key} missing for the custom arm {name!r}: its model is written from the DH "
                                      f"table and needs it (pass {key}=)", field=(key,))
         text = dh_table_urdf(name, table, convention, masses=masses, centres_of_mass=centres_of_mass,
-                             inertias=inertias, link_radius=link_radius, lower=limits["lower_limits"],
-                             upper=limits["upper_limits"], velocity=limits["velocity_limits"],
-                             effort=limits["effort_limits"], source=limits.get("data_source") or "")
+                             inertias=inertias, link_radius=link_radius,
+                             lower=joint_bound(limits["lower_limits"], "lower_limits", NUM_JOINTS, "rad"),
+                             upper=joint_bound(limits["upper_limits"], "upper_limits", NUM_JOINTS, "rad"),
+                             velocity=joint_limit(limits["velocity_limits"], "velocity_limits", NUM_JOINTS, "rad/s"),
+                             effort=joint_limit(limits["effort_limits"], "effort_limits", NUM_JOINTS, "N m"),
+                             source=limits.get("data_source") or "")
         return cls.from_plant(_parsed_text(text), base_frame="base", tool_frame="tool0", name=name, chain=chain,
                               model_text=text, **limits)
 
