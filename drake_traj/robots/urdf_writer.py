@@ -82,13 +82,14 @@ def _rpy(rotation) -> tuple[float, float, float]:
             math.atan2(r[1, 0], r[0, 0]) + 0.0)
 
 
-def chain_segments(chain: SerialChain, *, pedestal: bool = True) -> list[list[tuple[np.ndarray, np.ndarray]]]:
+def chain_segments(chain: SerialChain, pedestal: float | None = None) -> list[list[tuple[np.ndarray, np.ndarray]]]:
     """The line segments (start, end) [m] a plain model of ``chain`` puts its links' capsules on,
     each in its body's frame (the base's frame; M(i) for link i): link i runs from joint i (the
     origin of M(i)) along the joint's axis to the foot of the next joint's origin, then across to
-    it (where both parts are zero: a point, a ball at the joint). With ``pedestal``, the base
-    holds the lower half of link 1's part along joint 1's axis, so that link 1 stays clear of a
-    table flush with the base, and link 1 the upper half. Base first, then links 1..6."""
+    it (where both parts are zero: a point, a ball at the joint). With a ``pedestal`` radius [m],
+    the base holds the lower half of link 1's part along joint 1's axis, starting that far above
+    joint 1's origin (so that a capsule on it stands on a table flush with the base), and link 1
+    the upper half, clear of the table. Base first, then links 1..6."""
     segments: list[list[tuple[np.ndarray, np.ndarray]]] = [[]]
     for i in range(NUM_JOINTS):
         axis, end = chain.axes[i], chain.fixed[i + 1][:3, 3]
@@ -98,30 +99,21 @@ def chain_segments(chain: SerialChain, *, pedestal: bool = True) -> list[list[tu
             link.append((corner, end))
         segments.append(link)
     column = segments[1][0][1]  # link 1's first segment ends at its corner (or is the point at joint 1)
-    if pedestal and np.linalg.norm(column) > 1e-12 and np.allclose(np.cross(column, chain.axes[0]), 0.0):
+    height = float(np.linalg.norm(column))
+    if pedestal is not None and height > 1e-12 and np.allclose(np.cross(column, chain.axes[0]), 0.0):
         half = 0.5 * column
         segments[1][0] = (half, column)
-        start = chain.fixed[0]
-        segments[0] = [(start[:3, 3], start[:3, 3] + start[:3, :3] @ half)]
+        origin, rotation = chain.fixed[0][:3, 3], chain.fixed[0][:3, :3]
+        segments[0] = [(origin + rotation @ (min(pedestal, 0.5 * height) / height * column), origin + rotation @ half)]
     return segments
 
 
 def chain_capsules(chain: SerialChain, radii: Sequence[float], *, pedestal: bool = True) -> list[list[Shape]]:
-    """Capsules of ``radii[i-1]`` [m] on link i's :func:`chain_segments` of ``chain`` (the
-    pedestal's: ``radii[0]``, starting that far above the base's origin so that it stands on the
-    mounting surface), the ``shapes`` of :func:`chain_urdf` (base, links 1..6)."""
-    shapes = []
-    for body, segments in enumerate(chain_segments(chain, pedestal=pedestal)):
-        radius = float(radii[max(body - 1, 0)])
-        link = []
-        for k, (start, end) in enumerate(segments):
-            if body == 0:
-                length = float(np.linalg.norm(end - start))
-                start = start + min(radius, 0.5 * length) * (end - start) / length
-            link.append(capsule_between(f"{LINK_NAMES[body]}_{k}", start, end, radius,
-                                        colour="grey" if body == 0 else "blue"))
-        shapes.append(link)
-    return shapes
+    """Capsules of ``radii[i-1]`` [m] on link i's :func:`chain_segments` of ``chain`` (with a
+    pedestal of ``radii[0]`` on the base), the ``shapes`` of :func:`chain_urdf` (base, links 1..6)."""
+    return [[capsule_between(f"{LINK_NAMES[body]}_{k}", start, end, float(radii[max(body - 1, 0)]),
+                             colour="grey" if body == 0 else "blue") for k, (start, end) in enumerate(segments)]
+            for body, segments in enumerate(chain_segments(chain, float(radii[0]) if pedestal else None))]
 
 
 def _distance_to_segments(point: np.ndarray, segments) -> float:
@@ -142,7 +134,7 @@ def touching_pairs(chain: SerialChain, radius: float) -> list[tuple[int, int, st
     joints i+1..j all pass through P (turning about them keeps P fixed in both bodies), and
     their capsules overlap whenever dist(P, body i's segments) + dist(P, body j's) <= 2 radius
     (the triangle inequality). A spherical wrist's links 4 and 6 are such a pair."""
-    segments = chain_segments(chain)
+    segments = chain_segments(chain, radius)  # as chain_capsules(chain, [radius] * 6)
     pairs = []
     for i in range(NUM_JOINTS - 1):
         frames, frame = [], chain.fixed[i]  # joint frames F(i+1)..F(j) in M(i) at q = 0
