@@ -183,7 +183,8 @@ class ChainArm(Robot):
         ``centres_of_mass`` (6, 3) [m] and ``inertias`` (6, 6) rows [Ixx, Iyy, Izz, Ixy, Ixz,
         Iyz] [kg m²] in the convention's DH frames i (None: at the frame origin; a ball of
         ``link_radius``), capsules of ``link_radius`` [m]) and kept as URDF text
-        (:attr:`model_text`); every limit (lower_limits, upper_limits, velocity_limits,
+        (:attr:`model_text`, its frames ``base`` and ``tool0``: ``base_frame`` and ``tool_frame``
+        name a model file's); every limit (lower_limits, upper_limits, velocity_limits,
         acceleration_limits, effort_limits) must be given.
 
         Raises:

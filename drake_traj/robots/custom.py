@@ -180,8 +180,8 @@ class DhArm:
             Iyy, Izz, Ixy, Ixz, Iyz] [kg m²]; empty: the arm's default.
         link_radius: the radius of the links' collision capsules [m].
         payload: the rated payload [kg]; absent: not rated (then the arm takes no tool mass).
-        source: where the numbers come from (a paper, a document): the arm's ``data_source``
-            (``drake-traj robots``, results) with the scenario file.
+        source: where the numbers come from (a paper, a document): the arm's ``data_source``,
+            with the scenario file.
     """
 
     name: str = ""
