@@ -267,13 +267,19 @@ def robot_rows() -> list[tuple[str, ...]]:
 
 def list_robots(args) -> int:
     """``drake-traj robots``: a table of the known robots, the names a scenario's ``robot:`` takes
-    (an arm of one's own: ``robot: !CustomArm`` or ``!DhArm``)."""
+    (an arm of one's own: ``robot: !CustomArm`` or ``!DhArm``, with the shipped examples of one)."""
     rows = [ROBOT_COLUMNS] + robot_rows()
     widths = [max(len(row[k]) for row in rows) for k in range(len(ROBOT_COLUMNS) - 1)]
     for row in rows:
         print("  ".join(f"{cell:{width}}" for cell, width in zip(row, widths)) + "  " + row[-1])
     print("an arm of one's own in a scenario: robot: !CustomArm {model_file: ...} or robot: !DhArm {dh: ...} "
           "(drake_traj.robots.custom)")
+    own = {}  # an arm of one's own in the shipped scenarios -> (its file, its scenarios)
+    for entry in shipped_scenarios():
+        if entry.robot not in ROBOT_NAMES:
+            own.setdefault(entry.robot, (entry.path, []))[1].append(entry.name)
+    for label, (path, names) in own.items():
+        print(f"  e.g. {label} in {path} ({', '.join(names)}; drake-traj show {names[0]})")
     return EXIT_OK
 
 

@@ -205,7 +205,8 @@ class Scenario:
         taken from the scenario's folder); DrakeTrajError naming the field otherwise."""
         key = (repr(self.robot), self.directory())
         if self._robot is None or self._robot[0] != key:
-            self._robot = (key, resolve_robot(self.robot, self.directory()))
+            self._robot = (key, resolve_robot(self.robot, self.directory(), None if self.source is None else
+                                              self.source.path))
         return self._robot[1]
 
     def validate(self) -> None:

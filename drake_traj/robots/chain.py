@@ -43,7 +43,7 @@ from drake_traj.robots.task_space import rotation_from_zyx_euler, tcp_rows_into,
 from drake_traj.validation import finite_array, invalid, real_array
 
 __all__ = ["CHAIN", "SerialChain", "chain_kinematics", "chain_kinematics_into", "chain_reach",
-           "chain_singularity_factors", "inverse_kinematics_all"]
+           "chain_singularity_factors", "dh_link_frames", "dh_table", "inverse_kinematics_all"]
 
 NUM_JOINTS = 6
 CHAIN = 1.0  # model[0] of a serial chain (compiled_kinematics.task_kinematics_into)
@@ -132,26 +132,13 @@ class SerialChain:
             DrakeTrajError: a table not of shape (6, 4) (field ``table``), a non-finite entry
                 (its row and column), an unknown ``convention`` (field ``convention``).
         """
-        array = real_array(table, "table", "m and rad")
-        if array.shape != (NUM_JOINTS, 4):
-            raise invalid("table", f"the DH table must have shape (6, 4), rows [{', '.join(DH_COLUMNS)}] (m, m, rad, "
-                                   f"rad), got shape {array.shape}")
-        bad = np.argwhere(~np.isfinite(array))
-        if len(bad):
-            row, column = (int(v) for v in bad[0])
-            raise invalid("table", f"the DH table's row {row} ({joint_label(row)}), column {column} "
-                                   f"({DH_COLUMNS[column]}) must be finite, got {array[row, column]}", row, column)
-        if convention not in CONVENTIONS:
-            raise invalid("convention", f"convention must be one of {CONVENTIONS}, got {convention!r}")
+        array = dh_table(table, convention)
         fixed = np.empty((NUM_JOINTS + 1, 4, 4))
-        after = np.eye(4)  # the part of T_{i-1} after its joint's rotation
-        for i, (d, a, alpha, offset) in enumerate(array):
+        links = dh_link_frames(array, convention)  # the part of T_i after q_i's rotation
+        for i, (_, a, alpha, _) in enumerate(array):
             before = np.eye(4) if convention == "standard" else _rot_x(alpha) @ _shift(x=a)
-            fixed[i] = after @ before
-            after = _rot_z(offset) @ _shift(z=d)  # Rz(q + offset) = Rz(q) Rz(offset)
-            if convention == "standard":
-                after = after @ _shift(x=a) @ _rot_x(alpha)
-        fixed[NUM_JOINTS] = after
+            fixed[i] = before if i == 0 else links[i - 1] @ before
+        fixed[NUM_JOINTS] = links[NUM_JOINTS - 1]
         return cls(fixed, np.tile([0.0, 0.0, 1.0], (NUM_JOINTS, 1)))
 
     @classmethod
@@ -181,6 +168,38 @@ class SerialChain:
                                                axis=1).ravel(), self.axes.ravel()])
         model.flags.writeable = False
         return model
+
+
+def dh_table(table, convention: str) -> np.ndarray:
+    """``table`` as a finite (6, 4) array of rows [d, a, alpha, theta_offset] (m, m, rad, rad);
+    DrakeTrajError naming the field (``table``, its row and column; ``convention``) otherwise."""
+    array = real_array(table, "table", "m and rad")
+    if array.shape != (NUM_JOINTS, 4):
+        raise invalid("table", f"the DH table must have shape (6, 4), rows [{', '.join(DH_COLUMNS)}] (m, m, rad, "
+                               f"rad), got shape {array.shape}")
+    bad = np.argwhere(~np.isfinite(array))
+    if len(bad):
+        row, column = (int(v) for v in bad[0])
+        raise invalid("table", f"the DH table's row {row} ({joint_label(row)}), column {column} "
+                               f"({DH_COLUMNS[column]}) must be finite, got {array[row, column]}", row, column)
+    if convention not in CONVENTIONS:
+        raise invalid("convention", f"convention must be one of {CONVENTIONS}, got {convention!r}")
+    return array
+
+
+def dh_link_frames(table, convention: str = "standard") -> np.ndarray:
+    """(6, 4, 4): DH frame i (the frame a DH table gives link i's centre of mass and inertia in)
+    in the frame M(i) of :class:`SerialChain` (link i's joint frame turned by q_i), i = 1..6:
+    Rz(θ_offset_i) Tz(d_i) Tx(a_i) Rx(α_i) in the standard convention (frame i on joint i+1's
+    axis), Rz(θ_offset_i) Tz(d_i) in the modified one (frame i on joint i's axis). ``table`` as
+    :meth:`SerialChain.from_dh`."""
+    array = dh_table(table, convention)
+    frames = np.empty((NUM_JOINTS, 4, 4))
+    for i, (d, a, alpha, offset) in enumerate(array):
+        frames[i] = _rot_z(offset) @ _shift(z=d)  # Rz(q + offset) = Rz(q) Rz(offset)
+        if convention == "standard":
+            frames[i] = frames[i] @ _shift(x=a) @ _rot_x(alpha)
+    return frames
 
 
 def plant_frame(plant, frame, name: str) -> Frame:

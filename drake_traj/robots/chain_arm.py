@@ -16,10 +16,11 @@ from pydrake.multibody.plant import MultibodyPlant
 
 from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_label
 from drake_traj.robots.base import Robot, TaskKinematics, format_point
-from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_kinematics, chain_singularity_factors,
+from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_kinematics, chain_reach, chain_singularity_factors,
                                      inverse_kinematics_all, plant_chain, plant_frame)
 from drake_traj.robots.compiled_kinematics import task_kinematics_into
 from drake_traj.robots.task_space import orientation_error, pose_error, wrap_angle, wrapped
+from drake_traj.robots.urdf_writer import dh_table_urdf
 from drake_traj.validation import finite_array, invalid, joint_bound, joint_limit, path_argument
 
 __all__ = ["ChainArm"]
@@ -50,7 +51,7 @@ class ChainArm(Robot):
         chain: the kinematics.
         name: the arm's name (messages, scenario output).
         model_file: the URDF/SDF the simulation parses (:meth:`add_to_plant`); None for an arm
-            only planned for (built from a user's plant).
+            only planned for (built from a user's plant) or one with ``model_text``.
         base_frame, tool_frame: frame names in the model file.
         joint_names: the six joints, base to tool.
         lower_limits, upper_limits: joint position limits [rad], (6,).
@@ -61,13 +62,17 @@ class ChainArm(Robot):
         home: the start configuration [rad] (6,); default zeros clipped into the limits (often a
             singular configuration, the arm stretched: give one for a task-space planner).
         data_source: where the numbers come from.
+        model_text: the model as URDF text (an arm written from its DH table), parsed by
+            :meth:`add_to_plant` instead of a file.
+
+    Its :attr:`reach` is the chain's bound :func:`~drake_traj.robots.chain.chain_reach` [m].
     """
 
     joint_types = ("revolute",) * NUM_JOINTS
 
     def __init__(self, chain: SerialChain, *, name: str, model_file, base_frame: str, tool_frame: str, joint_names,
                  lower_limits, upper_limits, velocity_limits, acceleration_limits, effort_limits,
-                 rated_payload: float | None = None, home=None, data_source: str = ""):
+                 rated_payload: float | None = None, home=None, data_source: str = "", model_text: str | None = None):
         if not isinstance(chain, SerialChain):
             raise TypeError(f"chain must be a SerialChain, got {type(chain).__name__}")
         if not isinstance(name, str) or not name:
@@ -77,6 +82,7 @@ class ChainArm(Robot):
             raise invalid("joint_names", f"joint_names must be six non-empty texts, got {names!r}")
         self.chain, self.name, self.joint_names = chain, name, names
         self.model_file = None if model_file is None else path_argument(model_file, "model_file").resolve()
+        self.model_text = model_text
         self.base_frame, self.tool_frame = str(base_frame), str(tool_frame)
         given = dict(lower_limits=lower_limits, upper_limits=upper_limits, velocity_limits=velocity_limits,
                      acceleration_limits=acceleration_limits, effort_limits=effort_limits)
@@ -101,8 +107,10 @@ class ChainArm(Robot):
             raise invalid("home", f"home {joint_label(j, names)} = {home[j]:.6g} rad is beyond its limits "
                                   f"[{self._lower[j]:.6g}, {self._upper[j]:.6g}] rad", j)
         self._home = home
-        self.data_source = data_source or (f"the model file {self.model_file}" if self.model_file else "a user's plant")
+        self.data_source = data_source or (f"the model file {self.model_file}" if self.model_file else
+                                           "its DH table" if model_text else "a user's plant")
         self.model = chain.packed()
+        self.reach = chain_reach(self.model)
 
     # ---- constructors ------------------------------------------------------------------------
     @classmethod
@@ -126,13 +134,14 @@ class ChainArm(Robot):
 
     @classmethod
     def from_plant(cls, plant: MultibodyPlant, *, base_frame, tool_frame, name: str | None = None, model_file=None,
-                   chain: SerialChain | None = None, **limits) -> "ChainArm":
+                   chain: SerialChain | None = None, model_text: str | None = None, **limits) -> "ChainArm":
         """The arm of a finalized ``plant`` (a user's own, beside which a planner built from this
         arm runs): the chain from ``base_frame`` to ``tool_frame`` (Frames or names), the joint
         names, and the limits the plant has (position and velocity limits of the joints, effort
         limits of their actuators) unless ``limits`` gives them (see :meth:`from_model_file`).
         ``model_file``: the URDF/SDF of the arm for :meth:`add_to_plant` (None: the arm plans but
-        cannot add itself to a station); ``chain``: use this chain instead of the plant's (it
+        cannot add itself to a station); ``model_text``: the arm's URDF text instead of a file;
+        ``chain``: use this chain instead of the plant's (it
         must agree with the plant's to 1e-6 m and rad: :meth:`from_dh`); ``name`` defaults to
         the tool body's model instance name.
         """
@@ -155,27 +164,52 @@ class ChainArm(Robot):
                 limits[key] = np.array(values)
         return cls(chain or from_plant, name=name or plant.GetModelInstanceName(tool.model_instance()),
                    model_file=model_file, base_frame=base.name(), tool_frame=tool.name(),
-                   joint_names=[j.name() for j in joints], **{key: limits.get(key) for key in LIMIT_ARGUMENTS})
+                   joint_names=[j.name() for j in joints], model_text=model_text,
+                   **{key: limits.get(key) for key in LIMIT_ARGUMENTS})
 
     @classmethod
     def from_dh(cls, name: str, table, convention: str = "standard", *, model_file=None, base_frame: str = "base",
-                tool_frame: str = "tool0", **limits) -> "ChainArm":
+                tool_frame: str = "tool0", masses=None, centres_of_mass=None, inertias=None, link_radius: float = 0.05,
+                **limits) -> "ChainArm":
         """The arm of a DH table (:meth:`SerialChain.from_dh`; rows [d, a, alpha, theta_offset]
-        in m and rad) simulated with ``model_file`` (URDF/SDF), whose chain between
-        ``base_frame`` and ``tool_frame`` must be the table's (checked to 1e-6 m and rad at a
-        few configurations); joint names and limits as :meth:`from_model_file`.
+        in m and rad, ``convention`` "standard" or "modified").
+
+        With ``model_file`` (URDF/SDF): simulated with that file, whose chain between
+        ``base_frame`` and ``tool_frame`` must be the table's (checked to 1e-6 m and rad at a few
+        configurations); joint names and limits as :meth:`from_model_file`.
+
+        Without: the model is written from the table
+        (:func:`~drake_traj.robots.urdf_writer.dh_table_urdf`: ``masses`` (6,) [kg],
+        ``centres_of_mass`` (6, 3) [m] and ``inertias`` (6, 6) rows [Ixx, Iyy, Izz, Ixy, Ixz,
+        Iyz] [kg m²] in the convention's DH frames i (None: at the frame origin; a ball of
+        ``link_radius``), capsules of ``link_radius`` [m]) and kept as URDF text
+        (:attr:`model_text`, its frames ``base`` and ``tool0``: ``base_frame`` and ``tool_frame``
+        name a model file's); every limit (lower_limits, upper_limits, velocity_limits,
+        acceleration_limits, effort_limits) must be given.
 
         Raises:
-            DrakeTrajError: no ``model_file`` (writing one from a DH table is not available yet),
-                a table and a model file that disagree, and the errors of the other constructors.
+            DrakeTrajError: a missing limit or mass (naming it), a table and a model file that
+                disagree, and the errors of the other constructors.
         """
         chain = SerialChain.from_dh(table, convention)
-        if model_file is None:
-            raise invalid("model_file", f"the custom arm {name!r} from a DH table needs a model_file (URDF/SDF) for the "
-                                        "simulation: writing one from the table is not available yet")
-        path = path_argument(model_file, "model_file")
-        return cls.from_plant(_parsed(path), base_frame=base_frame, tool_frame=tool_frame, name=name,
-                              model_file=path, chain=chain, **limits)
+        if model_file is not None:
+            path = path_argument(model_file, "model_file")
+            return cls.from_plant(_parsed(path), base_frame=base_frame, tool_frame=tool_frame, name=name,
+                                  model_file=path, chain=chain, **limits)
+        needed = dict(masses=masses, **{key: limits.get(key) for key in LIMIT_ARGUMENTS[:5]})
+        for key, value in needed.items():
+            if value is None:
+                raise DrakeTrajError(f"{key} missing for the custom arm {name!r}: its model is written from the DH "
+                                     f"table and needs it (pass {key}=)", field=(key,))
+        text = dh_table_urdf(name, table, convention, masses=masses, centres_of_mass=centres_of_mass,
+                             inertias=inertias, link_radius=link_radius,
+                             lower=joint_bound(limits["lower_limits"], "lower_limits", NUM_JOINTS, "rad"),
+                             upper=joint_bound(limits["upper_limits"], "upper_limits", NUM_JOINTS, "rad"),
+                             velocity=joint_limit(limits["velocity_limits"], "velocity_limits", NUM_JOINTS, "rad/s"),
+                             effort=joint_limit(limits["effort_limits"], "effort_limits", NUM_JOINTS, "N m"),
+                             source=limits.get("data_source") or "")
+        return cls.from_plant(_parsed_text(text), base_frame="base", tool_frame="tool0", name=name, chain=chain,
+                              model_text=text, **limits)
 
     # ---- description -------------------------------------------------------------------------
     @property
@@ -211,7 +245,8 @@ class ChainArm(Robot):
 
     # ---- model -------------------------------------------------------------------------------
     def model_path(self) -> Path:
-        """The arm's model file (absolute); ValueError for an arm built without one."""
+        """The arm's model file (absolute); ValueError for an arm built without one (from a plant,
+        or with its model as text: :meth:`add_to_plant` adds either)."""
         if self.model_file is None:
             raise invalid("model_file", f"the custom arm {self.name!r} was built from a plant without a model_file: "
                                         "give model_file= to add it to a simulation's plant")
@@ -220,10 +255,14 @@ class ChainArm(Robot):
         return self.model_file
 
     def add_to_plant(self, plant):
-        """Parse the model file into ``plant`` (not finalized), weld ``base_frame`` to the world,
-        and give each of the six joints an actuator named ``{joint}_actuator`` (added where the
-        file has none) with the arm's effort limit [N m]. Returns the model instance."""
-        (instance,) = Parser(plant).AddModels(str(self.model_path()))
+        """Parse the model (its URDF text, else its file) into ``plant`` (not finalized), weld
+        ``base_frame`` to the world, and give each of the six joints an actuator named
+        ``{joint}_actuator`` (added where the file has none) with the arm's effort limit [N m].
+        Returns the model instance."""
+        if self.model_text is not None:
+            (instance,) = Parser(plant).AddModelsFromString(self.model_text, "urdf")
+        else:
+            (instance,) = Parser(plant).AddModels(str(self.model_path()))
         plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(self.base_frame, instance))
         actuators = (plant.get_joint_actuator(index) for index in plant.GetJointActuatorIndices())  # (instance): none
         actuated = {actuator.joint().name(): actuator for actuator in actuators  # before Finalize
@@ -307,6 +346,14 @@ def _parsed(path: Path) -> MultibodyPlant:
         Parser(plant).AddModels(str(path))
     except RuntimeError as error:
         raise invalid("model_file", f"the model file {path} could not be read: {error}") from None
+    plant.Finalize()
+    return plant
+
+
+def _parsed_text(text: str) -> MultibodyPlant:
+    """A finalized plant of the URDF ``text`` alone."""
+    plant = MultibodyPlant(0.0)
+    Parser(plant).AddModelsFromString(text, "urdf")
     plant.Finalize()
     return plant
 

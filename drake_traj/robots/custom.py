@@ -20,7 +20,8 @@ Three YAML forms (:data:`RobotChoice`)::
 
 :func:`resolve_robot` turns any of them into a :class:`~drake_traj.robots.base.Robot`; the two
 arms are built by :func:`build_chain_arm`, the one place that calls
-:class:`drake_traj.robots.chain.ChainArm`.
+:class:`drake_traj.robots.chain_arm.ChainArm` (a ``!DhArm``'s model is written from its table as
+URDF text, :func:`drake_traj.robots.urdf_writer.dh_table_urdf`).
 """
 
 from dataclasses import dataclass, field
@@ -29,7 +30,9 @@ from typing import Optional, Union
 
 import numpy as np
 
+from drake_traj.errors import DrakeTrajError, field_text
 from drake_traj.robots import ROBOT_NAMES, Robot, get_robot
+from drake_traj.robots.chain_arm import ChainArm
 from drake_traj.validation import finite_array, invalid, real_array
 
 __all__ = ["ARM_JOINTS", "CustomArm", "DhArm", "RobotChoice", "build_chain_arm", "resolve_robot", "robot_label"]
@@ -92,6 +95,20 @@ def _ranges(lower: np.ndarray | None, upper: np.ndarray | None, prefix: str) -> 
         j = int(np.flatnonzero(lower >= upper)[0])
         raise invalid(f"{prefix}.upper", f"{prefix}.upper[{j}] = {upper[j]:g} rad must be above {prefix}.lower[{j}] = "
                                           f"{lower[j]:g} rad", j)
+
+
+def _inertias(value, name: str) -> np.ndarray | None:
+    """``value`` as (ARM_JOINTS, 6) rows [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] [kg m²] of physical
+    inertias (principal moments >= 0 meeting the triangle inequality), None when empty."""
+    rows = _matrix(value, name, "kg m^2", 6, required=False)
+    for i, (ixx, iyy, izz, ixy, ixz, iyz) in enumerate([] if rows is None else rows):
+        moments = np.linalg.eigvalsh([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        tolerance = 1e-9 * max(float(np.max(np.abs(moments))), 1e-12)
+        if moments[0] < -tolerance or moments[2] > moments[0] + moments[1] + tolerance:
+            raise invalid(name, f"{name}[{i}] is not a rigid body's inertia: its principal moments "
+                                f"{', '.join(f'{m:.6g}' for m in moments)} kg m^2 must be >= 0 and each at most the sum "
+                                "of the other two", i)
+    return rows
 
 
 @dataclass
@@ -163,6 +180,8 @@ class DhArm:
             Iyy, Izz, Ixy, Ixz, Iyz] [kg m²]; empty: the arm's default.
         link_radius: the radius of the links' collision capsules [m].
         payload: the rated payload [kg]; absent: not rated (then the arm takes no tool mass).
+        source: where the numbers come from (a paper, a document): the arm's ``data_source``,
+            with the scenario file.
     """
 
     name: str = ""
@@ -178,6 +197,7 @@ class DhArm:
     inertias: list[list[float]] = field(default_factory=list)
     link_radius: float = 0.05
     payload: Optional[float] = None
+    source: str = ""
 
     CONVENTIONS = ("standard", "modified")
 
@@ -205,7 +225,7 @@ class DhArm:
                                         positive=True),
             masses=_joint_vector(self.masses, f"{prefix}.masses", "kg", required=True, positive=True),
             centres_of_mass=_matrix(self.centres_of_mass, f"{prefix}.centres_of_mass", "m", 3, required=False),
-            inertias=_matrix(self.inertias, f"{prefix}.inertias", "kg m^2", 6, required=False),
+            inertias=_inertias(self.inertias, f"{prefix}.inertias"),
             link_radius=float(radius), payload=_payload(self.payload, f"{prefix}.payload"))
 
 
@@ -218,10 +238,11 @@ def robot_label(choice: RobotChoice) -> str:
     return choice if isinstance(choice, str) else f"{choice.name} ({type(choice).__name__})"
 
 
-def resolve_robot(choice: RobotChoice, directory: Path | None = None) -> Robot:
+def resolve_robot(choice: RobotChoice, directory: Path | None = None, scenario_file: Path | None = None) -> Robot:
     """The robot of a scenario's ``robot:`` field: :func:`get_robot` for a name, or the arm a
     :class:`CustomArm` or :class:`DhArm` describes (a relative ``model_file`` from ``directory``,
-    default the working directory). Raises DrakeTrajError naming the field (``robot``,
+    default the working directory; its ``data_source`` names the model file or the DH arm's
+    ``source``, and ``scenario_file``). Raises DrakeTrajError naming the field (``robot``,
     ``robot.effort_limits``, ...)."""
     if isinstance(choice, str):
         try:
@@ -237,22 +258,32 @@ def resolve_robot(choice: RobotChoice, directory: Path | None = None) -> Robot:
         if not path.is_file():
             raise invalid("robot.model_file", f"robot.model_file {str(path)[:200]} is not a file")
         arguments["model_file"] = path
-    return build_chain_arm(choice, arguments)
+    origin = f"the model file {path}" if isinstance(choice, CustomArm) else (choice.source or "its DH table")
+    return build_chain_arm(choice, arguments, origin if scenario_file is None else f"{origin} (scenario {scenario_file})")
 
 
-def build_chain_arm(choice: CustomArm | DhArm, arguments: dict) -> Robot:
-    """The one call into :class:`drake_traj.robots.chain.ChainArm`: ``arguments`` are the checked
-    values of ``choice.validate()`` (numpy arrays [rad, rad/s, rad/s², N m, kg, m, kg m²], None
-    where not given; ``name``, frames, ``convention``, ``link_radius``, ``payload``), plus
-    ``model_file`` (an existing Path) for a :class:`CustomArm`.
+# ChainArm's argument and error fields -> the scenario's fields of a custom arm
+_ARGUMENTS = dict(lower="lower_limits", upper="upper_limits", payload="rated_payload")
+_FIELDS = {"lower_limits": "lower", "upper_limits": "upper", "rated_payload": "payload", "table": "dh",
+           "plant": "model_file"}
 
-    TODO(merge): ChainArm is written in parallel and is not in this package yet, so every custom
-    arm raises NotImplementedError here. At the merge this body becomes (with a module-level
-    ``from drake_traj.robots.chain import ChainArm`` and the argument names adjusted to ChainArm's)::
 
+def build_chain_arm(choice: CustomArm | DhArm, arguments: dict, data_source: str = "") -> Robot:
+    """The one call into :class:`drake_traj.robots.chain_arm.ChainArm`: ``arguments`` are the
+    checked values of ``choice.validate()`` (numpy arrays [rad, rad/s, rad/s², N m, kg, m, kg m²],
+    None where not given; ``name``, frames, ``convention``, ``link_radius``, ``payload``), plus
+    ``model_file`` (an existing Path) for a :class:`CustomArm`. A :class:`CustomArm` is
+    :meth:`ChainArm.from_model_file`; a :class:`DhArm` is :meth:`ChainArm.from_dh` with its
+    model written from the table (URDF text, no file). ``data_source``: where the numbers come
+    from. An error of the arm is raised at the choice's field (``robot.model_file`` for a model
+    without six revolute joints between its frames)."""
+    arguments = {_ARGUMENTS.get(key, key): value for key, value in arguments.items()}
+    try:
         if isinstance(choice, CustomArm):
-            return ChainArm.from_model_file(arguments.pop("model_file"), **arguments)
-        return ChainArm.from_dh(**arguments)
-    """
-    raise NotImplementedError(f"robot: !{type(choice).__name__} needs drake_traj.robots.chain.ChainArm, which this build "
-                              "does not have yet")
+            return ChainArm.from_model_file(arguments.pop("model_file"), data_source=data_source, **arguments)
+        return ChainArm.from_dh(arguments.pop("name"), arguments.pop("table"), arguments.pop("convention"),
+                                data_source=data_source, **arguments)
+    except DrakeTrajError as error:
+        head = _FIELDS.get(error.field[0], error.field[0]) if error.field else "model_file"
+        field = ("robot", head, *error.field[1:])
+        raise error.relocated(field, f"{field_text(field)}: {error}") from None

@@ -203,8 +203,10 @@ def test_bad_input():
     assert error.value.field == ("acceleration_limits",)
     with pytest.raises(TypeError, match=r"unknown arguments \['acceleration_limit'\]"):
         ChainArm.from_model_file(ur10e.model_path(), base_frame="base", tool_frame="tool0", acceleration_limit=1.4)
-    with pytest.raises(DrakeTrajError, match=r"needs a model_file \(URDF/SDF\)"):
-        ChainArm.from_dh("puma", PUMA_DH)
+    with pytest.raises(DrakeTrajError, match=r"masses missing for the custom arm 'puma': its model is written from the "
+                                             r"DH table") as error:
+        ChainArm.from_dh("puma", PUMA_DH)  # no model file: one is written from the table and the masses
+    assert error.value.field == ("masses",)
     with pytest.raises(DrakeTrajError, match=r"the DH table and the model file disagree"):
         ChainArm.from_dh("puma", PUMA_DH, model_file=ur10e.model_path(), acceleration_limits=1.0)
 

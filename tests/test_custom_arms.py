@@ -1,0 +1,350 @@
+"""Any 6-axis arm (issue 24): the PUMA 560 from its DH table (diagrams/puma560.yaml) through the
+closed loop, its written model against its table in both DH conventions, an arm from a user's
+URDF and from a user's plant, and bad input at its line."""
+
+import math
+
+import numpy as np
+import pytest
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+
+from drake_traj import QuinticConfig, cli, load_scenario, simulate
+from drake_traj.clearance import CellChecker
+from drake_traj.planners import make_planner
+from drake_traj.robots.chain import SerialChain
+from drake_traj.robots.chain_arm import ChainArm
+from drake_traj.robots.custom import DhArm
+from drake_traj.robots.task_space import orientation_error
+from drake_traj.robots.urdf_writer import touching_pairs
+from drake_traj.scenario import ScenarioError
+from drake_traj.scenario import make_planner as make_scenario_planner
+
+from conftest import DIAGRAMS
+
+PUMA = DIAGRAMS / "puma560.yaml"
+# relative; the logged reference is integrated (RK2 at 1 ms): its q̇ error measured 1.4e-6 rad/s
+# on the PUMA's quintic plan (1.3e-6 on the UR10e's, tests/test_simulation.py); the closed-form
+# plan itself is checked to 1e-12
+LIMIT_TOLERANCE = 3e-6
+
+
+def puma_arm() -> DhArm:
+    return load_scenario(PUMA, "quintic").robot
+
+
+def rot_x(angle):
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])
+
+
+def rot_z(angle):
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+
+
+def shift(x=0.0, z=0.0):
+    out = np.eye(4)
+    out[0, 3], out[2, 3] = x, z
+    return out
+
+
+def dh_frames(table, convention, q):
+    """DH frames 1..6 in the base frame, straight from the conventions' products."""
+    frames, pose = [], np.eye(4)
+    for (d, a, alpha, offset), angle in zip(table, q):
+        if convention == "standard":  # Rz(θ) Tz(d) Tx(a) Rx(α)
+            pose = pose @ rot_z(angle + offset) @ shift(z=d) @ shift(x=a) @ rot_x(alpha)
+        else:  # Craig: Rx(α_{i-1}) Tx(a_{i-1}) Rz(θ) Tz(d)
+            pose = pose @ rot_x(alpha) @ shift(x=a) @ rot_z(angle + offset) @ shift(z=d)
+        frames.append(pose)
+    return frames
+
+
+def chain_pose(chain, q):
+    """The flange pose of a SerialChain: fixed_0 R(a_1, q_1) fixed_1 ... R(a_6, q_6) fixed_6 (Rodrigues)."""
+    pose = chain.fixed[0].copy()
+    for axis, angle, fixed in zip(chain.axes, q, chain.fixed[1:]):
+        skew = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        turn = np.eye(4)
+        turn[:3, :3] = np.eye(3) + math.sin(angle) * skew + (1 - math.cos(angle)) * skew @ skew
+        pose = pose @ turn @ fixed
+    return pose
+
+
+def modified_from_standard(dh: DhArm) -> dict:
+    """The same arm as a modified (Craig) table: row i = [d_i, a_{i-1}, α_{i-1}, θ_i] (exact as the
+    PUMA's a_6 = α_6 = 0), its centres of mass and inertias moved from standard frame i to Craig's
+    frame i (standard frame i = Craig frame i · Tx(a_i) Rx(α_i))."""
+    table = np.array(dh.dh)
+    assert table[5, 1] == 0.0 and table[5, 2] == 0.0
+    modified = np.column_stack([table[:, 0], np.r_[0.0, table[:5, 1]], np.r_[0.0, table[:5, 2]], table[:, 3]])
+    coms, inertias = [], []
+    for (_, a, alpha, _), com, (ixx, iyy, izz, ixy, ixz, iyz) in zip(table, dh.centres_of_mass, dh.inertias):
+        X = shift(x=a) @ rot_x(alpha)
+        coms.append((X @ np.r_[com, 1.0])[:3])
+        tensor = X[:3, :3] @ np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]) @ X[:3, :3].T
+        inertias.append([tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2]])
+    return dict(table=modified, centres_of_mass=np.array(coms), inertias=np.array(inertias))
+
+
+def arm_from(dh: DhArm, convention: str, table, centres_of_mass, inertias) -> ChainArm:
+    return ChainArm.from_dh(dh.name, table, convention, masses=dh.masses, centres_of_mass=centres_of_mass,
+                            inertias=inertias, link_radius=dh.link_radius, lower_limits=dh.lower, upper_limits=dh.upper,
+                            velocity_limits=dh.velocity_limits, acceleration_limits=dh.acceleration_limits,
+                            effort_limits=dh.effort_limits)
+
+
+def model_flanges(arm: ChainArm, convention: str, table, masses, coms, inertias, configurations) -> list:
+    """The flange poses of the arm's written model at ``configurations``, each checked against the
+    table: the model's FK (MultibodyPlant) and the SerialChain's equal the DH product to 1e-9, and
+    every link's mass, centre of mass and inertia in the world are the table's."""
+    plant = MultibodyPlant(0.0)
+    arm.add_to_plant(plant)
+    plant.Finalize()
+    context = plant.CreateDefaultContext()
+    bodies = [plant.GetBodyByName(name) for name in ("shoulder_link", "upper_arm_link", "forearm_link",
+                                                      "wrist_1_link", "wrist_2_link", "wrist_3_link")]
+    flanges = []
+    for q in configurations:
+        plant.SetPositions(context, q)
+        frames = dh_frames(table, convention, q)
+        flange = plant.GetFrameByName("tool0").CalcPoseInWorld(context).GetAsMatrix4()
+        assert np.max(np.abs(flange - frames[5])) < 1e-9  # the model's FK is the table's
+        assert np.max(np.abs(chain_pose(arm.chain, q) - flange)) < 1e-9  # and the SerialChain's
+        flanges.append(flange)
+        for body, frame, mass, com, (ixx, iyy, izz, ixy, ixz, iyz) in zip(bodies, frames, masses, coms, inertias):
+            inertia = body.CalcSpatialInertiaInBodyFrame(context)
+            X = body.EvalPoseInWorld(context).GetAsMatrix4()
+            assert inertia.get_mass() == pytest.approx(mass, abs=1e-12)
+            centre = X[:3, :3] @ inertia.get_com() + X[:3, 3]
+            assert np.max(np.abs(centre - (frame @ np.r_[com, 1.0])[:3])) < 1e-9
+            about_com = inertia.Shift(inertia.get_com()).CalcRotationalInertia().CopyToFullMatrix3()
+            table_tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+            assert np.max(np.abs(X[:3, :3] @ about_com @ X[:3, :3].T - frame[:3, :3] @ table_tensor @ frame[:3, :3].T)) < 1e-9
+    return flanges
+
+
+def test_the_written_model_is_the_table_in_both_conventions():
+    dh = puma_arm()
+    modified = modified_from_standard(dh)
+    configurations = np.random.default_rng(5).uniform(dh.lower, dh.upper, (8, 6))
+    flanges = {}
+    for convention, table, coms, inertias in (("standard", dh.dh, dh.centres_of_mass, dh.inertias),
+                                              ("modified", modified["table"], modified["centres_of_mass"],
+                                               modified["inertias"])):
+        arm = arm_from(dh, convention, table, coms, inertias)
+        flanges[convention] = model_flanges(arm, convention, np.array(table), dh.masses, coms, inertias, configurations)
+    np.testing.assert_allclose(flanges["standard"], flanges["modified"], atol=1e-9)  # one arm, two tables
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_random_tables_are_written_exactly(seed, convention):
+    """Seeded random tables (lengths to 0.5 m, any angles and offsets), masses, centres of mass and
+    rigid-body inertias with products: the written model is the table in either convention."""
+    rng = np.random.default_rng(seed)
+    table = np.column_stack([rng.uniform(-0.5, 0.5, (6, 2)), rng.uniform(-np.pi, np.pi, (6, 2))])
+    masses, coms = rng.uniform(0.5, 10.0, 6), rng.uniform(-0.2, 0.2, (6, 3))
+    inertias = []
+    for _ in range(6):  # principal moments of a box, turned by a random rotation
+        x, y, z = rng.uniform(0.05, 0.5, 3) ** 2
+        moments = np.diag([y + z, x + z, x + y]) / 12
+        rotation = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+        tensor = rotation @ moments @ rotation.T
+        inertias.append([tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2]])
+    arm = ChainArm.from_dh("random_arm", table, convention, masses=masses, centres_of_mass=coms, inertias=inertias,
+                           lower_limits=[-np.pi] * 6, upper_limits=[np.pi] * 6, velocity_limits=1.0,
+                           acceleration_limits=1.0, effort_limits=10.0)
+    model_flanges(arm, convention, table, masses, coms, inertias, rng.uniform(-np.pi, np.pi, (5, 6)))
+
+
+def test_only_the_spherical_wrists_always_touching_links_are_filtered():
+    arm = load_scenario(PUMA, "quintic").base_robot()
+    assert arm.model_text.count("<drake:collision_filter_group") == 1
+    assert '<drake:member link="wrist_1_link"/>\n    <drake:member link="wrist_3_link"/>' in arm.model_text
+    checker = CellChecker(arm)
+    assert checker.contacts(arm.home_configuration, within=0.005) == []
+    bodies = {"base", "shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link", "wrist_3_link"}
+    seen, apart = set(), set()
+    for q in np.random.default_rng(3).uniform(arm.lower_limits, arm.upper_limits, (60, 6)):
+        for contact in checker.contacts(q, within=np.inf):
+            if set(contact.bodies) <= bodies:
+                seen.add(contact.bodies)
+                if contact.distance > 0.0:
+                    apart.add(contact.bodies)
+    assert len(seen) == 14  # the 15 non-adjacent pairs of the 7 bodies but wrist 1 - wrist 3
+    assert apart == seen  # each checked pair is apart somewhere: none is in contact everywhere
+
+
+def test_the_filtered_pairs_follow_from_the_geometry():
+    # the UR10e's table: its short column (d1 = 0.1807 m) puts the pedestal's top (d1 / 2) 0.0903 m
+    # below the shoulder, where axes 1 and 2 meet and the upper arm starts; its offset wrist's axes
+    # 4 and 5 meet 0.174 m (d4) from the forearm's capsule axis, 5 and 6 0.120 m (d5) from wrist 1's
+    ur10e = SerialChain.from_dh([[0.1807, 0, np.pi / 2, 0], [0, -0.6127, 0, 0], [0, -0.57155, 0, 0],
+                                 [0.17415, 0, np.pi / 2, 0], [0.11985, 0, -np.pi / 2, 0], [0.11655, 0, 0, 0]])
+    assert [pair[:2] for pair in touching_pairs(ur10e, 0.04)] == []  # 0.0903 m > 2 x 0.04 m
+    assert [pair[:2] for pair in touching_pairs(ur10e, 0.05)] == [(0, 2)]
+    assert [pair[:2] for pair in touching_pairs(ur10e, 0.07)] == [(0, 2), (4, 6)]  # 0.11985 m <= 2 x 0.07 m
+    assert [pair[:2] for pair in touching_pairs(ur10e, 0.09)] == [(0, 2), (3, 5), (4, 6)]  # 0.17415 m <= 2 x 0.09 m
+    puma = SerialChain.from_dh(puma_arm().dh)
+    assert [pair[:2] for pair in touching_pairs(puma, 0.05)] == [(4, 6)]
+
+
+@pytest.mark.parametrize("variant", ["pajak", "quintic"])
+def test_the_puma_runs_each_planner_in_the_closed_loop(variant):
+    scenario = load_scenario(PUMA, variant)
+    arm = scenario.base_robot()
+    result = simulate(scenario)
+    assert result.succeeded, result.failure
+    assert result.robot == "puma560" and np.array_equal(result.effort_limit, arm.effort_limits)
+    q_end = result.q_meas[-1]
+    if variant == "pajak":
+        goal = np.array(scenario.planner.waypoints[-1])
+        assert np.linalg.norm(arm.tcp_pose(q_end)[:3] - goal[:3]) < 1e-3
+        assert orientation_error(arm.tcp_pose(q_end)[3:], goal[3:]) < 1e-3
+        start = arm.tcp_pose(scenario.start_configuration())[3:]  # orientation held throughout
+        assert max(orientation_error(pose[3:], start) for pose in arm.tcp_pose(result.q_ref[::20])) < 0.05
+    else:
+        assert np.max(np.abs(q_end - scenario.planner.goals[-1])) < 1e-3
+        law = make_scenario_planner(scenario).law
+        _, qd, qdd = law.sample(np.linspace(0.0, law.duration, 20001))
+        assert np.max(np.abs(qd) / arm.velocity_limits) <= 1 + 1e-12
+        assert np.max(np.abs(qdd) / arm.joint_move_limits[1]) <= 1 + 1e-12
+    velocity, acceleration = arm.joint_move_limits
+    assert np.max(np.abs(result.qd_ref) / velocity) <= 1 + LIMIT_TOLERANCE
+    assert np.max(np.abs(result.qdd_ref) / acceleration) <= 1 + LIMIT_TOLERANCE
+    assert np.all(np.abs(result.tau) <= arm.effort_limits)
+    checker = scenario.cell_checker()  # what the run's preflight checked the plan with, on the executed motion
+    assert all(checker.contacts(q) == [] for q in result.q_meas[::5])
+
+
+USER_ARM = """name: user_arm
+robot: !CustomArm
+  model_file: puma.urdf
+  name: my_puma
+  acceleration_limits: [2.0, 2.0, 2.0, 2.0, 2.0, 2.0]
+  payload: 2.5
+q_initial: [0.2, 0.6, -2.5, 0.2, -0.9, 0.1]
+planner: !QuinticConfig
+  goals:
+    - [0.6, 0.4, -2.2, -0.3, -1.1, 0.5]
+"""
+
+
+def test_a_custom_arm_from_a_users_urdf_runs_a_quintic_task(tmp_path):
+    (tmp_path / "puma.urdf").write_text(load_scenario(PUMA, "quintic").base_robot().model_text)
+    path = tmp_path / "user_arm.yaml"
+    path.write_text(USER_ARM)
+    scenario = load_scenario(path)
+    arm = scenario.base_robot()
+    assert arm.name == "my_puma" and arm.model_file == tmp_path / "puma.urdf" and str(path) in arm.data_source
+    assert arm.reach == pytest.approx(0.672 + 0.4318 + math.hypot(0.0203, 0.15005) + 0.4318)
+    result = simulate(scenario)
+    assert result.succeeded and result.robot == "my_puma"
+    assert np.max(np.abs(result.q_meas[-1] - scenario.planner.goals[0])) < 1e-3
+    assert np.max(np.abs(result.qd_ref)) <= 1.0 * (1 + LIMIT_TOLERANCE)  # the file's velocity limits
+    assert np.max(np.abs(result.qdd_ref)) <= 2.0 * (1 + LIMIT_TOLERANCE)
+
+
+def test_an_arm_from_a_users_own_plant_plans_beside_it():
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    (instance,) = Parser(plant).AddModels(str(DIAGRAMS.parent / "models" / "ur5e.urdf"))  # "the user's file"
+    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("base", instance))
+    plant.Finalize()
+    arm = ChainArm.from_plant(plant, base_frame="base", tool_frame="tool0", acceleration_limits=[2.0] * 6)
+    assert arm.model_file is None and arm.data_source == "a user's plant"
+    start, goal = np.array([-1.5, -1.5, -2.0, -0.8, 1.6, 0.8]), np.array([-1.3, -1.7, -1.8, -1.0, 1.4, 1.0])
+    planner = builder.AddSystem(make_planner(QuinticConfig(goals=[goal.tolist()]), arm, start))
+    simulator = Simulator(builder.Build())
+    simulator.AdvanceTo(planner.planned_duration() + 0.01)
+    q = planner.GetOutputPort("desired_state").Eval(planner.GetMyContextFromRoot(simulator.get_context()))[:6]
+    assert np.max(np.abs(q - goal)) < 1e-6
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, q)
+    flange = plant.GetFrameByName("tool0").CalcPoseInWorld(context).GetAsMatrix4()
+    assert np.max(np.abs(chain_pose(arm.chain, q) - flange)) < 1e-9
+    with pytest.raises(ValueError, match=r"was built from a plant without a model_file"):
+        simulate(planner)
+
+
+def puma_yaml(**replace) -> str:
+    text = PUMA.read_text()
+    for old, new in replace.items():
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
+    return text
+
+
+def custom_arm_yaml(model_file: str, extra: str = "") -> str:
+    return (f"name: bad_arm\nrobot: !CustomArm\n  model_file: {model_file}\n  acceleration_limits: [2, 2, 2, 2, 2, 2]\n"
+            f"{extra}planner: !QuinticConfig\n  goals: [[0.1, 0.1, 0.1, 0.1, 0.1, 0.1]]\n")
+
+
+def line_of(text: str, start: str) -> int:
+    return next(k for k, line in enumerate(text.splitlines(), 1) if line.strip().startswith(start))
+
+
+def test_bad_custom_arms_are_refused_at_their_line_naming_the_field(tmp_path):
+    model = load_scenario(PUMA, "quintic").base_robot().model_text
+    cases = [
+        ("li.urdf", (DIAGRAMS.parent / "models" / "li_4dof.urdf").read_text(), "",
+         r"robot.model_file: 4 joints between base and tool0"),
+        ("prismatic.urdf", model.replace('<joint name="joint_3" type="revolute">', '<joint name="joint_3" type="prismatic">'),
+         "", r"robot.model_file: joint 'joint_3' is PrismaticJoint: a 6-axis arm has revolute joints only"),
+        ("no_speeds.urdf", model.replace(' velocity="1.0"', ""), "",
+         r"robot.velocity_limits: velocity_limits missing for the custom arm 'custom_arm'"),
+    ]
+    for name, urdf, extra, message in cases:
+        (tmp_path / name).write_text(urdf)
+        path = tmp_path / "bad.yaml"
+        path.write_text(custom_arm_yaml(name, extra))
+        with pytest.raises(ScenarioError, match=message) as caught:
+            load_scenario(path)
+        field = caught.value.field
+        assert field[0] == "robot" and f"bad.yaml, line {line_of(path.read_text(), field[1] + ':') if field[1] == 'model_file' else 2}," in str(caught.value)
+
+
+def test_a_bad_dh_table_is_refused_by_the_command_line(tmp_path, capsys):
+    path = tmp_path / "puma.yaml"
+    path.write_text(puma_yaml(**{"    - [0.0, 0.4318, 0.0, 0.0]": "    - [0.0, .nan, 0.0, 0.0]"}))
+    assert cli.main(["run", str(path), "--variant", "quintic", "--out", str(tmp_path / "out")]) == 2
+    error = capsys.readouterr().err
+    assert f"puma.yaml, line {line_of(path.read_text(), '- [0.0, .nan')}" in error and "robot.dh[1][1] must be finite" in error
+    path.write_text(puma_yaml(**{"    - [0.0, 0.0, 0.0, 0.0]\n": "    - [0.0, 0.0, 0.0]\n"}))
+    with pytest.raises(ScenarioError, match=r"robot.dh .*rows must have the same length"):
+        load_scenario(path, "quintic")
+    path.write_text(puma_yaml(**{"[0.066, 0.086, 0.020,": "[0.066, 0.086, 0.0125,"}))  # link 3 as published
+    with pytest.raises(ScenarioError, match=r"robot.inertias\[2\] is not a rigid body's inertia: its principal moments "
+                                            r"0.0125, 0.066, 0.086 kg m\^2 must be >= 0 and each at most the sum") as caught:
+        load_scenario(path, "quintic")
+    assert caught.value.field == ("robot", "inertias", 2)
+
+
+def test_a_pajak_waypoint_beyond_the_pumas_reach_names_its_numbers(tmp_path):
+    path = tmp_path / "puma.yaml"
+    path.write_text(puma_yaml(**{"      - [0.6231217554964667, 0.2536176948257900,": "      - [1.8231217554964667, 0.2536176948257900,"}))
+    with pytest.raises(ValueError, match=r"waypoint 2 cannot be reached: .*the arm reaches at most 1\.68702 m") as caught:
+        simulate(load_scenario(path, "pajak"))
+    assert caught.value.field == ("planner", "waypoints", 2)
+    assert f"puma.yaml, line {line_of(path.read_text(), '- [1.8231')}" in str(caught.value)
+
+
+def test_a_payload_above_the_pumas_rating_is_refused(tmp_path):
+    path = tmp_path / "puma.yaml"
+    path.write_text(puma_yaml(**{"  max_duration: 30.0\n\nquintic:": "  max_duration: 30.0\n  cell:\n    tool:\n      mass: 3.0\n\nquintic:"}))
+    with pytest.raises(ScenarioError, match=r"cell.tool.mass = 3 kg is above the puma560 robot's rated payload of 2.5 kg"):
+        load_scenario(path, "pajak")
+
+
+def test_the_command_line_shows_the_puma_example(capsys):
+    assert cli.main(["list"]) == 0
+    listing = capsys.readouterr().out
+    assert any("puma560_pajak" in line and "puma560 (DhArm)" in line for line in listing.splitlines())
+    assert cli.main(["robots"]) == 0
+    robots = capsys.readouterr().out
+    assert "puma560 (DhArm)" in robots and "puma560.yaml" in robots
+    assert not any(line.startswith("puma560 ") for line in robots.splitlines())  # not a registered robot
