@@ -10,7 +10,7 @@ from typing import Union
 
 from drake_traj.planners import boryga, li, pajak, quintic
 from drake_traj.planners.baselines import movej, ruckig, toppra
-from drake_traj.planners.base import PlannerSystem
+from drake_traj.planners.base import PlannerSystem, planner_robot
 from drake_traj.planners.boryga import BorygaConfig
 from drake_traj.planners.baselines.movej import MovejConfig
 from drake_traj.planners.baselines.ruckig import RuckigConfig
@@ -46,11 +46,15 @@ PlannerConfig = Union[QuinticConfig, PajakConfig, BorygaConfig, LiConfig, MovejC
 
 
 def make_planner(config: PlannerConfig, robot: Robot, q_initial) -> PlannerSystem:
-    """The planner system ``config`` describes, on ``robot``, starting at rest at ``q_initial``."""
+    """The planner system ``config`` describes, on ``robot``, starting at rest at ``q_initial``;
+    its :attr:`~drake_traj.planners.base.PlannerSystem.robot` is ``robot`` (a station runs it
+    there and refuses another robot)."""
     try:
         maker = _MAKERS[type(config)]
     except KeyError:
         raise TypeError(f"config must be one of {[c.__name__ for c in PLANNER_CONFIGS]}, got {type(config).__name__} "
                         "(a scenario's planner is drake_traj.make_planner(scenario))") from None
     instance_of(robot, Robot, "robot")
-    return maker(config, robot, finite_array(q_initial, "q_initial", "rad or m", shape=(robot.num_joints,)))
+    planner = maker(config, robot, finite_array(q_initial, "q_initial", "rad or m", shape=(robot.num_joints,)))
+    planner.robot = planner_robot(robot, planner.num_joints)
+    return planner
