@@ -310,9 +310,10 @@ def _chain_frames(model, q, axes, origins, rotation, flange):
 
 
 @compiled
-def _determinant(matrix):
-    """det of a square matrix by Gaussian elimination with partial pivoting (``matrix`` is
-    overwritten)."""
+def _eliminate(matrix, rhs):
+    """Gaussian elimination with partial pivoting of the square ``matrix`` to upper triangular
+    form, the same row operations on ``rhs`` (both overwritten); returns det ``matrix`` (0.0, and
+    the elimination stopped, for a singular one)."""
     n = matrix.shape[0]
     det = 1.0
     for col in range(n):
@@ -325,12 +326,14 @@ def _determinant(matrix):
         if pivot != col:
             for k in range(n):
                 matrix[col, k], matrix[pivot, k] = matrix[pivot, k], matrix[col, k]
+            rhs[col], rhs[pivot] = rhs[pivot], rhs[col]
             det = -det
         det *= matrix[col, col]
         for row in range(col + 1, n):
             factor = matrix[row, col] / matrix[col, col]
             for k in range(col, n):
                 matrix[row, k] -= factor * matrix[col, k]
+            rhs[row] -= factor * rhs[col]
     return det
 
 
@@ -348,7 +351,7 @@ def _hadamard_ratio(linear, axes, length):
             scaled[3 + k, j] = axes[j, k]
             norm += scaled[k, j] ** 2 + axes[j, k] ** 2
         product *= math.sqrt(norm)
-    return min(1.0, abs(_determinant(scaled)) / product) ** (1.0 / 3.0)
+    return min(1.0, abs(_eliminate(scaled, np.zeros(6))) / product) ** (1.0 / 3.0)
 
 
 @compiled
@@ -426,28 +429,13 @@ def chain_singularity_factors(model, q) -> dict[str, tuple[float, str]]:
 
 @compiled
 def _solve6(matrix, rhs, out):
-    """out = matrix⁻¹ rhs (6x6, Gaussian elimination with partial pivoting; both overwritten);
+    """out = matrix⁻¹ rhs (6x6, :func:`_eliminate` then back substitution; both overwritten);
     False for a singular matrix."""
-    n = 6
-    for col in range(n):
-        pivot = col
-        for row in range(col + 1, n):
-            if abs(matrix[row, col]) > abs(matrix[pivot, col]):
-                pivot = row
-        if matrix[pivot, col] == 0.0:
-            return False
-        if pivot != col:
-            for k in range(n):
-                matrix[col, k], matrix[pivot, k] = matrix[pivot, k], matrix[col, k]
-            rhs[col], rhs[pivot] = rhs[pivot], rhs[col]
-        for row in range(col + 1, n):
-            factor = matrix[row, col] / matrix[col, col]
-            for k in range(col, n):
-                matrix[row, k] -= factor * matrix[col, k]
-            rhs[row] -= factor * rhs[col]
-    for row in range(n - 1, -1, -1):
+    if _eliminate(matrix, rhs) == 0.0:
+        return False
+    for row in range(5, -1, -1):
         total = rhs[row]
-        for k in range(row + 1, n):
+        for k in range(row + 1, 6):
             total -= matrix[row, k] * out[k]
         out[row] = total / matrix[row, row]
     return True
