@@ -14,11 +14,21 @@ processes load it (``cache=True``). Where the cache lives, in numba's order:
 and when none of them is writable, the kernels are compiled in every process instead of failing
 at import. IEEE semantics hold (no fastmath): a division by zero gives ±inf or NaN as in numpy
 (``error_model="numpy"``), never an exception.
+
+numba checks a cached function against its own source file only (numba issue #1833): a cached
+function that calls compiled code of another module would go on running the old code after an
+edit of that module. Such a function is made in a closure over :func:`sources_digest` of the
+modules it reaches (numba hashes a function's closure into its cache key): the pattern of
+``drake_traj.planners.pajak.kernel``, ``drake_traj.robots.compiled_kinematics``,
+``drake_traj.robots.ur_closed_form`` and ``drake_traj.robots.chain``.
 """
+
+import hashlib
+from pathlib import Path
 
 import numba
 
-__all__ = ["compiled"]
+__all__ = ["compiled", "sources_digest"]
 
 
 def compiled(function):
@@ -29,3 +39,12 @@ def compiled(function):
         return numba.njit(cache=True, error_model="numpy")(function)
     except RuntimeError:  # numba found no writable cache directory: compile in each process
         return numba.njit(error_model="numpy")(function)
+
+
+def sources_digest(*files) -> str:
+    """sha256 of the source ``files`` (each once, in sorted order): the value a compiled function
+    that reaches compiled code of those files closes over (see the module docstring)."""
+    digest = hashlib.sha256()
+    for file in sorted(set(map(str, files))):
+        digest.update(Path(file).read_bytes())
+    return digest.hexdigest()

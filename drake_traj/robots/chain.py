@@ -36,14 +36,19 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import Frame, RevoluteJoint, WeldJoint
 
-from drake_traj.compiled import compiled
+from drake_traj.compiled import compiled, sources_digest
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError, joint_label
 from drake_traj.robots.base import FLANGE, format_point
+from drake_traj.robots import task_space
 from drake_traj.robots.task_space import rotation_from_zyx_euler, tcp_rows_into, velocity_product_terms, wrap_angle
 from drake_traj.validation import finite_array, invalid, real_array
 
 __all__ = ["CHAIN", "SerialChain", "chain_kinematics", "chain_kinematics_into", "chain_reach",
            "chain_singularity_factors", "dh_link_frames", "dh_table", "inverse_kinematics_all"]
+
+# The compiled functions below that call task_space's close over its digest, numba's cache key
+# (drake_traj.compiled): an edit of task_space.py recompiles them.
+_DEPENDENCIES = sources_digest(task_space.__file__)
 
 NUM_JOINTS = 6
 CHAIN = 1.0  # model[0] of a serial chain (compiled_kinematics.task_kinematics_into)
@@ -354,43 +359,57 @@ def _hadamard_ratio(linear, axes, length):
     return min(1.0, abs(_eliminate(scaled, np.zeros(6))) / product) ** (1.0 / 3.0)
 
 
-@compiled
-def chain_kinematics_into(model, q, qd, tool, pose, jac, bias):
-    """k(q) into ``pose`` (6), the analytic J into ``jac`` (6, 6) and J̇q̇ into ``bias`` (6) of the
-    TCP ``tool`` (X_FT, 4x4) of the packed chain ``model`` (:meth:`SerialChain.packed`) at q
-    [rad], q̇ [rad/s]; returns (cos φ_Y, singularity measure) — the contract of
-    :func:`drake_traj.robots.ur_closed_form.kinematics_into`, base frame, metres and radians.
+def _chain_kinematics_into_with(dependencies):
+    @compiled
+    def chain_kinematics_into(model, q, qd, tool, pose, jac, bias):
+        """k(q) into ``pose`` (6), the analytic J into ``jac`` (6, 6) and J̇q̇ into ``bias`` (6) of the
+        TCP ``tool`` (X_FT, 4x4) of the packed chain ``model`` (:meth:`SerialChain.packed`) at q
+        [rad], q̇ [rad/s]; returns (cos φ_Y, singularity measure) — the contract of
+        :func:`drake_traj.robots.ur_closed_form.kinematics_into`, base frame, metres and radians.
 
-    Joint axes z_j at origins o_j and the flange by the chain product; J_v columns
-    z_j x (o_F - o_j); the bias by :func:`~drake_traj.robots.task_space.velocity_product_terms`
-    along r_j = o_{j+1} - o_j (o_6 the flange); the measure (the Hadamard
-    ratio's cube root, module docstring) from the flange's columns; the TCP and Euler rows by
-    :func:`~drake_traj.robots.task_space.tcp_rows_into`.
-    """
-    axes, origins = np.empty((6, 3)), np.empty((7, 3))
-    rotation, flange = np.empty((3, 3)), np.empty(3)
-    _chain_frames(model, q, axes, origins, rotation, flange)
-    origins[6, 0], origins[6, 1], origins[6, 2] = flange[0], flange[1], flange[2]
-    for j in range(6):
-        d0, d1, d2 = flange[0] - origins[j, 0], flange[1] - origins[j, 1], flange[2] - origins[j, 2]
-        jac[0, j] = axes[j, 1] * d2 - axes[j, 2] * d1
-        jac[1, j] = axes[j, 2] * d0 - axes[j, 0] * d2
-        jac[2, j] = axes[j, 0] * d1 - axes[j, 1] * d0
-    links = np.empty((6, 3))
-    for j in range(6):
-        for k in range(3):
-            links[j, k] = origins[j + 1, k] - origins[j, k]
-    omega, alpha, acceleration = np.empty(3), np.empty(3), np.empty(3)
-    velocity_product_terms(axes, links, qd, omega, alpha, acceleration)  # the bias (q̈ = 0)
-    measure = _hadamard_ratio(jac, axes, model[_LENGTH])
-    cy = tcp_rows_into(rotation, axes, flange, omega, alpha, acceleration, tool, pose, jac, bias)
-    return cy, measure
+        Joint axes z_j at origins o_j and the flange by the chain product; J_v columns
+        z_j x (o_F - o_j); the bias by :func:`~drake_traj.robots.task_space.velocity_product_terms`
+        along r_j = o_{j+1} - o_j (o_6 the flange); the measure (the Hadamard
+        ratio's cube root, module docstring) from the flange's columns; the TCP and Euler rows by
+        :func:`~drake_traj.robots.task_space.tcp_rows_into`.
+        """
+        dependencies  # noqa: B018 (numba's cache key: drake_traj.compiled.sources_digest)
+        axes, origins = np.empty((6, 3)), np.empty((7, 3))
+        rotation, flange = np.empty((3, 3)), np.empty(3)
+        _chain_frames(model, q, axes, origins, rotation, flange)
+        origins[6, 0], origins[6, 1], origins[6, 2] = flange[0], flange[1], flange[2]
+        for j in range(6):
+            d0, d1, d2 = flange[0] - origins[j, 0], flange[1] - origins[j, 1], flange[2] - origins[j, 2]
+            jac[0, j] = axes[j, 1] * d2 - axes[j, 2] * d1
+            jac[1, j] = axes[j, 2] * d0 - axes[j, 0] * d2
+            jac[2, j] = axes[j, 0] * d1 - axes[j, 1] * d0
+        links = np.empty((6, 3))
+        for j in range(6):
+            for k in range(3):
+                links[j, k] = origins[j + 1, k] - origins[j, k]
+        omega, alpha, acceleration = np.empty(3), np.empty(3), np.empty(3)
+        velocity_product_terms(axes, links, qd, omega, alpha, acceleration)  # the bias (q̈ = 0)
+        measure = _hadamard_ratio(jac, axes, model[_LENGTH])
+        cy = tcp_rows_into(rotation, axes, flange, omega, alpha, acceleration, tool, pose, jac, bias)
+        return cy, measure
+
+    return chain_kinematics_into
 
 
-@compiled
-def _kinematics_many(model, q, qd, tool, pose, jac, bias, cos_pitch, measure):
-    for k in range(q.shape[0]):
-        cos_pitch[k], measure[k] = chain_kinematics_into(model, q[k], qd[k], tool, pose[k], jac[k], bias[k])
+chain_kinematics_into = _chain_kinematics_into_with(_DEPENDENCIES)
+
+
+def _kinematics_many_with(dependencies):
+    @compiled
+    def _kinematics_many(model, q, qd, tool, pose, jac, bias, cos_pitch, measure):
+        dependencies  # noqa: B018 (numba's cache key: drake_traj.compiled.sources_digest)
+        for k in range(q.shape[0]):
+            cos_pitch[k], measure[k] = chain_kinematics_into(model, q[k], qd[k], tool, pose[k], jac[k], bias[k])
+
+    return _kinematics_many
+
+
+_kinematics_many = _kinematics_many_with(_DEPENDENCIES)
 
 
 def chain_kinematics(model, q, qd, tool=FLANGE):

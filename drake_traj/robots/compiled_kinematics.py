@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 
-from drake_traj.compiled import compiled
+from drake_traj.compiled import compiled, sources_digest
 from drake_traj.robots import chain, task_space, ur_closed_form
 from drake_traj.robots.chain import CHAIN, chain_kinematics_into
 from drake_traj.robots.ur_closed_form import UR_CLOSED_FORM
@@ -23,21 +23,29 @@ from drake_traj.robots.ur_closed_form import kinematics_into as ur_kinematics_in
 
 __all__ = ["SOURCES", "task_kinematics_into"]
 
-# The source files of the compiled code behind task_kinematics_into: a compiled caller digests
-# them into its cache key (numba checks only the caller's own file; see pajak/kernel.py).
+# The source files of the compiled code behind task_kinematics_into: it and its compiled callers
+# (the Pająk kernel) close over their digest, numba's cache key (drake_traj.compiled).
 SOURCES = (__file__, ur_closed_form.__file__, chain.__file__, task_space.__file__)
+_DEPENDENCIES = sources_digest(*SOURCES)
 
 
-@compiled
-def task_kinematics_into(model, q, qd, tool, pose, jac, bias):
-    """k(q), the analytic J and J̇q̇ of the TCP ``tool`` (X_FT, 4x4) of the arm ``model`` into
-    ``pose`` (6), ``jac`` (6, 6) and ``bias`` (6); returns (cos φ_Y, singularity measure in
-    [0, 1]). An unknown ``model[0]`` fills NaN (the callers treat a non-finite pose as a failure)."""
-    if model[0] == UR_CLOSED_FORM:
-        return ur_kinematics_into(model, q, qd, tool, pose, jac, bias)
-    if model[0] == CHAIN:
-        return chain_kinematics_into(model, q, qd, tool, pose, jac, bias)
-    pose[:] = math.nan
-    jac[:, :] = math.nan
-    bias[:] = math.nan
-    return math.nan, math.nan
+def _task_kinematics_into_with(dependencies):
+    @compiled
+    def task_kinematics_into(model, q, qd, tool, pose, jac, bias):
+        """k(q), the analytic J and J̇q̇ of the TCP ``tool`` (X_FT, 4x4) of the arm ``model`` into
+        ``pose`` (6), ``jac`` (6, 6) and ``bias`` (6); returns (cos φ_Y, singularity measure in
+        [0, 1]). An unknown ``model[0]`` fills NaN (the callers treat a non-finite pose as a failure)."""
+        dependencies  # noqa: B018 (numba's cache key: drake_traj.compiled.sources_digest)
+        if model[0] == UR_CLOSED_FORM:
+            return ur_kinematics_into(model, q, qd, tool, pose, jac, bias)
+        if model[0] == CHAIN:
+            return chain_kinematics_into(model, q, qd, tool, pose, jac, bias)
+        pose[:] = math.nan
+        jac[:, :] = math.nan
+        bias[:] = math.nan
+        return math.nan, math.nan
+
+    return task_kinematics_into
+
+
+task_kinematics_into = _task_kinematics_into_with(_DEPENDENCIES)

@@ -19,16 +19,14 @@ Equation numbers in comments are Pająk 2024's; docs/papers.md explains the corr
 improvements (each a flag of the parameters).
 """
 
-import hashlib
 import inspect
 import math
 from enum import IntEnum
-from pathlib import Path
 
 import numpy as np
 
 from drake_traj import compiled as compiled_module
-from drake_traj.compiled import compiled
+from drake_traj.compiled import compiled, sources_digest
 from drake_traj.planners.laws import scaling
 from drake_traj.planners.laws.scaling import relaxed_scaling
 from drake_traj.planners.pajak import limits
@@ -410,15 +408,7 @@ def blend_progress(position, reference, travel: float, length: float):
 # sources (``dependencies``, unused otherwise); they call each other through the module's globals.
 
 
-def _sources_digest(*files) -> str:
-    """sha256 of the source ``files`` (in sorted order)."""
-    digest = hashlib.sha256()
-    for file in sorted(set(files)):
-        digest.update(Path(file).read_bytes())
-    return digest.hexdigest()
-
-
-_DEPENDENCIES = _sources_digest(
+_DEPENDENCIES = sources_digest(
     *(inspect.getsourcefile(function.py_func) for function in (kinematics_into, orientation_error, wrapped)),
     *compiled_kinematics.SOURCES, scaling.__file__, limits.__file__, compiled_module.__file__)
 
