@@ -38,7 +38,7 @@ from drake_traj.planners.pajak.kernel import (
     finished_kernel,
     update_kernel,
 )
-from drake_traj.planners.pajak.parameters import PajakConfig
+from drake_traj.planners.pajak.parameters import PajakConfig, limits_for_robot
 from drake_traj.robots import UR10E, Robot
 
 __all__ = ["DISCRETE_NAMES", "PajakLaw"]
@@ -88,7 +88,7 @@ class PajakLaw:
         self.robot, self.kinematics = robot, kinematics
         self.tool = np.ascontiguousarray(kinematics.tool, dtype=float)  # X_FT, the kernels' ``tool``
         self.model = np.ascontiguousarray(kinematics.model, dtype=float)  # the arm, the kernels' ``model``
-        p = parameters.validate()
+        p = limits_for_robot(parameters.validate(), robot).validate()  # None limits: the robot's joint-move limits
         self.parameters = p
         self.waypoints = np.ascontiguousarray(p.waypoints)
         count = len(self.waypoints)

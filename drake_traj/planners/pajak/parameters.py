@@ -2,6 +2,7 @@
 entry, tag ``!PajakConfig``) and the paper's task (:func:`paper_parameters`)."""
 
 from dataclasses import dataclass, field, replace
+from typing import Optional
 
 import numpy as np
 
@@ -9,7 +10,8 @@ from drake_traj.robots import ur10e  # the paper's arm: its task, start and join
 from drake_traj.validation import flag, invalid, positive_vector, real_array, step_size
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
 
-__all__ = ["PAPER_METHOD", "PajakConfig", "TASK_JOINTS", "paper_initial_configuration", "paper_parameters"]
+__all__ = ["PAPER_METHOD", "PajakConfig", "TASK_JOINTS", "limits_for_robot", "paper_initial_configuration",
+           "paper_parameters"]
 
 TASK_JOINTS = 6  # the planner drives six joints, one per task coordinate [x, y, z, φ_X, φ_Y, φ_Z]
 
@@ -35,8 +37,10 @@ class PajakConfig:
         waypoints: (w, 6) task poses p_1..p_w [x, y, z, φ_X, φ_Y, φ_Z] [m, rad]; p_w is p_f.
         position_gain: Λ_P (scalar or 6 values) [1/s²], eq. 9.
         velocity_gain: Λ_V (scalar or 6 values) [1/s], eq. 9.
-        velocity_limit: q̇_max = -q̇_min (scalar or 6) [rad/s], eq. 4.
-        acceleration_limit: q̈_max = -q̈_min (scalar or 6) [rad/s²], eq. 5.
+        velocity_limit: q̇_max = -q̇_min (scalar or 6) [rad/s], eq. 4; None (left out): the
+            robot's joint-move speeds (:attr:`~drake_traj.robots.base.Robot.joint_move_limits`).
+        acceleration_limit: q̈_max = -q̈_min (scalar or 6) [rad/s²], eq. 5; None: the robot's
+            joint-move accelerations.
         vartheta: ϑ, penalty threshold on the normalised distance d (eq. 14), in (0, 0.5).
         rho: ρ, penalty strength (eq. 14) [rad²/s³], not given in the paper (ours: 0.03, docs/papers.md).
         accuracy: ε, the task is finished when the TCP is this close to p_w [m] (and its
@@ -82,8 +86,8 @@ class PajakConfig:
     waypoints: list[list[float]] = field(default_factory=list)
     position_gain: float = 20.0
     velocity_gain: float = 9.392
-    velocity_limit: float = ur10e.DEFAULT_JOINT_MOVE_VELOCITY
-    acceleration_limit: float = ur10e.DEFAULT_JOINT_MOVE_ACCELERATION
+    velocity_limit: Optional[float] = None  # (typing.Optional: the form pydrake's YAML reader takes)
+    acceleration_limit: Optional[float] = None
     vartheta: float = 0.1
     rho: float = 0.03
     accuracy: float = 0.001
@@ -110,7 +114,8 @@ class PajakConfig:
 
     def validate(self) -> "PajakConfig":
         """Check every field; return a copy with arrays normalised ((w, 6) waypoints, (6,) gains
-        and limits). Raises ValueError naming the field."""
+        and limits, None limits kept: :meth:`for_robot` fills them). Raises ValueError naming the
+        field."""
         n = TASK_JOINTS
         waypoints = real_array(self.waypoints, "waypoints", "m and rad, shape (w, 6)")
         if waypoints.ndim == 1 and waypoints.shape == (6,):
@@ -131,7 +136,9 @@ class PajakConfig:
                 "singular (gimbal lock) there", field=("waypoints", k))
         values = {}
         for name in ("position_gain", "velocity_gain", "velocity_limit", "acceleration_limit"):
-            values[name] = positive_vector(getattr(self, name), name, n)
+            value = getattr(self, name)
+            is_default_limit = value is None and name.endswith("_limit")
+            values[name] = None if is_default_limit else positive_vector(value, name, n)
         for name in (
             "rho", "accuracy", "orientation_accuracy", "neighbourhood", "scaling_rate", "scaling_slew", "jerk_budget",
             "singularity_threshold", "max_damping",
@@ -166,6 +173,14 @@ class PajakConfig:
         return replace(self, waypoints=waypoints, vartheta=float(vartheta), **values)
 
 
+def limits_for_robot(config: PajakConfig, robot) -> PajakConfig:
+    """``config`` with a velocity or acceleration limit left out (None) taken from ``robot``'s
+    joint-move limits (:attr:`~drake_traj.robots.base.Robot.joint_move_limits`, per joint)."""
+    velocity, acceleration = robot.joint_move_limits
+    return replace(config, velocity_limit=velocity if config.velocity_limit is None else config.velocity_limit,
+                   acceleration_limit=acceleration if config.acceleration_limit is None else config.acceleration_limit)
+
+
 def paper_initial_configuration() -> np.ndarray:
     """q(0) of the paper's task: [-π/2, -π/2, -3π/4, -π/4, π/2, π/4] [rad] (the UR10e's home)."""
     return np.array(ur10e.HOME)
@@ -187,6 +202,7 @@ def paper_parameters(simulation: int = 3, **overrides) -> PajakConfig:
         [0.275, -0.525, 0.730],  # p_f
     ]
     waypoints = np.array([p + orientation for p in positions])
-    settings = dict(waypoints=waypoints, limit_velocity=simulation >= 2, limit_acceleration=simulation == 3)
+    settings = dict(waypoints=waypoints, limit_velocity=simulation >= 2, limit_acceleration=simulation == 3,
+                    velocity_limit=ur10e.DEFAULT_JOINT_MOVE_VELOCITY, acceleration_limit=ur10e.DEFAULT_JOINT_MOVE_ACCELERATION)
     settings.update(overrides)
     return PajakConfig(**settings)

@@ -13,6 +13,7 @@ from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.planners.baselines.ruckig import jerk_limited_limits
 from drake_traj.planners.pajak import PajakConfig, PajakPlanner
+from drake_traj.planners.pajak.parameters import limits_for_robot
 from drake_traj.planners.smooth.timing import SmoothTiming, time_path
 from drake_traj.robots import Robot
 from drake_traj.validation import instance_of, positive_vector, whole_number
@@ -145,9 +146,10 @@ def make_retimed_pajak(config: RetimedPajakConfig, robot: Robot, q_initial) -> S
     preflight raises (an unreachable waypoint, a stall, ...) and what the timing raises."""
     instance_of(config.pajak, PajakConfig, "pajak")
     samples = pajak_joint_path(config.pajak, robot, q_initial)
+    pajak = limits_for_robot(config.pajak, robot)  # the limits the Pająk planner kept
     n = robot.num_joints
-    velocity, acceleration, jerk = jerk_limited_limits(robot, np.broadcast_to(config.pajak.velocity_limit, (n,)),
-                                                       np.broadcast_to(config.pajak.acceleration_limit, (n,)),
+    velocity, acceleration, jerk = jerk_limited_limits(robot, np.broadcast_to(pajak.velocity_limit, (n,)),
+                                                       np.broadcast_to(pajak.acceleration_limit, (n,)),
                                                        config.jerk_limit)
     timing = _timed(samples, "pajak", velocity, acceleration, jerk,
                     whole_number(config.grid_points, "grid_points", minimum=20))
