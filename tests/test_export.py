@@ -168,7 +168,7 @@ def test_every_export_names_the_robot(result, tmp_path):
     assert headers["ros2"][0].endswith("on the ur10e")
 
 
-UR_ARMS = [name for name in UR_CONTROLLER_ARMS if name in ROBOT_NAMES]
+UR_ARMS = list(UR_CONTROLLER_ARMS)
 
 
 @pytest.mark.parametrize("name", UR_ARMS)
@@ -195,3 +195,17 @@ def test_urscript_refuses_an_arm_no_ur_controller_drives(result, tmp_path, robot
                                           rf"{robot or 'an unknown robot'}$"):
         SimulationResult(**{**vars(result), "robot": robot}).export(tmp_path / "x.script", "urscript")
     assert not (tmp_path / "x.script").exists()
+
+
+def test_the_ur_controller_arms_are_the_registered_e_series_arms():
+    assert set(UR_CONTROLLER_ARMS) <= set(ROBOT_NAMES)
+    assert {"ur3e", "ur5e", "ur10e", "ur16e", "ur20"} <= set(UR_CONTROLLER_ARMS)
+    assert not {"li_4dof", "ur30"} & set(UR_CONTROLLER_ARMS)
+
+
+@pytest.mark.parametrize("robot, ur_driver", [("ur10e", True), ("ur3e", True), ("puma_like", False), ("li_4dof", False)])
+def test_the_ros2_hint_names_the_ur_driver_only_for_a_ur_arm(result, tmp_path, robot, ur_driver):
+    hint = SimulationResult(**{**vars(result), "robot": robot}).export(tmp_path / "x.yaml", "ros2",
+                                                                       period=0.01).read_text().splitlines()[1]
+    assert ("/scaled_joint_trajectory_controller/" in hint) == ur_driver
+    assert hint.startswith("# (ros2 topic pub --once /") and "/joint_trajectory " in hint
