@@ -16,7 +16,7 @@ from drake_traj.clearance import CellChecker
 from drake_traj.planners import make_planner
 from drake_traj.robots.chain import SerialChain
 from drake_traj.robots.chain_arm import ChainArm
-from drake_traj.robots.custom import DhArm
+from drake_traj.robots.custom import DhArm, resolve_robot
 from drake_traj.robots.task_space import orientation_error
 from drake_traj.robots.urdf_writer import touching_pairs
 from drake_traj.scenario import ScenarioError
@@ -348,3 +348,11 @@ def test_the_command_line_shows_the_puma_example(capsys):
     robots = capsys.readouterr().out
     assert "puma560 (DhArm)" in robots and "puma560.yaml" in robots
     assert not any(line.startswith("puma560 ") for line in robots.splitlines())  # not a registered robot
+
+
+def test_a_zero_length_dh_table_is_refused_at_dh():
+    arm = puma_arm()
+    arm.dh = [[0.0, 0.0, row[2], row[3]] for row in arm.dh]
+    with pytest.raises(ValueError, match=r"^robot.dh: a chain needs at least one link of non-zero length") as caught:
+        resolve_robot(arm)
+    assert caught.value.field == ("robot", "dh")

@@ -265,7 +265,7 @@ def resolve_robot(choice: RobotChoice, directory: Path | None = None, scenario_f
 # ChainArm's argument and error fields -> the scenario's fields of a custom arm
 _ARGUMENTS = dict(lower="lower_limits", upper="upper_limits", payload="rated_payload")
 _FIELDS = {"lower_limits": "lower", "upper_limits": "upper", "rated_payload": "payload", "table": "dh",
-           "plant": "model_file"}
+           "fixed": "dh", "axes": "dh", "plant": "model_file"}
 
 
 def build_chain_arm(choice: CustomArm | DhArm, arguments: dict, data_source: str = "") -> Robot:
