@@ -255,7 +255,10 @@ def test_an_arm_from_a_users_own_plant_plans_beside_it():
     (instance,) = Parser(plant).AddModels(str(DIAGRAMS.parent / "models" / "ur5e.urdf"))  # "the user's file"
     plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("base", instance))
     plant.Finalize()
-    arm = ChainArm.from_plant(plant, base_frame="base", tool_frame="tool0", acceleration_limits=[2.0] * 6)
+    with pytest.raises(ValueError, match=r"^the custom arm's name would be 'ur5e' \(the tool body's model instance\), "
+                                         r"a known robot's name .*give the arm a name of its own \(name=\)"):
+        ChainArm.from_plant(plant, base_frame="base", tool_frame="tool0", acceleration_limits=[2.0] * 6)
+    arm = ChainArm.from_plant(plant, name="my_arm", base_frame="base", tool_frame="tool0", acceleration_limits=[2.0] * 6)
     assert arm.model_file is None and arm.data_source == "a user's plant"
     start, goal = np.array([-1.5, -1.5, -2.0, -0.8, 1.6, 0.8]), np.array([-1.3, -1.7, -1.8, -1.0, 1.4, 1.0])
     planner = builder.AddSystem(make_planner(QuinticConfig(goals=[goal.tolist()]), arm, start))
@@ -356,3 +359,87 @@ def test_a_zero_length_dh_table_is_refused_at_dh():
     with pytest.raises(ValueError, match=r"^robot.dh: a chain needs at least one link of non-zero length") as caught:
         resolve_robot(arm)
     assert caught.value.field == ("robot", "dh")
+
+
+def puma_from_dh(name="my_puma", **change) -> ChainArm:
+    """The PUMA 560 through ChainArm.from_dh (the Python path), its data changed by ``change``."""
+    dh = puma_arm()
+    arguments = dict(masses=dh.masses, centres_of_mass=dh.centres_of_mass, inertias=dh.inertias,
+                     link_radius=dh.link_radius, lower_limits=dh.lower, upper_limits=dh.upper,
+                     velocity_limits=dh.velocity_limits, acceleration_limits=dh.acceleration_limits,
+                     effort_limits=dh.effort_limits, rated_payload=dh.payload)
+    return ChainArm.from_dh(name, dh.dh, **{**arguments, **change})
+
+
+def test_limits_upside_down_are_refused_before_drake_parses_them():
+    with pytest.raises(ValueError, match=r"^upper_limits\[0\] = -3 rad must be above lower_limits\[0\] = 3 rad") as caught:
+        ChainArm.from_dh("z", puma_arm().dh, lower_limits=[3] * 6, upper_limits=[-3] * 6, velocity_limits=1.,
+                         acceleration_limits=2., effort_limits=100., masses=[1] * 6)
+    assert caught.value.field == ("upper_limits", 0)
+
+
+def test_a_users_model_file_with_a_limit_upside_down_is_an_error_naming_the_file(tmp_path, capsys):
+    model = load_scenario(PUMA, "quintic").base_robot().model_text
+    start = model.index('<limit lower="', model.index('<joint name="joint_2"'))
+    end = model.index('velocity=', start)
+    (tmp_path / "bad.urdf").write_text(model[:start] + '<limit lower="7.0" upper="6.28" ' + model[end:])
+    path = tmp_path / "bad.yaml"
+    path.write_text(custom_arm_yaml("bad.urdf"))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
+    error = capsys.readouterr().err
+    assert "robot.model_file: the model file" in error and "bad.urdf could not be read" in error
+    with pytest.raises(ScenarioError, match=r"robot.model_file: the model file .*bad.urdf could not be read: .*joint") as caught:
+        load_scenario(path)
+    assert caught.value.field == ("robot", "model_file")
+
+
+@pytest.mark.parametrize("change, field, pattern", [
+    (dict(masses=[1.0, 1.0, 0.0, 1.0, 1.0, 1.0]), ("masses", 2), r"masses\[2\] must be positive \[kg\], got 0"),
+    (dict(masses=[1.0, -2.0, 1.0, 1.0, 1.0, 1.0]), ("masses", 1), r"masses\[1\] must be positive \[kg\], got -2"),
+    (dict(inertias=[[0.1, 0.0, 0.35, 0, 0, 0]] + [[0.1, 0.1, 0.1, 0, 0, 0]] * 5), ("inertias", 0),
+     r"inertias\[0\] is not a rigid body's inertia: its principal moments 0, 0.1, 0.35"),
+    (dict(inertias=[[0.1, 0.1, 0.1, 0, 0, 0]] * 3 + [[0.1, 0.1, 0.3, 0, 0, 0]] + [[0.1, 0.1, 0.1, 0, 0, 0]] * 2),
+     ("inertias", 3), r"inertias\[3\] is not a rigid body's inertia: .* each at most the sum of the other two"),
+    (dict(rated_payload=float("nan")), ("rated_payload",), r"rated_payload must be finite"),
+    (dict(rated_payload=-1.0), ("rated_payload",), r"rated_payload must be positive \[kg\]"),
+    (dict(link_radius=0.0), ("link_radius",), r"link_radius must be positive \[m\], got 0"),
+    (dict(link_radius=float("nan")), ("link_radius",), r"link_radius must be finite"),
+    (dict(centres_of_mass=np.zeros((6, 2))), ("centres_of_mass",),
+     r"centres_of_mass must be 6 rows of 3 numbers \[m\], got shape \(6, 2\)"),
+])
+def test_from_dh_refuses_what_the_scenario_refuses_naming_the_argument(change, field, pattern):
+    with pytest.raises(ValueError, match=pattern) as caught:
+        puma_from_dh(**change)
+    assert caught.value.field == field
+
+
+def test_the_constructor_checks_the_rated_payload(tmp_path):
+    (tmp_path / "puma.urdf").write_text(load_scenario(PUMA, "quintic").base_robot().model_text)
+    arm = ChainArm.from_model_file(tmp_path / "puma.urdf", base_frame="base", tool_frame="tool0",
+                                   acceleration_limits=2.0, rated_payload=2.5)
+    assert arm.name == "puma" and arm.rated_payload == 2.5
+    for rating in (float("nan"), 0.0, -2.5):
+        with pytest.raises(ValueError, match=r"^rated_payload must be") as caught:
+            ChainArm.from_model_file(tmp_path / "puma.urdf", base_frame="base", tool_frame="tool0",
+                                     acceleration_limits=2.0, rated_payload=rating)
+        assert caught.value.field == ("rated_payload",)
+
+
+def test_a_custom_arm_cannot_take_a_known_robots_name(tmp_path):
+    """A PUMA named "ur10e" would be exported as a UR10e's URScript: every constructor refuses a
+    known robot's name, given or defaulted from the file's stem."""
+    with pytest.raises(ValueError, match=r"^name 'ur10e' is a known robot's name") as caught:
+        puma_from_dh(name="ur10e")
+    assert caught.value.field == ("name",)
+    (tmp_path / "ur5e.urdf").write_text(load_scenario(PUMA, "quintic").base_robot().model_text)
+    with pytest.raises(ValueError, match=r"^the custom arm's name would be 'ur5e' \(the model file's name 'ur5e.urdf'\), "
+                                         r"a known robot's name .*\(name=\)") as caught:
+        ChainArm.from_model_file(tmp_path / "ur5e.urdf", base_frame="base", tool_frame="tool0", acceleration_limits=2.0)
+    assert caught.value.field == ("name",)
+    arm = ChainArm.from_model_file(tmp_path / "ur5e.urdf", name="my_puma", base_frame="base", tool_frame="tool0",
+                                   acceleration_limits=2.0)
+    assert arm.name == "my_puma"
+    with pytest.raises(ValueError, match=r"^name 'li_4dof' is a known robot's name"):
+        ChainArm(arm.chain, name="li_4dof", model_file=arm.model_file, base_frame="base", tool_frame="tool0",
+                 joint_names=arm.joint_names, lower_limits=arm.lower_limits, upper_limits=arm.upper_limits,
+                 velocity_limits=1.0, acceleration_limits=2.0, effort_limits=100.0)

@@ -15,6 +15,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
 from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_label
+from drake_traj.robots import ROBOT_NAMES, arm_checks
 from drake_traj.robots.base import Robot, TaskKinematics, format_point
 from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_kinematics, chain_reach, chain_singularity_factors,
                                      inverse_kinematics_all, plant_chain, plant_frame)
@@ -75,8 +76,7 @@ class ChainArm(Robot):
                  rated_payload: float | None = None, home=None, data_source: str = "", model_text: str | None = None):
         if not isinstance(chain, SerialChain):
             raise TypeError(f"chain must be a SerialChain, got {type(chain).__name__}")
-        if not isinstance(name, str) or not name:
-            raise invalid("name", f"name must be a non-empty text, got {name!r}")
+        arm_checks.arm_name(name, "name", plain=False)
         names = tuple(joint_names)
         if len(names) != NUM_JOINTS or not all(isinstance(n, str) and n for n in names):
             raise invalid("joint_names", f"joint_names must be six non-empty texts, got {names!r}")
@@ -92,14 +92,11 @@ class ChainArm(Robot):
                                      f"arguments give it (pass {key}=)", field=(key,))
         self._lower = joint_bound(lower_limits, "lower_limits", NUM_JOINTS, "rad")
         self._upper = joint_bound(upper_limits, "upper_limits", NUM_JOINTS, "rad")
-        if np.any(self._lower >= self._upper):
-            j = int(np.argmax(self._lower >= self._upper))
-            raise invalid("upper_limits", f"{joint_label(j, names)}: the upper limit {self._upper[j]:.6g} rad must be "
-                                          f"above the lower limit {self._lower[j]:.6g} rad", j)
+        arm_checks.ranges(self._lower, self._upper, "lower_limits", "upper_limits")
         self._velocity = joint_limit(velocity_limits, "velocity_limits", NUM_JOINTS, "rad/s")
         self._acceleration = joint_limit(acceleration_limits, "acceleration_limits", NUM_JOINTS, "rad/s^2")
         self._effort = joint_limit(effort_limits, "effort_limits", NUM_JOINTS, "N m")
-        self.rated_payload = None if rated_payload is None else float(rated_payload)
+        self.rated_payload = arm_checks.payload(rated_payload, "rated_payload")
         home = np.clip(np.zeros(NUM_JOINTS), self._lower, self._upper) if home is None else \
             finite_array(home, "home", "rad", shape=(NUM_JOINTS,))
         if np.any((home < self._lower) | (home > self._upper)):
@@ -128,9 +125,10 @@ class ChainArm(Robot):
                 neither in the file nor given (naming the field).
         """
         path = path_argument(path, "model_file")
+        name = _default_name(name, path.stem, f"the model file's name {path.name!r}")
         plant = _parsed(path)
         return cls.from_plant(plant, base_frame=base_frame, tool_frame=tool_frame, model_file=path,
-                              name=name or path.stem, **limits)
+                              name=name, **limits)
 
     @classmethod
     def from_plant(cls, plant: MultibodyPlant, *, base_frame, tool_frame, name: str | None = None, model_file=None,
@@ -162,7 +160,8 @@ class ChainArm(Robot):
         for key, values in found.items():
             if limits.get(key) is None and np.all(np.isfinite(values)):
                 limits[key] = np.array(values)
-        return cls(chain or from_plant, name=name or plant.GetModelInstanceName(tool.model_instance()),
+        name = _default_name(name, plant.GetModelInstanceName(tool.model_instance()), "the tool body's model instance")
+        return cls(chain or from_plant, name=name,
                    model_file=model_file, base_frame=base.name(), tool_frame=tool.name(),
                    joint_names=[j.name() for j in joints], model_text=model_text,
                    **{key: limits.get(key) for key in LIMIT_ARGUMENTS})
@@ -196,15 +195,24 @@ class ChainArm(Robot):
             path = path_argument(model_file, "model_file")
             return cls.from_plant(_parsed(path), base_frame=base_frame, tool_frame=tool_frame, name=name,
                                   model_file=path, chain=chain, **limits)
+        arm_checks.arm_name(name, "name")  # (the written model's name)
         needed = dict(masses=masses, **{key: limits.get(key) for key in LIMIT_ARGUMENTS[:5]})
         for key, value in needed.items():
             if value is None:
                 raise DrakeTrajError(f"{key} missing for the custom arm {name!r}: its model is written from the DH "
                                      f"table and needs it (pass {key}=)", field=(key,))
-        text = dh_table_urdf(name, table, convention, masses=masses, centres_of_mass=centres_of_mass,
-                             inertias=inertias, link_radius=link_radius,
-                             lower=joint_bound(limits["lower_limits"], "lower_limits", NUM_JOINTS, "rad"),
-                             upper=joint_bound(limits["upper_limits"], "upper_limits", NUM_JOINTS, "rad"),
+        # every argument checked before the model is written and parsed (Drake's parser exits the
+        # process on some bad data, warns only on others)
+        lower = joint_bound(limits["lower_limits"], "lower_limits", NUM_JOINTS, "rad")
+        upper = joint_bound(limits["upper_limits"], "upper_limits", NUM_JOINTS, "rad")
+        arm_checks.ranges(lower, upper, "lower_limits", "upper_limits")
+        joint_limit(limits["acceleration_limits"], "acceleration_limits", NUM_JOINTS, "rad/s^2")
+        arm_checks.payload(limits.get("rated_payload"), "rated_payload")
+        text = dh_table_urdf(name, table, convention,
+                             masses=arm_checks.joint_vector(masses, "masses", "kg", required=True, positive=True),
+                             centres_of_mass=arm_checks.matrix(centres_of_mass, "centres_of_mass", "m", 3, required=False),
+                             inertias=arm_checks.inertia_rows(inertias, "inertias"),
+                             link_radius=arm_checks.link_radius(link_radius, "link_radius"), lower=lower, upper=upper,
                              velocity=joint_limit(limits["velocity_limits"], "velocity_limits", NUM_JOINTS, "rad/s"),
                              effort=joint_limit(limits["effort_limits"], "effort_limits", NUM_JOINTS, "N m"),
                              source=limits.get("data_source") or "")
@@ -344,18 +352,37 @@ def _parsed(path: Path) -> MultibodyPlant:
     plant = MultibodyPlant(0.0)
     try:
         Parser(plant).AddModels(str(path))
-    except RuntimeError as error:
-        raise invalid("model_file", f"the model file {path} could not be read: {error}") from None
-    plant.Finalize()
+        plant.Finalize()
+    except (RuntimeError, SystemExit) as error:  # Drake's parser exits on some bad data (a limit's lower > upper)
+        raise invalid("model_file", f"the model file {path} could not be read: {_drake_reason(error)}") from None
     return plant
 
 
 def _parsed_text(text: str) -> MultibodyPlant:
-    """A finalized plant of the URDF ``text`` alone."""
+    """A finalized plant of the URDF ``text`` (written from a DH table) alone."""
     plant = MultibodyPlant(0.0)
-    Parser(plant).AddModelsFromString(text, "urdf")
-    plant.Finalize()
+    try:
+        Parser(plant).AddModelsFromString(text, "urdf")
+        plant.Finalize()
+    except (RuntimeError, SystemExit) as error:
+        raise invalid("table", f"the model written from the DH table could not be read: {_drake_reason(error)}") from None
     return plant
+
+
+def _drake_reason(error: BaseException) -> str:
+    """Drake's message of a parser failure (a SystemExit carries it as its code)."""
+    return str(error.code if isinstance(error, SystemExit) else error).strip()
+
+
+def _default_name(name: str | None, default: str, origin: str) -> str:
+    """``name``, or ``default`` (from ``origin``) unless that is a known robot's name (then a
+    DrakeTrajError asking for ``name=``: a custom arm must not pass for a known robot)."""
+    if name is not None:
+        return name
+    if default in ROBOT_NAMES:
+        raise invalid("name", f"the custom arm's name would be {default!r} ({origin}), a known robot's name (runs and "
+                              "exports are told apart by it): give the arm a name of its own (name=)")
+    return default
 
 
 def _check_agreement(chain: SerialChain, other: SerialChain) -> None:

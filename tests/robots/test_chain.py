@@ -59,7 +59,7 @@ def test_ur10e_dh_chain_is_the_closed_form(tool):
 
 
 def test_ur10e_urdf_chain_is_the_closed_form():
-    arm = ChainArm.from_model_file(ur10e.model_path(), base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
+    arm = ChainArm.from_model_file(ur10e.model_path(), name="generic_ur10e", base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
     assert arm.joint_names == ur10e.JOINT_NAMES
     np.testing.assert_array_equal(arm.upper_limits, ur10e.POSITION_LIMIT)
     np.testing.assert_array_equal(arm.velocity_limits, ur10e.VELOCITY_LIMIT)
@@ -198,11 +198,11 @@ def test_bad_input():
     plant, tool = plant_with(["revolute"] * 3 + ["prismatic"] + ["revolute"] * 2)
     with pytest.raises(DrakeTrajError, match=r"joint 'slider' is PrismaticJoint"):
         SerialChain.from_plant(plant, "world", tool)
-    with pytest.raises(DrakeTrajError, match=r"acceleration_limits missing for the custom arm 'ur10e'") as error:
-        ChainArm.from_model_file(ur10e.model_path(), base_frame="base", tool_frame="tool0")
+    with pytest.raises(DrakeTrajError, match=r"acceleration_limits missing for the custom arm 'generic_ur10e'") as error:
+        ChainArm.from_model_file(ur10e.model_path(), name="generic_ur10e", base_frame="base", tool_frame="tool0")
     assert error.value.field == ("acceleration_limits",)
     with pytest.raises(TypeError, match=r"unknown arguments \['acceleration_limit'\]"):
-        ChainArm.from_model_file(ur10e.model_path(), base_frame="base", tool_frame="tool0", acceleration_limit=1.4)
+        ChainArm.from_model_file(ur10e.model_path(), name="generic_ur10e", base_frame="base", tool_frame="tool0", acceleration_limit=1.4)
     with pytest.raises(DrakeTrajError, match=r"masses missing for the custom arm 'puma': its model is written from the "
                                              r"DH table") as error:
         ChainArm.from_dh("puma", PUMA_DH)  # no model file: one is written from the table and the masses
@@ -229,7 +229,8 @@ def test_add_to_plant_gives_every_joint_its_actuator(tmp_path):
     for joint, effort in zip(ur10e.JOINT_NAMES, efforts):
         actuator = plant.GetJointActuatorByName(f"{joint}_actuator", instance)
         assert actuator.joint().name() == joint and actuator.effort_limit() == effort
-    planned = ChainArm.from_plant(plant, base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
+    planned = ChainArm.from_plant(plant, name="generic_ur10e", base_frame="base", tool_frame="tool0",
+                                  acceleration_limits=1.4)
     np.testing.assert_array_equal(planned.effort_limits, efforts)
     np.testing.assert_allclose(planned.tcp_pose(ur10e.HOME), ur10e.task_pose(ur10e.HOME), atol=1e-12, rtol=0)
     with pytest.raises(DrakeTrajError, match=r"built from a plant without a model_file"):
