@@ -443,3 +443,65 @@ def test_a_custom_arm_cannot_take_a_known_robots_name(tmp_path):
         ChainArm(arm.chain, name="li_4dof", model_file=arm.model_file, base_frame="base", tool_frame="tool0",
                  joint_names=arm.joint_names, lower_limits=arm.lower_limits, upper_limits=arm.upper_limits,
                  velocity_limits=1.0, acceleration_limits=2.0, effort_limits=100.0)
+
+
+def six_r_sdf() -> str:
+    """A small 6R arm as SDFormat (axes z, y, y, x, y, x; links of 1 kg), the joints with effort
+    limits: Drake's SDF parser gives each an actuator named after the joint."""
+    origins = [(0, 0, 0.2), (0, 0, 0.1), (0.3, 0, 0), (0.3, 0, 0), (0.1, 0, 0), (0.1, 0, 0)]
+    axes = ["0 0 1", "0 1 0", "0 1 0", "1 0 0", "0 1 0", "1 0 0"]
+    inertial = ("<inertial><mass>1.0</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz>"
+                "<ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>")
+    links, joints, pose = ['<link name="base">' + inertial + "</link>"], [], np.zeros(3)
+    for i, (origin, axis) in enumerate(zip(origins, axes), 1):
+        pose = pose + origin
+        links.append(f'<link name="link{i}"><pose>{pose[0]} {pose[1]} {pose[2]} 0 0 0</pose>{inertial}</link>')
+        joints.append(f'<joint name="j{i}" type="revolute"><parent>{"base" if i == 1 else f"link{i - 1}"}</parent>'
+                      f'<child>link{i}</child><axis><xyz>{axis}</xyz><limit><lower>-3</lower><upper>3</upper>'
+                      f'<velocity>2</velocity><effort>60</effort></limit></axis></joint>')
+    return ('<?xml version="1.0"?>\n<sdf version="1.9"><model name="six_r">' + "".join(links) + "".join(joints)
+            + '<frame name="tool0" attached_to="link6"><pose>0.05 0 0 0 0 0</pose></frame></model></sdf>\n')
+
+
+@pytest.mark.parametrize("model", ["six_r.sdf", "ros_style.urdf"])
+def test_an_sdf_arm_and_an_arm_with_its_own_actuator_names_run_in_the_closed_loop(tmp_path, model):
+    """The station finds each joint's actuator by its joint, whatever the model calls it."""
+    if model.endswith(".sdf"):
+        text, goal = six_r_sdf(), [0.4, -0.3, 0.5, 0.3, -0.4, 0.2]
+    else:
+        text = load_scenario(PUMA, "quintic").base_robot().model_text
+        assert text.count('_actuator">') == 6
+        text, goal = text.replace('_actuator">', '_motor">'), [0.6, 0.4, -2.2, -0.3, -1.1, 0.5]
+    (tmp_path / model).write_text(text)
+    path = tmp_path / "arm.yaml"
+    path.write_text(f"name: own_actuators\nrobot: !CustomArm\n  model_file: {model}\n  name: my_arm\n"
+                    "  acceleration_limits: [2, 2, 2, 2, 2, 2]\n"
+                    f"q_initial: {[0.2, 0.6, -2.5, 0.2, -0.9, 0.1] if model.endswith('.urdf') else [0.0] * 6}\n"
+                    f"planner: !QuinticConfig\n  goals: [{goal}]\n")
+    scenario = load_scenario(path)
+    plant = MultibodyPlant(0.001)
+    instance = scenario.base_robot().add_to_plant(plant)
+    plant.Finalize()
+    names = [plant.get_joint_actuator(index).name() for index in plant.GetJointActuatorIndices(instance)]
+    assert names == ([f"j{i}" for i in range(1, 7)] if model.endswith(".sdf") else [f"joint_{i}_motor" for i in range(1, 7)])
+    result = simulate(scenario)
+    assert result.succeeded and result.robot == "my_arm"
+    assert np.max(np.abs(result.q_meas[-1] - goal)) < 1e-3
+    assert np.max(np.abs(result.qd_ref)) <= (2.0 if model.endswith(".sdf") else 1.0) * (1 + LIMIT_TOLERANCE)
+
+
+def test_actuators_out_of_the_joints_order_are_refused(tmp_path):
+    """The plant's desired-state and actuation ports go by actuator: a model whose transmissions
+    come in another order than its joints would drive the wrong joints."""
+    text = load_scenario(PUMA, "quintic").base_robot().model_text
+    start = text.index('<transmission name="joint_1_transmission">')
+    end = text.index("</transmission>", start) + len("</transmission>\n")
+    first = text[start:end]
+    text = text[:start] + text[end:]
+    at = text.index("</robot>")
+    (tmp_path / "reordered.urdf").write_text(text[:at] + first + text[at:])
+    path = tmp_path / "arm.yaml"
+    path.write_text(custom_arm_yaml("reordered.urdf"))
+    with pytest.raises(ValueError, match=r"the custom_arm model's actuators drive the joints \['joint_2', 'joint_3', "
+                                         r"'joint_4', 'joint_5', 'joint_6', 'joint_1'\] in this order"):
+        simulate(load_scenario(path))

@@ -16,7 +16,7 @@ from pydrake.multibody.plant import MultibodyPlant
 
 from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_label
 from drake_traj.robots import ROBOT_NAMES, arm_checks
-from drake_traj.robots.base import Robot, TaskKinematics, format_point
+from drake_traj.robots.base import Robot, TaskKinematics, format_point, joint_actuators
 from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_kinematics, chain_reach, chain_singularity_factors,
                                      inverse_kinematics_all, plant_chain, plant_frame)
 from drake_traj.robots.compiled_kinematics import task_kinematics_into
@@ -264,25 +264,21 @@ class ChainArm(Robot):
 
     def add_to_plant(self, plant):
         """Parse the model (its URDF text, else its file) into ``plant`` (not finalized), weld
-        ``base_frame`` to the world, and give each of the six joints an actuator named
-        ``{joint}_actuator`` (added where the file has none) with the arm's effort limit [N m].
-        Returns the model instance."""
+        ``base_frame`` to the world, and give each of the six joints an actuator (the model's,
+        whatever its name: :func:`~drake_traj.robots.base.joint_actuators`; ``{joint}_actuator``
+        added where the model has none) with the arm's effort limit [N m]. Returns the model
+        instance."""
         if self.model_text is not None:
             (instance,) = Parser(plant).AddModelsFromString(self.model_text, "urdf")
         else:
             (instance,) = Parser(plant).AddModels(str(self.model_path()))
         plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(self.base_frame, instance))
-        actuators = (plant.get_joint_actuator(index) for index in plant.GetJointActuatorIndices())  # (instance): none
-        actuated = {actuator.joint().name(): actuator for actuator in actuators  # before Finalize
-                    if actuator.model_instance() == instance}
+        actuated = joint_actuators(plant, instance)
         for joint_name, effort in zip(self.joint_names, self._effort):
             actuator = actuated.get(joint_name)
             if actuator is None:
                 actuator = plant.AddJointActuator(f"{joint_name}_actuator", plant.GetJointByName(joint_name, instance),
                                                   float(effort))
-            elif actuator.name() != f"{joint_name}_actuator":
-                raise invalid("model_file", f"the actuator of {joint_name!r} in {self.model_file} is named "
-                                            f"{actuator.name()!r}; the simulation expects {joint_name}_actuator")
             actuator.set_effort_limit(float(effort))
             if actuator.effort_limit() != float(effort):
                 raise RuntimeError(f"the effort limit of {actuator.name()} did not take effect")
