@@ -95,7 +95,13 @@ def _ur_arm(result) -> Robot:
         served = models[0] if len(models) == 1 else f"{', '.join(models[:-1])} or {models[-1]}"
         raise ExportError(f"URScript runs on a {served} controller; the run {result.name!r} is on "
                           f"{result.robot or 'an unknown robot'}")
-    return get_robot(result.robot)
+    robot = get_robot(result.robot)
+    logged = np.asarray(result.effort_limit, dtype=float)
+    if logged.shape != robot.effort_limits.shape or not np.allclose(logged, robot.effort_limits, rtol=1e-9, atol=0):
+        raise ExportError(f"the run {result.name!r} names the {result.robot}, but its torque limits {logged.tolist()} N m "
+                          f"are not the {ur_model(robot.name)}'s {robot.effort_limits.tolist()} N m: it was not run on "
+                          f"a {ur_model(robot.name)}, and URScript is not exported for it")
+    return robot
 
 
 def _check_ur_arm(result, t, q, qd) -> Robot:
