@@ -505,3 +505,19 @@ def test_actuators_out_of_the_joints_order_are_refused(tmp_path):
     with pytest.raises(ValueError, match=r"the custom_arm model's actuators drive the joints \['joint_2', 'joint_3', "
                                          r"'joint_4', 'joint_5', 'joint_6', 'joint_1'\] in this order"):
         simulate(load_scenario(path))
+
+
+def test_boryga_loop_on_the_puma_is_the_seeded_ik_nearest_the_reference():
+    """The loop law's knots (warm-started IK, each from the reference) are the seeded search's
+    solutions nearest the reference (the branch of the start), to 1e-9 rad."""
+    from drake_traj.planners.boryga.config import BorygaConfig, make
+
+    arm = load_scenario(PUMA, "quintic").base_robot()
+    reference = np.array([0.2, 0.6, -2.5, 0.2, -0.9, 0.1])
+    law = make(BorygaConfig(), arm, reference).law
+    orientation = arm.tcp_pose(reference)[3:]
+    for tau in np.linspace(0.0, law.plan.duration, 15):
+        position = law.plan.sample(tau)[0].reshape(3)
+        expected = arm._nearest_solution(np.concatenate([position, orientation]), reference)
+        np.testing.assert_allclose(law.exact(tau)[0], expected, atol=1e-9, rtol=0)
+        np.testing.assert_allclose(arm.tcp_pose(law.sample(tau)[0])[:3], position, atol=1e-6)

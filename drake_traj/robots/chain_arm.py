@@ -18,7 +18,7 @@ from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_
 from drake_traj.robots import ROBOT_NAMES, arm_checks
 from drake_traj.robots.base import Robot, TaskKinematics, format_point, joint_actuators
 from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_kinematics, chain_reach, chain_singularity_factors,
-                                     inverse_kinematics_all, plant_chain, plant_frame)
+                                     inverse_kinematics_all, inverse_kinematics_near, plant_chain, plant_frame)
 from drake_traj.robots.compiled_kinematics import task_kinematics_into
 from drake_traj.robots.task_space import orientation_error, pose_error, wrap_angle, wrapped
 from drake_traj.robots.urdf_writer import dh_table_urdf
@@ -306,18 +306,32 @@ class ChainArm(Robot):
         return inverse_kinematics_all(self.model, pose, self.tcp_offset, self._lower, self._upper)
 
     def point_ik(self, points, reference) -> np.ndarray:
-        """IK of TCP positions (N, 3) [m] at the TCP orientation of ``reference``: for each, the
-        solution nearest ``reference`` (each joint moved by whole turns towards it within the limits)."""
+        """IK of TCP positions (N, 3) [m] at the TCP orientation of ``reference``, on its branch:
+        each point's solution is Newton's from the previous point's (the first's from
+        ``reference``: :func:`~drake_traj.robots.chain.inverse_kinematics_near`, within 0.5 rad
+        of it, regular, within the limits); where that fails, the solution of all
+        (:meth:`inverse_kinematics_all`) nearest that start (each joint moved by whole turns
+        towards it within the limits). Points along a path in order follow one branch."""
         reference = finite_array(reference, "reference", "rad", shape=(NUM_JOINTS,))
         orientation = self.tcp_pose(reference)[3:]
-        out = []
+        out, start = [], reference
         for point in np.asarray(points, dtype=float).reshape(-1, 3):
-            candidates = []
-            for q in self.inverse_kinematics_all(np.concatenate([point, orientation])):
-                shifted = q + 2 * np.pi * np.round((reference - q) / (2 * np.pi))
-                candidates.append(np.where((shifted < self._lower) | (shifted > self._upper), q, shifted))
-            out.append(min(candidates, key=lambda q: float(np.sum((q - reference) ** 2))))
+            pose = np.concatenate([point, orientation])
+            q = inverse_kinematics_near(self.model, pose, start, self.tcp_offset, self._lower, self._upper)
+            if q is None:
+                q = self._nearest_solution(pose, start)
+            out.append(q)
+            start = q
         return np.array(out).reshape(-1, NUM_JOINTS)
+
+    def _nearest_solution(self, pose, start) -> np.ndarray:
+        """The solution of ``pose`` (:meth:`inverse_kinematics_all`) nearest ``start`` [rad], each
+        joint moved by whole turns towards it within the limits."""
+        candidates = []
+        for q in self.inverse_kinematics_all(pose):
+            shifted = q + 2 * np.pi * np.round((start - q) / (2 * np.pi))
+            candidates.append(np.where((shifted < self._lower) | (shifted > self._upper), q, shifted))
+        return min(candidates, key=lambda q: float(np.sum((q - start) ** 2)))
 
     def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
         """qd = J⁻¹ [v; 0], qdd = J⁻¹ ([a; 0] - J̇q̇) with the TCP's analytic Jacobian (one q);
