@@ -19,7 +19,7 @@ from pydrake.trajectories import PiecewisePolynomial
 from drake_traj.version import __version__
 from drake_traj.errors import DrakeTrajError
 from drake_traj.output import write_file
-from drake_traj.robots import ROBOT_NAMES, Robot, get_robot
+from drake_traj.robots import UR_ARMS, Robot, get_robot
 
 __all__ = ["FORMATS", "ExportError", "export", "reference_trajectory", "resample"]
 
@@ -28,9 +28,12 @@ UR_CYCLE = 0.002  # [s], the UR controller's servo cycle (500 Hz)
 MIN_PERIOD = 1e-4  # [s], the finest resampling (10 kHz): the log itself is at 1 ms
 LOOKAHEAD_RANGE = (0.03, 0.2)  # [s], servoj lookahead_time (UR script manual)
 GAIN_RANGE = (100.0, 2000.0)  # servoj gain (UR script manual)
-# The arms a UR e-Series controller (PolyScope 5) drives, by their names in drake_traj.robots; the
-# URScript export serves those of them that are registered (ROBOT_NAMES)
-UR_CONTROLLER_ARMS = ("ur3e", "ur5e", "ur10e", "ur16e", "ur20", "ur30")
+# The registered arms a UR e-Series controller (PolyScope 5) drives (drake_traj.robots.UR_ARMS); a
+# custom arm cannot take one of their names (ChainArm refuses it)
+UR_CONTROLLER_ARMS = tuple(arm.name for arm in UR_ARMS)
+# Where a ROS 2 JointTrajectory is published: the UR ROS 2 driver's controller for a UR arm
+ROS2_TOPICS = {True: "/scaled_joint_trajectory_controller/joint_trajectory",
+               False: "/<your_joint_trajectory_controller>/joint_trajectory"}
 
 
 class ExportError(DrakeTrajError):
@@ -86,13 +89,19 @@ def ur_model(name: str) -> str:
 
 def _ur_arm(result) -> Robot:
     """The UR arm of ``result``'s run, or an ExportError naming the arms a UR controller drives."""
-    arms = [name for name in UR_CONTROLLER_ARMS if name in ROBOT_NAMES]
+    arms = UR_CONTROLLER_ARMS
     if result.robot not in arms:
         models = [ur_model(name) for name in arms]
         served = models[0] if len(models) == 1 else f"{', '.join(models[:-1])} or {models[-1]}"
         raise ExportError(f"URScript runs on a {served} controller; the run {result.name!r} is on "
                           f"{result.robot or 'an unknown robot'}")
-    return get_robot(result.robot)
+    robot = get_robot(result.robot)
+    logged = np.asarray(result.effort_limit, dtype=float)
+    if logged.shape != robot.effort_limits.shape or not np.allclose(logged, robot.effort_limits, rtol=1e-9, atol=0):
+        raise ExportError(f"the run {result.name!r} names the {result.robot}, but its torque limits {logged.tolist()} N m "
+                          f"are not the {ur_model(robot.name)}'s {robot.effort_limits.tolist()} N m: it was not run on "
+                          f"a {ur_model(robot.name)}, and URScript is not exported for it")
+    return robot
 
 
 def _check_ur_arm(result, t, q, qd) -> Robot:
@@ -144,7 +153,7 @@ def _ros2(result, t, q, qd, qdd, joint_names) -> str:
                "points": points}
     comment = (f"# trajectory_msgs/JointTrajectory from drake-traj {__version__}: the reference of the run {result.name!r} "
                f"on the {result.robot or 'robot'}\n"
-               "# (ros2 topic pub --once /scaled_joint_trajectory_controller/joint_trajectory "
+               f"# (ros2 topic pub --once {ROS2_TOPICS[result.robot in UR_CONTROLLER_ARMS]} "
                "trajectory_msgs/msg/JointTrajectory \"$(cat FILE)\")\n")
     return comment + yaml.safe_dump(message, sort_keys=False, default_flow_style=None, width=1000)
 

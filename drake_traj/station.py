@@ -48,6 +48,7 @@ from drake_traj.errors import Cause, Failure
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
 from drake_traj.robots import UR10E, Robot
+from drake_traj.robots.base import joint_actuators
 from drake_traj.robots.custom import robot_label
 from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, check_planned_duration, default_plant_config,
                                  default_simulator_config)
@@ -180,8 +181,12 @@ def add_station(
 
     plant, scene_graph = AddMultibodyPlant(plant_config, builder)
     instance = robot.add_to_plant(plant)
+    actuators = joint_actuators(plant, instance)  # by joint: a model names its actuators as it likes
+    if list(actuators) != list(robot.joint_names):  # the plant's desired-state and actuation ports go by actuator
+        raise invalid("robot", f"the {robot.name} model's actuators drive the joints {list(actuators)} in this order; the "
+                               f"station drives {list(robot.joint_names)}: one actuator per joint, in the joints' order")
     for joint_name, kp, kd in zip(robot.joint_names, gains.kp, gains.kd):
-        plant.GetJointActuatorByName(f"{joint_name}_actuator", instance).set_controller_gains(PdControllerGains(p=kp, d=kd))
+        actuators[joint_name].set_controller_gains(PdControllerGains(p=kp, d=kd))
     # the cell's geometry, the tool's body and payload: contact with them, and between the arm's
     # non-adjacent links, is simulated (and ends the run: run_station)
     add_cell(plant, cell or Cell(), instance, robot=robot, directory=cell_directory)

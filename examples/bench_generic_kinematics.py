@@ -14,7 +14,10 @@ one after the other within each repeat:
 3. the law integrated: the compiled ``integrate_kernel`` of the whole task (RK4 at 1 ms, four
    evaluations a step), per step;
 4. the reach check before a run (``PajakLaw.reach_failure``: every IK solution of the four
-   waypoints; closed form against the chain's numerical IK), per waypoint.
+   waypoints; closed form against the chain's numerical IK), per waypoint;
+5. point IK as Boryga's loop law calls it (``point_ik`` of one point, the reference's
+   orientation and branch) at 200 points of a smooth path near the home configuration: the
+   closed form against the chain's IK warm-started from the reference, per point.
 
 Prints the times and the ratios chain / closed form (issue 24 asks for at most 2 for the law),
 and the two motions' finish times. A benchmark, not a test: numbers depend on the machine.
@@ -75,6 +78,14 @@ def reach_seconds(law: PajakLaw, q0) -> float:
     return (time.perf_counter() - start) / len(law.waypoints)
 
 
+def point_ik_seconds(robot, points, reference) -> float:
+    """Wall time per point [s] of ``robot.point_ik`` called once per point."""
+    start = time.perf_counter()
+    for point in points:
+        robot.point_ik(point[None], reference)
+    return (time.perf_counter() - start) / len(points)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=7)
@@ -93,7 +104,9 @@ def main():
     kinematics_seconds(chain._kinematics_many, arm.model, q[:10], qd[:10])
     law_seconds(closed_law, states[:5])
     law_seconds(chain_law, states[:5])
-    times = {key: ([], []) for key in ("kinematics", "law", "integrate", "reach check")}
+    path = ur10e.task_pose(q0)[:3] + np.cumsum(rng.normal(scale=4e-4, size=(200, 3)), axis=0)  # 2 ms of 0.2 m/s
+    point_ik_seconds(arm, path[:2], q0)
+    times = {key: ([], []) for key in ("kinematics", "law", "integrate", "reach check", "point IK")}
     finish = []
     for _ in range(args.repeats):
         times["kinematics"][0].append(kinematics_seconds(kinematics_many, ur10e.MODEL, q, qd))
@@ -105,6 +118,8 @@ def main():
             times["integrate"][k].append(seconds)
             finish.append((k, T))
             times["reach check"][k].append(reach_seconds(law, q0))
+        times["point IK"][0].append(point_ik_seconds(ur10e.UR10E, path, q0))
+        times["point IK"][1].append(point_ik_seconds(arm, path, q0))
     print(f"Pająk 2024 sim 3, {len(states)} law states, {args.repeats} repeats (medians; ratio range)\n")
     print("| measurement | UR closed form [µs] | DH chain [µs] | ratio chain / closed |")
     print("|---|---|---|---|")

@@ -16,7 +16,7 @@ from drake_traj.clearance import CellChecker
 from drake_traj.planners import make_planner
 from drake_traj.robots.chain import SerialChain
 from drake_traj.robots.chain_arm import ChainArm
-from drake_traj.robots.custom import DhArm
+from drake_traj.robots.custom import DhArm, resolve_robot
 from drake_traj.robots.task_space import orientation_error
 from drake_traj.robots.urdf_writer import touching_pairs
 from drake_traj.scenario import ScenarioError
@@ -255,7 +255,10 @@ def test_an_arm_from_a_users_own_plant_plans_beside_it():
     (instance,) = Parser(plant).AddModels(str(DIAGRAMS.parent / "models" / "ur5e.urdf"))  # "the user's file"
     plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("base", instance))
     plant.Finalize()
-    arm = ChainArm.from_plant(plant, base_frame="base", tool_frame="tool0", acceleration_limits=[2.0] * 6)
+    with pytest.raises(ValueError, match=r"^the custom arm's name would be 'ur5e' \(the tool body's model instance\), "
+                                         r"a known robot's name .*give the arm a name of its own \(name=\)"):
+        ChainArm.from_plant(plant, base_frame="base", tool_frame="tool0", acceleration_limits=[2.0] * 6)
+    arm = ChainArm.from_plant(plant, name="my_arm", base_frame="base", tool_frame="tool0", acceleration_limits=[2.0] * 6)
     assert arm.model_file is None and arm.data_source == "a user's plant"
     start, goal = np.array([-1.5, -1.5, -2.0, -0.8, 1.6, 0.8]), np.array([-1.3, -1.7, -1.8, -1.0, 1.4, 1.0])
     planner = builder.AddSystem(make_planner(QuinticConfig(goals=[goal.tolist()]), arm, start))
@@ -348,3 +351,173 @@ def test_the_command_line_shows_the_puma_example(capsys):
     robots = capsys.readouterr().out
     assert "puma560 (DhArm)" in robots and "puma560.yaml" in robots
     assert not any(line.startswith("puma560 ") for line in robots.splitlines())  # not a registered robot
+
+
+def test_a_zero_length_dh_table_is_refused_at_dh():
+    arm = puma_arm()
+    arm.dh = [[0.0, 0.0, row[2], row[3]] for row in arm.dh]
+    with pytest.raises(ValueError, match=r"^robot.dh: a chain needs at least one link of non-zero length") as caught:
+        resolve_robot(arm)
+    assert caught.value.field == ("robot", "dh")
+
+
+def puma_from_dh(name="my_puma", **change) -> ChainArm:
+    """The PUMA 560 through ChainArm.from_dh (the Python path), its data changed by ``change``."""
+    dh = puma_arm()
+    arguments = dict(masses=dh.masses, centres_of_mass=dh.centres_of_mass, inertias=dh.inertias,
+                     link_radius=dh.link_radius, lower_limits=dh.lower, upper_limits=dh.upper,
+                     velocity_limits=dh.velocity_limits, acceleration_limits=dh.acceleration_limits,
+                     effort_limits=dh.effort_limits, rated_payload=dh.payload)
+    return ChainArm.from_dh(name, dh.dh, **{**arguments, **change})
+
+
+def test_limits_upside_down_are_refused_before_drake_parses_them():
+    with pytest.raises(ValueError, match=r"^upper_limits\[0\] = -3 rad must be above lower_limits\[0\] = 3 rad") as caught:
+        ChainArm.from_dh("z", puma_arm().dh, lower_limits=[3] * 6, upper_limits=[-3] * 6, velocity_limits=1.,
+                         acceleration_limits=2., effort_limits=100., masses=[1] * 6)
+    assert caught.value.field == ("upper_limits", 0)
+
+
+def test_a_users_model_file_with_a_limit_upside_down_is_an_error_naming_the_file(tmp_path, capsys):
+    model = load_scenario(PUMA, "quintic").base_robot().model_text
+    start = model.index('<limit lower="', model.index('<joint name="joint_2"'))
+    end = model.index('velocity=', start)
+    (tmp_path / "bad.urdf").write_text(model[:start] + '<limit lower="7.0" upper="6.28" ' + model[end:])
+    path = tmp_path / "bad.yaml"
+    path.write_text(custom_arm_yaml("bad.urdf"))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
+    error = capsys.readouterr().err
+    assert "robot.model_file: the model file" in error and "bad.urdf could not be read" in error
+    with pytest.raises(ScenarioError, match=r"robot.model_file: the model file .*bad.urdf could not be read: .*joint") as caught:
+        load_scenario(path)
+    assert caught.value.field == ("robot", "model_file")
+
+
+@pytest.mark.parametrize("change, field, pattern", [
+    (dict(masses=[1.0, 1.0, 0.0, 1.0, 1.0, 1.0]), ("masses", 2), r"masses\[2\] must be positive \[kg\], got 0"),
+    (dict(masses=[1.0, -2.0, 1.0, 1.0, 1.0, 1.0]), ("masses", 1), r"masses\[1\] must be positive \[kg\], got -2"),
+    (dict(inertias=[[0.1, 0.0, 0.35, 0, 0, 0]] + [[0.1, 0.1, 0.1, 0, 0, 0]] * 5), ("inertias", 0),
+     r"inertias\[0\] is not a rigid body's inertia: its principal moments 0, 0.1, 0.35"),
+    (dict(inertias=[[0.1, 0.1, 0.1, 0, 0, 0]] * 3 + [[0.1, 0.1, 0.3, 0, 0, 0]] + [[0.1, 0.1, 0.1, 0, 0, 0]] * 2),
+     ("inertias", 3), r"inertias\[3\] is not a rigid body's inertia: .* each at most the sum of the other two"),
+    (dict(rated_payload=float("nan")), ("rated_payload",), r"rated_payload must be finite"),
+    (dict(rated_payload=-1.0), ("rated_payload",), r"rated_payload must be positive \[kg\]"),
+    (dict(link_radius=0.0), ("link_radius",), r"link_radius must be positive \[m\], got 0"),
+    (dict(link_radius=float("nan")), ("link_radius",), r"link_radius must be finite"),
+    (dict(centres_of_mass=np.zeros((6, 2))), ("centres_of_mass",),
+     r"centres_of_mass must be 6 rows of 3 numbers \[m\], got shape \(6, 2\)"),
+])
+def test_from_dh_refuses_what_the_scenario_refuses_naming_the_argument(change, field, pattern):
+    with pytest.raises(ValueError, match=pattern) as caught:
+        puma_from_dh(**change)
+    assert caught.value.field == field
+
+
+def test_the_constructor_checks_the_rated_payload(tmp_path):
+    (tmp_path / "puma.urdf").write_text(load_scenario(PUMA, "quintic").base_robot().model_text)
+    arm = ChainArm.from_model_file(tmp_path / "puma.urdf", base_frame="base", tool_frame="tool0",
+                                   acceleration_limits=2.0, rated_payload=2.5)
+    assert arm.name == "puma" and arm.rated_payload == 2.5
+    for rating in (float("nan"), 0.0, -2.5):
+        with pytest.raises(ValueError, match=r"^rated_payload must be") as caught:
+            ChainArm.from_model_file(tmp_path / "puma.urdf", base_frame="base", tool_frame="tool0",
+                                     acceleration_limits=2.0, rated_payload=rating)
+        assert caught.value.field == ("rated_payload",)
+
+
+def test_a_custom_arm_cannot_take_a_known_robots_name(tmp_path):
+    """A PUMA named "ur10e" would be exported as a UR10e's URScript: every constructor refuses a
+    known robot's name, given or defaulted from the file's stem."""
+    with pytest.raises(ValueError, match=r"^name 'ur10e' is a known robot's name") as caught:
+        puma_from_dh(name="ur10e")
+    assert caught.value.field == ("name",)
+    (tmp_path / "ur5e.urdf").write_text(load_scenario(PUMA, "quintic").base_robot().model_text)
+    with pytest.raises(ValueError, match=r"^the custom arm's name would be 'ur5e' \(the model file's name 'ur5e.urdf'\), "
+                                         r"a known robot's name .*\(name=\)") as caught:
+        ChainArm.from_model_file(tmp_path / "ur5e.urdf", base_frame="base", tool_frame="tool0", acceleration_limits=2.0)
+    assert caught.value.field == ("name",)
+    arm = ChainArm.from_model_file(tmp_path / "ur5e.urdf", name="my_puma", base_frame="base", tool_frame="tool0",
+                                   acceleration_limits=2.0)
+    assert arm.name == "my_puma"
+    with pytest.raises(ValueError, match=r"^name 'li_4dof' is a known robot's name"):
+        ChainArm(arm.chain, name="li_4dof", model_file=arm.model_file, base_frame="base", tool_frame="tool0",
+                 joint_names=arm.joint_names, lower_limits=arm.lower_limits, upper_limits=arm.upper_limits,
+                 velocity_limits=1.0, acceleration_limits=2.0, effort_limits=100.0)
+
+
+def six_r_sdf() -> str:
+    """A small 6R arm as SDFormat (axes z, y, y, x, y, x; links of 1 kg), the joints with effort
+    limits: Drake's SDF parser gives each an actuator named after the joint."""
+    origins = [(0, 0, 0.2), (0, 0, 0.1), (0.3, 0, 0), (0.3, 0, 0), (0.1, 0, 0), (0.1, 0, 0)]
+    axes = ["0 0 1", "0 1 0", "0 1 0", "1 0 0", "0 1 0", "1 0 0"]
+    inertial = ("<inertial><mass>1.0</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz>"
+                "<ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>")
+    links, joints, pose = ['<link name="base">' + inertial + "</link>"], [], np.zeros(3)
+    for i, (origin, axis) in enumerate(zip(origins, axes), 1):
+        pose = pose + origin
+        links.append(f'<link name="link{i}"><pose>{pose[0]} {pose[1]} {pose[2]} 0 0 0</pose>{inertial}</link>')
+        joints.append(f'<joint name="j{i}" type="revolute"><parent>{"base" if i == 1 else f"link{i - 1}"}</parent>'
+                      f'<child>link{i}</child><axis><xyz>{axis}</xyz><limit><lower>-3</lower><upper>3</upper>'
+                      f'<velocity>2</velocity><effort>60</effort></limit></axis></joint>')
+    return ('<?xml version="1.0"?>\n<sdf version="1.9"><model name="six_r">' + "".join(links) + "".join(joints)
+            + '<frame name="tool0" attached_to="link6"><pose>0.05 0 0 0 0 0</pose></frame></model></sdf>\n')
+
+
+@pytest.mark.parametrize("model", ["six_r.sdf", "ros_style.urdf"])
+def test_an_sdf_arm_and_an_arm_with_its_own_actuator_names_run_in_the_closed_loop(tmp_path, model):
+    """The station finds each joint's actuator by its joint, whatever the model calls it."""
+    if model.endswith(".sdf"):
+        text, goal = six_r_sdf(), [0.4, -0.3, 0.5, 0.3, -0.4, 0.2]
+    else:
+        text = load_scenario(PUMA, "quintic").base_robot().model_text
+        assert text.count('_actuator">') == 6
+        text, goal = text.replace('_actuator">', '_motor">'), [0.6, 0.4, -2.2, -0.3, -1.1, 0.5]
+    (tmp_path / model).write_text(text)
+    path = tmp_path / "arm.yaml"
+    path.write_text(f"name: own_actuators\nrobot: !CustomArm\n  model_file: {model}\n  name: my_arm\n"
+                    "  acceleration_limits: [2, 2, 2, 2, 2, 2]\n"
+                    f"q_initial: {[0.2, 0.6, -2.5, 0.2, -0.9, 0.1] if model.endswith('.urdf') else [0.0] * 6}\n"
+                    f"planner: !QuinticConfig\n  goals: [{goal}]\n")
+    scenario = load_scenario(path)
+    plant = MultibodyPlant(0.001)
+    instance = scenario.base_robot().add_to_plant(plant)
+    plant.Finalize()
+    names = [plant.get_joint_actuator(index).name() for index in plant.GetJointActuatorIndices(instance)]
+    assert names == ([f"j{i}" for i in range(1, 7)] if model.endswith(".sdf") else [f"joint_{i}_motor" for i in range(1, 7)])
+    result = simulate(scenario)
+    assert result.succeeded and result.robot == "my_arm"
+    assert np.max(np.abs(result.q_meas[-1] - goal)) < 1e-3
+    assert np.max(np.abs(result.qd_ref)) <= (2.0 if model.endswith(".sdf") else 1.0) * (1 + LIMIT_TOLERANCE)
+
+
+def test_actuators_out_of_the_joints_order_are_refused(tmp_path):
+    """The plant's desired-state and actuation ports go by actuator: a model whose transmissions
+    come in another order than its joints would drive the wrong joints."""
+    text = load_scenario(PUMA, "quintic").base_robot().model_text
+    start = text.index('<transmission name="joint_1_transmission">')
+    end = text.index("</transmission>", start) + len("</transmission>\n")
+    first = text[start:end]
+    text = text[:start] + text[end:]
+    at = text.index("</robot>")
+    (tmp_path / "reordered.urdf").write_text(text[:at] + first + text[at:])
+    path = tmp_path / "arm.yaml"
+    path.write_text(custom_arm_yaml("reordered.urdf"))
+    with pytest.raises(ValueError, match=r"the custom_arm model's actuators drive the joints \['joint_2', 'joint_3', "
+                                         r"'joint_4', 'joint_5', 'joint_6', 'joint_1'\] in this order"):
+        simulate(load_scenario(path))
+
+
+def test_boryga_loop_on_the_puma_is_the_seeded_ik_nearest_the_reference():
+    """The loop law's knots (warm-started IK, each from the reference) are the seeded search's
+    solutions nearest the reference (the branch of the start), to 1e-9 rad."""
+    from drake_traj.planners.boryga.config import BorygaConfig, make
+
+    arm = load_scenario(PUMA, "quintic").base_robot()
+    reference = np.array([0.2, 0.6, -2.5, 0.2, -0.9, 0.1])
+    law = make(BorygaConfig(), arm, reference).law
+    orientation = arm.tcp_pose(reference)[3:]
+    for tau in np.linspace(0.0, law.plan.duration, 15):
+        position = law.plan.sample(tau)[0].reshape(3)
+        expected = arm._nearest_solution(np.concatenate([position, orientation]), reference)
+        np.testing.assert_allclose(law.exact(tau)[0], expected, atol=1e-9, rtol=0)
+        np.testing.assert_allclose(arm.tcp_pose(law.sample(tau)[0])[:3], position, atol=1e-6)

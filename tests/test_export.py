@@ -168,7 +168,7 @@ def test_every_export_names_the_robot(result, tmp_path):
     assert headers["ros2"][0].endswith("on the ur10e")
 
 
-UR_ARMS = [name for name in UR_CONTROLLER_ARMS if name in ROBOT_NAMES]
+UR_ARMS = list(UR_CONTROLLER_ARMS)
 
 
 @pytest.mark.parametrize("name", UR_ARMS)
@@ -179,12 +179,14 @@ def test_urscript_checks_each_ur_arm_against_its_own_ratings(result, tmp_path, n
     speed[k, 2] = 1.001 * robot.velocity_limits[2]  # joint 3, just above that arm's rated speed
     with pytest.raises(ExportError, match=rf"joint 3 \(elbow_joint\) speed {speed[k, 2]:.4f} rad/s at t = {result.t[k]:.3f} "
                                           rf"s is beyond the {model}'s {robot.velocity_limits[2]:.4f} rad/s"):
-        SimulationResult(**{**vars(result), "robot": name, "qd_ref": speed}).export(tmp_path / "x.script", "urscript")
+        SimulationResult(**{**vars(result), "robot": name, "effort_limit": robot.effort_limits,
+                            "qd_ref": speed}).export(tmp_path / "x.script", "urscript")
     torque = np.zeros_like(result.tau)  # (the UR10e run's own torques are beyond a small arm's ratings)
     torque[7, 0] = -robot.effort_limits[0]  # the simulated drive saturated
     with pytest.raises(ExportError, match=rf"joint 1 \(shoulder_pan_joint\) torque -{robot.effort_limits[0]:.4f} N m "
                                           rf"at t = {result.t[7]:.3f} s is beyond the {model}'s"):
-        SimulationResult(**{**vars(result), "robot": name, "tau": torque}).export(tmp_path / "x.script", "urscript")
+        SimulationResult(**{**vars(result), "robot": name, "effort_limit": robot.effort_limits,
+                            "tau": torque}).export(tmp_path / "x.script", "urscript")
     assert not (tmp_path / "x.script").exists()
 
 
@@ -194,4 +196,28 @@ def test_urscript_refuses_an_arm_no_ur_controller_drives(result, tmp_path, robot
     with pytest.raises(ExportError, match=rf"URScript runs on a {served} controller; the run 'quintic_ptp' is on "
                                           rf"{robot or 'an unknown robot'}$"):
         SimulationResult(**{**vars(result), "robot": robot}).export(tmp_path / "x.script", "urscript")
+    assert not (tmp_path / "x.script").exists()
+
+
+def test_the_ur_controller_arms_are_the_registered_e_series_arms():
+    assert set(UR_CONTROLLER_ARMS) <= set(ROBOT_NAMES)
+    assert {"ur3e", "ur5e", "ur10e", "ur16e", "ur20"} <= set(UR_CONTROLLER_ARMS)
+    assert not {"li_4dof", "ur30"} & set(UR_CONTROLLER_ARMS)
+
+
+@pytest.mark.parametrize("robot, ur_driver", [("ur10e", True), ("ur3e", True), ("puma_like", False), ("li_4dof", False)])
+def test_the_ros2_hint_names_the_ur_driver_only_for_a_ur_arm(result, tmp_path, robot, ur_driver):
+    hint = SimulationResult(**{**vars(result), "robot": robot}).export(tmp_path / "x.yaml", "ros2",
+                                                                       period=0.01).read_text().splitlines()[1]
+    assert ("/scaled_joint_trajectory_controller/" in hint) == ur_driver
+    assert hint.startswith("# (ros2 topic pub --once /") and "/joint_trajectory " in hint
+
+
+def test_urscript_refuses_a_run_whose_logged_limits_are_not_the_named_arms(result, tmp_path):
+    """A run named after a UR arm but logged with another arm's torque limits (a custom arm that
+    took the name, before ChainArm refused it) is not exported for that arm's controller."""
+    puma = np.array([97.6, 186.4, 89.4, 24.2, 20.1, 21.3])
+    with pytest.raises(ExportError, match=r"the run 'quintic_ptp' names the ur10e, but its torque limits \[97.6, .*\] N m "
+                                          r"are not the UR10e's \[330.0, 330.0, 150.0, 56.0, 56.0, 56.0\] N m"):
+        SimulationResult(**{**vars(result), "effort_limit": puma}).export(tmp_path / "x.script", "urscript")
     assert not (tmp_path / "x.script").exists()

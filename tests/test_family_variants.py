@@ -76,11 +76,12 @@ def test_readme_your_arm_python_a_users_urdf_in_the_station_and_beside_a_users_p
     start = ur_eseries.HOME
     down = [np.pi, 0.0, 3 * np.pi / 4]
     task = PajakConfig(waypoints=[[-0.134, -0.378, 0.51, *down], [0.16, -0.378, 0.51, *down]])
-    arm = ChainArm.from_model_file(model, base_frame="base", tool_frame="tool0", acceleration_limits=1.4, home=start)
+    arm = ChainArm.from_model_file(model, name="my_arm", base_frame="base", tool_frame="tool0", acceleration_limits=1.4,
+                                   home=start)
     result = simulate(make_planner_for(task, arm, start))
     analytic = make_planner_for(task, get_robot("ur5e"), start)
     analytic.preflight()
-    assert result.succeeded and result.robot == "ur5e"
+    assert result.succeeded and result.robot == "my_arm"
     assert result.duration == pytest.approx(analytic.plan().end_time(), abs=1e-3)
 
     builder = DiagramBuilder()
@@ -88,7 +89,7 @@ def test_readme_your_arm_python_a_users_urdf_in_the_station_and_beside_a_users_p
     Parser(plant).AddModels(model)
     plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("base"))
     plant.Finalize()
-    arm = ChainArm.from_plant(plant, base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
+    arm = ChainArm.from_plant(plant, name="my_arm", base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
     planner = builder.AddSystem(make_planner_for(task, arm, start))
     planner.preflight()
     log = LogVectorOutput(planner.GetOutputPort("desired_state"), builder)

@@ -26,7 +26,7 @@ from drake_traj.data import data_directory
 from drake_traj.errors import Cause, DrakeTrajError
 from drake_traj.validation import finite_array, invalid, real_array
 
-__all__ = ["FLANGE", "LIMIT_TOL", "PointRobot", "Robot", "TaskKinematics"]
+__all__ = ["FLANGE", "LIMIT_TOL", "PointRobot", "Robot", "TaskKinematics", "joint_actuators"]
 
 LIMIT_TOL = 1e-12  # slack on joint limits [rad or m]
 FLANGE = np.eye(4)  # X_FT of a TCP at the flange: no tool offset
@@ -207,7 +207,7 @@ class Robot:
     def add_to_plant(self, plant):
         """Parse the model into ``plant`` (not finalized) and weld its base to the world.
 
-        Returns the model instance; each joint J has an actuator named ``J_actuator``.
+        Returns the model instance; each joint has an actuator (:func:`joint_actuators` finds it).
         """
         (instance,) = Parser(plant).AddModels(str(self.model_path()))
         plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(self.base_frame, instance))
@@ -423,3 +423,11 @@ class PointRobot(Robot):
         if problems:
             raise DrakeTrajError(self._message(flat, problems, label, times), cause=Cause.UNREACHABLE)
         return q.reshape(p.shape[:-1] + (self.num_joints,))
+
+
+def joint_actuators(plant, instance) -> dict:
+    """The actuators of the model instance ``instance`` of ``plant`` (finalized or not) by the
+    name of the joint each drives: a model names its actuators as it likes (Drake's SDF parser
+    after the joint, a ROS URDF's transmission as its author)."""
+    actuators = (plant.get_joint_actuator(index) for index in plant.GetJointActuatorIndices())  # (instance): finalized only
+    return {actuator.joint().name(): actuator for actuator in actuators if actuator.model_instance() == instance}

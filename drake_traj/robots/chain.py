@@ -651,3 +651,33 @@ def inverse_kinematics_all(model, pose, tool=FLANGE, lower=None, upper=None) -> 
                                          f"{float(np.max(measures)):.2g} at best): the joint solution is not determined")
     return np.array(regular)
 
+
+
+WARM_START_REACH = 0.5  # [rad], a warm-started IK solution this close to its start (every joint) keeps its branch
+
+
+def inverse_kinematics_near(model, pose, start, tool=FLANGE, lower=None, upper=None):
+    """The joint solution q (6,) [rad] of the TCP pose ``pose`` = [x, y, z, φ_X, φ_Y, φ_Z] (as
+    :func:`inverse_kinematics_all`) that Levenberg-Marquardt then Newton reach from ``start``
+    alone (a warm start: the previous point's solution on a path), on ``start``'s branch: None
+    unless it converges (pose error below :data:`IK_TOLERANCE`) within :data:`WARM_START_REACH`
+    of ``start`` in every joint, within the limits ``lower``, ``upper`` [rad] and regular
+    (measure at least :data:`IK_SINGULAR_TOLERANCE`). The caller then falls back to the seeds
+    (:func:`inverse_kinematics_all`)."""
+    model = np.ascontiguousarray(model, dtype=float)
+    tool = np.ascontiguousarray(tool, dtype=float)
+    start = np.ascontiguousarray(start, dtype=float).reshape(1, NUM_JOINTS)
+    goal = np.eye(4)
+    goal[:3, :3] = rotation_from_zyx_euler(pose[3:])
+    goal[:3, 3] = pose[:3]
+    solution, residual = np.empty_like(start), np.empty(1)
+    _newton_from_seeds(model, tool, goal, start, IK_ITERATIONS, solution, residual)
+    q = solution[0]
+    if not residual[0] < IK_TOLERANCE or np.max(np.abs(q - start[0])) > WARM_START_REACH:
+        return None
+    if (lower is not None and np.any(q < np.asarray(lower) - 1e-12)) or \
+            (upper is not None and np.any(q > np.asarray(upper) + 1e-12)):
+        return None
+    if chain_kinematics(model, q, np.zeros(NUM_JOINTS), tool)[4] < IK_SINGULAR_TOLERANCE:
+        return None
+    return q

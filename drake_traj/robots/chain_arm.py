@@ -15,9 +15,10 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
 from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_label
-from drake_traj.robots.base import Robot, TaskKinematics, format_point
+from drake_traj.robots import ROBOT_NAMES, arm_checks
+from drake_traj.robots.base import Robot, TaskKinematics, format_point, joint_actuators
 from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_kinematics, chain_reach, chain_singularity_factors,
-                                     inverse_kinematics_all, plant_chain, plant_frame)
+                                     inverse_kinematics_all, inverse_kinematics_near, plant_chain, plant_frame)
 from drake_traj.robots.compiled_kinematics import task_kinematics_into
 from drake_traj.robots.task_space import orientation_error, pose_error, wrap_angle, wrapped
 from drake_traj.robots.urdf_writer import dh_table_urdf
@@ -75,8 +76,7 @@ class ChainArm(Robot):
                  rated_payload: float | None = None, home=None, data_source: str = "", model_text: str | None = None):
         if not isinstance(chain, SerialChain):
             raise TypeError(f"chain must be a SerialChain, got {type(chain).__name__}")
-        if not isinstance(name, str) or not name:
-            raise invalid("name", f"name must be a non-empty text, got {name!r}")
+        arm_checks.arm_name(name, "name", plain=False)
         names = tuple(joint_names)
         if len(names) != NUM_JOINTS or not all(isinstance(n, str) and n for n in names):
             raise invalid("joint_names", f"joint_names must be six non-empty texts, got {names!r}")
@@ -92,14 +92,11 @@ class ChainArm(Robot):
                                      f"arguments give it (pass {key}=)", field=(key,))
         self._lower = joint_bound(lower_limits, "lower_limits", NUM_JOINTS, "rad")
         self._upper = joint_bound(upper_limits, "upper_limits", NUM_JOINTS, "rad")
-        if np.any(self._lower >= self._upper):
-            j = int(np.argmax(self._lower >= self._upper))
-            raise invalid("upper_limits", f"{joint_label(j, names)}: the upper limit {self._upper[j]:.6g} rad must be "
-                                          f"above the lower limit {self._lower[j]:.6g} rad", j)
+        arm_checks.ranges(self._lower, self._upper, "lower_limits", "upper_limits")
         self._velocity = joint_limit(velocity_limits, "velocity_limits", NUM_JOINTS, "rad/s")
         self._acceleration = joint_limit(acceleration_limits, "acceleration_limits", NUM_JOINTS, "rad/s^2")
         self._effort = joint_limit(effort_limits, "effort_limits", NUM_JOINTS, "N m")
-        self.rated_payload = None if rated_payload is None else float(rated_payload)
+        self.rated_payload = arm_checks.payload(rated_payload, "rated_payload")
         home = np.clip(np.zeros(NUM_JOINTS), self._lower, self._upper) if home is None else \
             finite_array(home, "home", "rad", shape=(NUM_JOINTS,))
         if np.any((home < self._lower) | (home > self._upper)):
@@ -128,9 +125,10 @@ class ChainArm(Robot):
                 neither in the file nor given (naming the field).
         """
         path = path_argument(path, "model_file")
+        name = _default_name(name, path.stem, f"the model file's name {path.name!r}")
         plant = _parsed(path)
         return cls.from_plant(plant, base_frame=base_frame, tool_frame=tool_frame, model_file=path,
-                              name=name or path.stem, **limits)
+                              name=name, **limits)
 
     @classmethod
     def from_plant(cls, plant: MultibodyPlant, *, base_frame, tool_frame, name: str | None = None, model_file=None,
@@ -162,7 +160,8 @@ class ChainArm(Robot):
         for key, values in found.items():
             if limits.get(key) is None and np.all(np.isfinite(values)):
                 limits[key] = np.array(values)
-        return cls(chain or from_plant, name=name or plant.GetModelInstanceName(tool.model_instance()),
+        name = _default_name(name, plant.GetModelInstanceName(tool.model_instance()), "the tool body's model instance")
+        return cls(chain or from_plant, name=name,
                    model_file=model_file, base_frame=base.name(), tool_frame=tool.name(),
                    joint_names=[j.name() for j in joints], model_text=model_text,
                    **{key: limits.get(key) for key in LIMIT_ARGUMENTS})
@@ -196,15 +195,24 @@ class ChainArm(Robot):
             path = path_argument(model_file, "model_file")
             return cls.from_plant(_parsed(path), base_frame=base_frame, tool_frame=tool_frame, name=name,
                                   model_file=path, chain=chain, **limits)
+        arm_checks.arm_name(name, "name")  # (the written model's name)
         needed = dict(masses=masses, **{key: limits.get(key) for key in LIMIT_ARGUMENTS[:5]})
         for key, value in needed.items():
             if value is None:
                 raise DrakeTrajError(f"{key} missing for the custom arm {name!r}: its model is written from the DH "
                                      f"table and needs it (pass {key}=)", field=(key,))
-        text = dh_table_urdf(name, table, convention, masses=masses, centres_of_mass=centres_of_mass,
-                             inertias=inertias, link_radius=link_radius,
-                             lower=joint_bound(limits["lower_limits"], "lower_limits", NUM_JOINTS, "rad"),
-                             upper=joint_bound(limits["upper_limits"], "upper_limits", NUM_JOINTS, "rad"),
+        # every argument checked before the model is written and parsed (Drake's parser exits the
+        # process on some bad data, warns only on others)
+        lower = joint_bound(limits["lower_limits"], "lower_limits", NUM_JOINTS, "rad")
+        upper = joint_bound(limits["upper_limits"], "upper_limits", NUM_JOINTS, "rad")
+        arm_checks.ranges(lower, upper, "lower_limits", "upper_limits")
+        joint_limit(limits["acceleration_limits"], "acceleration_limits", NUM_JOINTS, "rad/s^2")
+        arm_checks.payload(limits.get("rated_payload"), "rated_payload")
+        text = dh_table_urdf(name, table, convention,
+                             masses=arm_checks.joint_vector(masses, "masses", "kg", required=True, positive=True),
+                             centres_of_mass=arm_checks.matrix(centres_of_mass, "centres_of_mass", "m", 3, required=False),
+                             inertias=arm_checks.inertia_rows(inertias, "inertias"),
+                             link_radius=arm_checks.link_radius(link_radius, "link_radius"), lower=lower, upper=upper,
                              velocity=joint_limit(limits["velocity_limits"], "velocity_limits", NUM_JOINTS, "rad/s"),
                              effort=joint_limit(limits["effort_limits"], "effort_limits", NUM_JOINTS, "N m"),
                              source=limits.get("data_source") or "")
@@ -256,25 +264,21 @@ class ChainArm(Robot):
 
     def add_to_plant(self, plant):
         """Parse the model (its URDF text, else its file) into ``plant`` (not finalized), weld
-        ``base_frame`` to the world, and give each of the six joints an actuator named
-        ``{joint}_actuator`` (added where the file has none) with the arm's effort limit [N m].
-        Returns the model instance."""
+        ``base_frame`` to the world, and give each of the six joints an actuator (the model's,
+        whatever its name: :func:`~drake_traj.robots.base.joint_actuators`; ``{joint}_actuator``
+        added where the model has none) with the arm's effort limit [N m]. Returns the model
+        instance."""
         if self.model_text is not None:
             (instance,) = Parser(plant).AddModelsFromString(self.model_text, "urdf")
         else:
             (instance,) = Parser(plant).AddModels(str(self.model_path()))
         plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(self.base_frame, instance))
-        actuators = (plant.get_joint_actuator(index) for index in plant.GetJointActuatorIndices())  # (instance): none
-        actuated = {actuator.joint().name(): actuator for actuator in actuators  # before Finalize
-                    if actuator.model_instance() == instance}
+        actuated = joint_actuators(plant, instance)
         for joint_name, effort in zip(self.joint_names, self._effort):
             actuator = actuated.get(joint_name)
             if actuator is None:
                 actuator = plant.AddJointActuator(f"{joint_name}_actuator", plant.GetJointByName(joint_name, instance),
                                                   float(effort))
-            elif actuator.name() != f"{joint_name}_actuator":
-                raise invalid("model_file", f"the actuator of {joint_name!r} in {self.model_file} is named "
-                                            f"{actuator.name()!r}; the simulation expects {joint_name}_actuator")
             actuator.set_effort_limit(float(effort))
             if actuator.effort_limit() != float(effort):
                 raise RuntimeError(f"the effort limit of {actuator.name()} did not take effect")
@@ -302,18 +306,32 @@ class ChainArm(Robot):
         return inverse_kinematics_all(self.model, pose, self.tcp_offset, self._lower, self._upper)
 
     def point_ik(self, points, reference) -> np.ndarray:
-        """IK of TCP positions (N, 3) [m] at the TCP orientation of ``reference``: for each, the
-        solution nearest ``reference`` (each joint moved by whole turns towards it within the limits)."""
+        """IK of TCP positions (N, 3) [m] at the TCP orientation of ``reference``, on its branch:
+        each point's solution is Newton's from the previous point's (the first's from
+        ``reference``: :func:`~drake_traj.robots.chain.inverse_kinematics_near`, within 0.5 rad
+        of it, regular, within the limits); where that fails, the solution of all
+        (:meth:`inverse_kinematics_all`) nearest that start (each joint moved by whole turns
+        towards it within the limits). Points along a path in order follow one branch."""
         reference = finite_array(reference, "reference", "rad", shape=(NUM_JOINTS,))
         orientation = self.tcp_pose(reference)[3:]
-        out = []
+        out, start = [], reference
         for point in np.asarray(points, dtype=float).reshape(-1, 3):
-            candidates = []
-            for q in self.inverse_kinematics_all(np.concatenate([point, orientation])):
-                shifted = q + 2 * np.pi * np.round((reference - q) / (2 * np.pi))
-                candidates.append(np.where((shifted < self._lower) | (shifted > self._upper), q, shifted))
-            out.append(min(candidates, key=lambda q: float(np.sum((q - reference) ** 2))))
+            pose = np.concatenate([point, orientation])
+            q = inverse_kinematics_near(self.model, pose, start, self.tcp_offset, self._lower, self._upper)
+            if q is None:
+                q = self._nearest_solution(pose, start)
+            out.append(q)
+            start = q
         return np.array(out).reshape(-1, NUM_JOINTS)
+
+    def _nearest_solution(self, pose, start) -> np.ndarray:
+        """The solution of ``pose`` (:meth:`inverse_kinematics_all`) nearest ``start`` [rad], each
+        joint moved by whole turns towards it within the limits."""
+        candidates = []
+        for q in self.inverse_kinematics_all(pose):
+            shifted = q + 2 * np.pi * np.round((start - q) / (2 * np.pi))
+            candidates.append(np.where((shifted < self._lower) | (shifted > self._upper), q, shifted))
+        return min(candidates, key=lambda q: float(np.sum((q - start) ** 2)))
 
     def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
         """qd = J⁻¹ [v; 0], qdd = J⁻¹ ([a; 0] - J̇q̇) with the TCP's analytic Jacobian (one q);
@@ -344,18 +362,37 @@ def _parsed(path: Path) -> MultibodyPlant:
     plant = MultibodyPlant(0.0)
     try:
         Parser(plant).AddModels(str(path))
-    except RuntimeError as error:
-        raise invalid("model_file", f"the model file {path} could not be read: {error}") from None
-    plant.Finalize()
+        plant.Finalize()
+    except (RuntimeError, SystemExit) as error:  # Drake's parser exits on some bad data (a limit's lower > upper)
+        raise invalid("model_file", f"the model file {path} could not be read: {_drake_reason(error)}") from None
     return plant
 
 
 def _parsed_text(text: str) -> MultibodyPlant:
-    """A finalized plant of the URDF ``text`` alone."""
+    """A finalized plant of the URDF ``text`` (written from a DH table) alone."""
     plant = MultibodyPlant(0.0)
-    Parser(plant).AddModelsFromString(text, "urdf")
-    plant.Finalize()
+    try:
+        Parser(plant).AddModelsFromString(text, "urdf")
+        plant.Finalize()
+    except (RuntimeError, SystemExit) as error:
+        raise invalid("table", f"the model written from the DH table could not be read: {_drake_reason(error)}") from None
     return plant
+
+
+def _drake_reason(error: BaseException) -> str:
+    """Drake's message of a parser failure (a SystemExit carries it as its code)."""
+    return str(error.code if isinstance(error, SystemExit) else error).strip()
+
+
+def _default_name(name: str | None, default: str, origin: str) -> str:
+    """``name``, or ``default`` (from ``origin``) unless that is a known robot's name (then a
+    DrakeTrajError asking for ``name=``: a custom arm must not pass for a known robot)."""
+    if name is not None:
+        return name
+    if default in ROBOT_NAMES:
+        raise invalid("name", f"the custom arm's name would be {default!r} ({origin}), a known robot's name (runs and "
+                              "exports are told apart by it): give the arm a name of its own (name=)")
+    return default
 
 
 def _check_agreement(chain: SerialChain, other: SerialChain) -> None:

@@ -28,87 +28,29 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Optional, Union
 
-import numpy as np
-
 from drake_traj.errors import DrakeTrajError, field_text
-from drake_traj.robots import ROBOT_NAMES, Robot, get_robot
+from drake_traj.robots import Robot, get_robot
+from drake_traj.robots.arm_checks import ARM_JOINTS, arm_name, inertia_rows, joint_vector, link_radius, matrix, payload, ranges
 from drake_traj.robots.chain_arm import ChainArm
-from drake_traj.validation import finite_array, invalid, real_array
+from drake_traj.validation import invalid
 
 __all__ = ["ARM_JOINTS", "CustomArm", "DhArm", "RobotChoice", "build_chain_arm", "resolve_robot", "robot_label"]
 
-ARM_JOINTS = 6  # a custom arm has six revolute joints
-_NAME_CHARACTERS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-")
-
-
-def _joint_vector(value, name: str, unit: str, *, required: bool, positive: bool = False) -> np.ndarray | None:
-    """``value`` as ARM_JOINTS finite numbers (positive if asked), None when empty and not
-    ``required``; DrakeTrajError naming the field ``name`` otherwise."""
-    array = real_array(value, name, unit)
-    if array.size == 0:
-        if required:
-            raise invalid(name, f"{name} is missing: a custom arm needs {ARM_JOINTS} values [{unit}]")
-        return None
-    array = finite_array(array, name, unit, shape=(ARM_JOINTS,))
-    if positive and np.any(array <= 0):
-        j = int(np.flatnonzero(array <= 0)[0])
-        raise invalid(name, f"{name}[{j}] must be positive [{unit}], got {array[j]:g}", j)
-    return array
-
-
-def _matrix(value, name: str, unit: str, columns: int, *, required: bool) -> np.ndarray | None:
-    """``value`` as a finite (ARM_JOINTS, columns) array, None when empty and not ``required``."""
-    rows = real_array(value, name, unit, "a list of rows of numbers")
-    if rows.size == 0:
-        if required:
-            raise invalid(name, f"{name} is missing: a custom arm needs {ARM_JOINTS} rows of {columns} numbers [{unit}]")
-        return None
-    if rows.shape != (ARM_JOINTS, columns):
-        raise invalid(name, f"{name} must be {ARM_JOINTS} rows of {columns} numbers [{unit}], got shape {rows.shape}")
-    bad = np.argwhere(~np.isfinite(rows))
-    if len(bad):
-        i, k = (int(v) for v in bad[0])
-        raise invalid(name, f"{name}[{i}][{k}] must be finite [{unit}], got {rows[i, k]}", i, k)
-    return rows
-
-
-def _arm_name(value, name: str) -> str:
-    if not isinstance(value, str) or not value or len(value) > 64 or not set(value) <= _NAME_CHARACTERS:
-        raise invalid(name, f"{name} must be a plain name (letters, digits, _ and -; at most 64 characters), got {value!r:.80}")
-    if value in ROBOT_NAMES:
-        raise invalid(name, f"{name} {value!r} is a known robot's name (runs and exports are told apart by it); "
-                            "choose another")
-    return value
-
-
-def _payload(value, name: str) -> float | None:
-    if value is None:
-        return None
-    payload = finite_array(value, name, "kg", shape=())
-    if payload < 0:
-        raise invalid(name, f"{name} must be >= 0 kg, got {float(payload):g}")
-    return float(payload)
-
-
-def _ranges(lower: np.ndarray | None, upper: np.ndarray | None, prefix: str) -> None:
-    if lower is not None and upper is not None and np.any(lower >= upper):
-        j = int(np.flatnonzero(lower >= upper)[0])
-        raise invalid(f"{prefix}.upper", f"{prefix}.upper[{j}] = {upper[j]:g} rad must be above {prefix}.lower[{j}] = "
-                                          f"{lower[j]:g} rad", j)
-
-
-def _inertias(value, name: str) -> np.ndarray | None:
-    """``value`` as (ARM_JOINTS, 6) rows [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] [kg m²] of physical
-    inertias (principal moments >= 0 meeting the triangle inequality), None when empty."""
-    rows = _matrix(value, name, "kg m^2", 6, required=False)
-    for i, (ixx, iyy, izz, ixy, ixz, iyz) in enumerate([] if rows is None else rows):
-        moments = np.linalg.eigvalsh([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-        tolerance = 1e-9 * max(float(np.max(np.abs(moments))), 1e-12)
-        if moments[0] < -tolerance or moments[2] > moments[0] + moments[1] + tolerance:
-            raise invalid(name, f"{name}[{i}] is not a rigid body's inertia: its principal moments "
-                                f"{', '.join(f'{m:.6g}' for m in moments)} kg m^2 must be >= 0 and each at most the sum "
-                                "of the other two", i)
-    return rows
+def _joint_data(arm, prefix: str, *, required: bool) -> dict:
+    """The joint ranges, speeds, accelerations (always required), torques and payload of a
+    CustomArm or DhArm, checked (``required``: the model carries none of them)."""
+    lower = joint_vector(arm.lower, f"{prefix}.lower", "rad", required=required)
+    upper = joint_vector(arm.upper, f"{prefix}.upper", "rad", required=required)
+    ranges(lower, upper, f"{prefix}.lower", f"{prefix}.upper")
+    return dict(
+        lower=lower, upper=upper,
+        velocity_limits=joint_vector(arm.velocity_limits, f"{prefix}.velocity_limits", "rad/s", required=required,
+                                     positive=True),
+        acceleration_limits=joint_vector(arm.acceleration_limits, f"{prefix}.acceleration_limits", "rad/s^2",
+                                         required=True, positive=True),
+        effort_limits=joint_vector(arm.effort_limits, f"{prefix}.effort_limits", "N m", required=required,
+                                   positive=True),
+        payload=payload(arm.payload, f"{prefix}.payload"))
 
 
 @dataclass
@@ -147,19 +89,8 @@ class CustomArm:
             if not isinstance(value, str) or not value.strip():
                 raise invalid(f"{prefix}.{key}", f"{prefix}.{key} is missing: give the model's "
                                                  f"{'file' if key == 'model_file' else key.replace('_', ' ')}")
-        lower = _joint_vector(self.lower, f"{prefix}.lower", "rad", required=False)
-        upper = _joint_vector(self.upper, f"{prefix}.upper", "rad", required=False)
-        _ranges(lower, upper, prefix)
-        return dict(
-            name=_arm_name(self.name, f"{prefix}.name"), base_frame=self.base_frame, tool_frame=self.tool_frame,
-            lower=lower, upper=upper,
-            velocity_limits=_joint_vector(self.velocity_limits, f"{prefix}.velocity_limits", "rad/s", required=False,
-                                          positive=True),
-            acceleration_limits=_joint_vector(self.acceleration_limits, f"{prefix}.acceleration_limits", "rad/s^2",
-                                              required=True, positive=True),
-            effort_limits=_joint_vector(self.effort_limits, f"{prefix}.effort_limits", "N m", required=False,
-                                        positive=True),
-            payload=_payload(self.payload, f"{prefix}.payload"))
+        return dict(name=arm_name(self.name, f"{prefix}.name"), base_frame=self.base_frame, tool_frame=self.tool_frame,
+                    **_joint_data(self, prefix, required=False))
 
 
 @dataclass
@@ -207,26 +138,14 @@ class DhArm:
         if self.convention not in self.CONVENTIONS:
             raise invalid(f"{prefix}.convention", f"{prefix}.convention must be one of {self.CONVENTIONS}, "
                                                   f"got {self.convention!r:.40}")
-        table = _matrix(self.dh, f"{prefix}.dh", "m, m, rad, rad", 4, required=True)
-        lower = _joint_vector(self.lower, f"{prefix}.lower", "rad", required=True)
-        upper = _joint_vector(self.upper, f"{prefix}.upper", "rad", required=True)
-        _ranges(lower, upper, prefix)
-        radius = finite_array(self.link_radius, f"{prefix}.link_radius", "m", shape=())
-        if radius <= 0:
-            raise invalid(f"{prefix}.link_radius", f"{prefix}.link_radius must be positive [m], got {float(radius):g}")
+        table = matrix(self.dh, f"{prefix}.dh", "m, m, rad, rad", 4, required=True)
         return dict(
-            name=_arm_name(self.name, f"{prefix}.name"), convention=self.convention, table=table,
-            lower=lower, upper=upper,
-            velocity_limits=_joint_vector(self.velocity_limits, f"{prefix}.velocity_limits", "rad/s", required=True,
-                                          positive=True),
-            acceleration_limits=_joint_vector(self.acceleration_limits, f"{prefix}.acceleration_limits", "rad/s^2",
-                                              required=True, positive=True),
-            effort_limits=_joint_vector(self.effort_limits, f"{prefix}.effort_limits", "N m", required=True,
-                                        positive=True),
-            masses=_joint_vector(self.masses, f"{prefix}.masses", "kg", required=True, positive=True),
-            centres_of_mass=_matrix(self.centres_of_mass, f"{prefix}.centres_of_mass", "m", 3, required=False),
-            inertias=_inertias(self.inertias, f"{prefix}.inertias"),
-            link_radius=float(radius), payload=_payload(self.payload, f"{prefix}.payload"))
+            name=arm_name(self.name, f"{prefix}.name"), convention=self.convention, table=table,
+            **_joint_data(self, prefix, required=True),
+            masses=joint_vector(self.masses, f"{prefix}.masses", "kg", required=True, positive=True),
+            centres_of_mass=matrix(self.centres_of_mass, f"{prefix}.centres_of_mass", "m", 3, required=False),
+            inertias=inertia_rows(self.inertias, f"{prefix}.inertias"),
+            link_radius=link_radius(self.link_radius, f"{prefix}.link_radius"))
 
 
 RobotChoice = Union[str, CustomArm, DhArm]
@@ -265,7 +184,7 @@ def resolve_robot(choice: RobotChoice, directory: Path | None = None, scenario_f
 # ChainArm's argument and error fields -> the scenario's fields of a custom arm
 _ARGUMENTS = dict(lower="lower_limits", upper="upper_limits", payload="rated_payload")
 _FIELDS = {"lower_limits": "lower", "upper_limits": "upper", "rated_payload": "payload", "table": "dh",
-           "plant": "model_file"}
+           "fixed": "dh", "axes": "dh", "plant": "model_file"}
 
 
 def build_chain_arm(choice: CustomArm | DhArm, arguments: dict, data_source: str = "") -> Robot:

@@ -12,7 +12,7 @@ from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
 from drake_traj.planners.pajak import PajakLaw
 from drake_traj.robots import ur10e
 from drake_traj.robots.chain import (CHAIN, SerialChain, chain_kinematics, chain_singularity_factors,
-                                     inverse_kinematics_all)
+                                     inverse_kinematics_all, inverse_kinematics_near)
 from drake_traj.robots.chain_arm import ChainArm
 from drake_traj.robots.compiled_kinematics import task_kinematics_into
 from drake_traj.robots.task_space import wrap_angle, zyx_euler_from_rotation
@@ -59,7 +59,7 @@ def test_ur10e_dh_chain_is_the_closed_form(tool):
 
 
 def test_ur10e_urdf_chain_is_the_closed_form():
-    arm = ChainArm.from_model_file(ur10e.model_path(), base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
+    arm = ChainArm.from_model_file(ur10e.model_path(), name="generic_ur10e", base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
     assert arm.joint_names == ur10e.JOINT_NAMES
     np.testing.assert_array_equal(arm.upper_limits, ur10e.POSITION_LIMIT)
     np.testing.assert_array_equal(arm.velocity_limits, ur10e.VELOCITY_LIMIT)
@@ -198,11 +198,11 @@ def test_bad_input():
     plant, tool = plant_with(["revolute"] * 3 + ["prismatic"] + ["revolute"] * 2)
     with pytest.raises(DrakeTrajError, match=r"joint 'slider' is PrismaticJoint"):
         SerialChain.from_plant(plant, "world", tool)
-    with pytest.raises(DrakeTrajError, match=r"acceleration_limits missing for the custom arm 'ur10e'") as error:
-        ChainArm.from_model_file(ur10e.model_path(), base_frame="base", tool_frame="tool0")
+    with pytest.raises(DrakeTrajError, match=r"acceleration_limits missing for the custom arm 'generic_ur10e'") as error:
+        ChainArm.from_model_file(ur10e.model_path(), name="generic_ur10e", base_frame="base", tool_frame="tool0")
     assert error.value.field == ("acceleration_limits",)
     with pytest.raises(TypeError, match=r"unknown arguments \['acceleration_limit'\]"):
-        ChainArm.from_model_file(ur10e.model_path(), base_frame="base", tool_frame="tool0", acceleration_limit=1.4)
+        ChainArm.from_model_file(ur10e.model_path(), name="generic_ur10e", base_frame="base", tool_frame="tool0", acceleration_limit=1.4)
     with pytest.raises(DrakeTrajError, match=r"masses missing for the custom arm 'puma': its model is written from the "
                                              r"DH table") as error:
         ChainArm.from_dh("puma", PUMA_DH)  # no model file: one is written from the table and the masses
@@ -229,7 +229,8 @@ def test_add_to_plant_gives_every_joint_its_actuator(tmp_path):
     for joint, effort in zip(ur10e.JOINT_NAMES, efforts):
         actuator = plant.GetJointActuatorByName(f"{joint}_actuator", instance)
         assert actuator.joint().name() == joint and actuator.effort_limit() == effort
-    planned = ChainArm.from_plant(plant, base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
+    planned = ChainArm.from_plant(plant, name="generic_ur10e", base_frame="base", tool_frame="tool0",
+                                  acceleration_limits=1.4)
     np.testing.assert_array_equal(planned.effort_limits, efforts)
     np.testing.assert_allclose(planned.tcp_pose(ur10e.HOME), ur10e.task_pose(ur10e.HOME), atol=1e-12, rtol=0)
     with pytest.raises(DrakeTrajError, match=r"built from a plant without a model_file"):
@@ -251,3 +252,42 @@ def test_robot_services_match_the_ur10e():
     points = ur10e.task_pose(ur10e.HOME)[:3] + np.array([[0.05, 0.0, 0.0], [0.0, -0.1, 0.05]])
     np.testing.assert_allclose(arm.point_ik(points, ur10e.HOME), ur10e.UR10E.point_ik(points, ur10e.HOME),
                                atol=1e-9, rtol=0)
+
+
+@pytest.mark.parametrize("move", [0.7, 1.0])
+def test_point_ik_follows_the_branch_from_a_warm_start_as_the_seeds_would(monkeypatch, move):
+    """point_ik along a path: each point from the previous point's solution (Newton), the same
+    solutions as the seeded search's nearest to that start (to 1e-9 rad), the UR10e's closed form
+    on its branch, and no seeded search while the warm start holds; a far point (another branch
+    nearer) falls back to the seeds."""
+    arm = ChainArm.from_dh("ur10e_dh", UR_DH, model_file=ur10e.model_path(), acceleration_limits=1.4,
+                           home=ur10e.HOME)
+    rng = np.random.default_rng(int(10 * move))
+    for _ in range(3):
+        reference = ur10e.HOME + rng.uniform(-move, move, 6) * np.array([1, 0.3, 0.3, 1, 0.3, 1])
+        tcp = arm.tcp_pose(reference)[:3]
+        path = tcp + np.linspace(0.0, 1.0, 40)[:, None] * rng.uniform(-0.05, 0.05, 3)  # a 2-9 cm line
+        searches = []
+        seeded = arm.inverse_kinematics_all
+        monkeypatch.setattr(arm, "inverse_kinematics_all", lambda pose: searches.append(pose) or seeded(pose))
+        warm = arm.point_ik(path, reference)
+        assert searches == []  # every point from the previous one
+        monkeypatch.undo()
+        start = reference
+        for point, q in zip(path, warm):
+            expected = arm._nearest_solution(np.concatenate([point, arm.tcp_pose(reference)[3:]]), start)
+            np.testing.assert_allclose(q, expected, atol=1e-9, rtol=0)
+            start = q
+        np.testing.assert_allclose(warm, ur10e.UR10E.point_ik(path, reference), atol=1e-9, rtol=0)
+    # Newton from HOME: taken within 0.5 rad and the limits, refused beyond either
+    near = ur10e.HOME + np.array([0.1, 0.0, 0.0, 0.0, 0.0, 0.0])
+    lower, upper = arm.lower_limits, arm.upper_limits
+    np.testing.assert_allclose(inverse_kinematics_near(arm.model, ur10e.task_pose(near), ur10e.HOME, lower=lower,
+                                                       upper=upper), near, atol=1e-9, rtol=0)
+    assert inverse_kinematics_near(arm.model, ur10e.task_pose(near), ur10e.HOME, lower=lower,
+                                   upper=np.r_[ur10e.HOME[0] + 0.05, upper[1:]]) is None
+    assert inverse_kinematics_near(arm.model, ur10e.task_pose(ur10e.HOME + np.r_[0.6, np.zeros(5)]), ur10e.HOME,
+                                   lower=lower, upper=upper) is None
+    path = arm.tcp_pose(ur10e.HOME)[:3] + np.array([[0.0, 0.0, 0.0], [0.3, -0.2, 0.1]])
+    monkeypatch.setattr("drake_traj.robots.chain_arm.inverse_kinematics_near", lambda *args: None)
+    np.testing.assert_allclose(arm.point_ik(path, ur10e.HOME), ur10e.UR10E.point_ik(path, ur10e.HOME), atol=1e-9, rtol=0)

@@ -35,7 +35,7 @@ def dh_arm():
 
 
 def urdf_arm():
-    return ChainArm.from_model_file(ur10e.model_path(), base_frame="base", tool_frame="tool0",
+    return ChainArm.from_model_file(ur10e.model_path(), name="generic_ur10e", base_frame="base", tool_frame="tool0",
                                     acceleration_limits=1.4, home=ur10e.HOME)
 
 
@@ -75,7 +75,7 @@ def test_plant_built_arm_ik_is_the_closed_forms():
     Parser(plant).AddModels(str(ur10e.model_path()))
     plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("base"))
     plant.Finalize()
-    arm = ChainArm.from_plant(plant, base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
+    arm = ChainArm.from_plant(plant, name="generic_ur10e", base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
     rng = np.random.default_rng(24)
     for _ in range(4):
         pose = ur10e.task_pose(rng.uniform(-np.pi, np.pi, 6))

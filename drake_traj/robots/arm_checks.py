@@ -1,0 +1,106 @@
+"""The checks of a custom 6-axis arm's data, one set for both ways in: a scenario's
+``!CustomArm``/``!DhArm`` (:mod:`drake_traj.robots.custom`, fields ``robot.lower``, ...) and
+:class:`~drake_traj.robots.chain_arm.ChainArm` and its constructors (arguments ``lower_limits``,
+...). Each takes the name of its field and raises a DrakeTrajError (a ValueError) naming it (and
+the index: ``masses[2]``); they run before a model is written or parsed, so Drake never sees
+data it would refuse.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drake_traj.robots import ROBOT_NAMES
+from drake_traj.validation import finite_array, invalid, real_array
+
+__all__ = ["ARM_JOINTS", "arm_name", "inertia_rows", "joint_vector", "link_radius", "matrix", "payload", "ranges"]
+
+ARM_JOINTS = 6  # a custom arm has six revolute joints
+_NAME_CHARACTERS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-")
+
+
+def joint_vector(value, name: str, unit: str, *, required: bool, positive: bool = False) -> np.ndarray | None:
+    """``value`` as ARM_JOINTS finite numbers (positive if asked), None when empty (or None) and
+    not ``required``."""
+    array = real_array([] if value is None else value, name, unit)
+    if array.size == 0:
+        if required:
+            raise invalid(name, f"{name} is missing: a custom arm needs {ARM_JOINTS} values [{unit}]")
+        return None
+    array = finite_array(array, name, unit, shape=(ARM_JOINTS,))
+    if positive and np.any(array <= 0):
+        j = int(np.flatnonzero(array <= 0)[0])
+        raise invalid(name, f"{name}[{j}] must be positive [{unit}], got {array[j]:g}", j)
+    return array
+
+
+def matrix(value, name: str, unit: str, columns: int, *, required: bool) -> np.ndarray | None:
+    """``value`` as a finite (ARM_JOINTS, columns) array, None when empty (or None) and not
+    ``required``."""
+    rows = real_array([] if value is None else value, name, unit, "a list of rows of numbers")
+    if rows.size == 0:
+        if required:
+            raise invalid(name, f"{name} is missing: a custom arm needs {ARM_JOINTS} rows of {columns} numbers [{unit}]")
+        return None
+    if rows.shape != (ARM_JOINTS, columns):
+        raise invalid(name, f"{name} must be {ARM_JOINTS} rows of {columns} numbers [{unit}], got shape {rows.shape}")
+    bad = np.argwhere(~np.isfinite(rows))
+    if len(bad):
+        i, k = (int(v) for v in bad[0])
+        raise invalid(name, f"{name}[{i}][{k}] must be finite [{unit}], got {rows[i, k]}", i, k)
+    return rows
+
+
+def arm_name(value, name: str, *, plain: bool = True) -> str:
+    """A custom arm's name: a non-empty text (``plain``: letters, digits, _ and -, at most 64
+    characters, as it goes into a written model), not a known robot's (:data:`ROBOT_NAMES`:
+    runs and exports are told apart by the name)."""
+    if not isinstance(value, str) or not value or (
+            plain and (len(value) > 64 or not set(value) <= _NAME_CHARACTERS)):
+        what = "a plain name (letters, digits, _ and -; at most 64 characters)" if plain else "a non-empty text"
+        raise invalid(name, f"{name} must be {what}, got {value!r:.80}")
+    if value in ROBOT_NAMES:
+        raise invalid(name, f"{name} {value!r} is a known robot's name (runs and exports are told apart by it); "
+                            "choose another")
+    return value
+
+
+def payload(value, name: str) -> float | None:
+    """A rated payload [kg]: finite and > 0, or None (not rated)."""
+    if value is None:
+        return None
+    rating = finite_array(value, name, "kg", shape=())
+    if rating <= 0:
+        raise invalid(name, f"{name} must be positive [kg] (leave it out for an arm without a rating), "
+                            f"got {float(rating):g}")
+    return float(rating)
+
+
+def ranges(lower: np.ndarray | None, upper: np.ndarray | None, lower_name: str, upper_name: str) -> None:
+    """Each joint's upper limit above its lower limit [rad]; the error names ``upper_name[j]``."""
+    if lower is not None and upper is not None and np.any(lower >= upper):
+        j = int(np.flatnonzero(lower >= upper)[0])
+        raise invalid(upper_name, f"{upper_name}[{j}] = {upper[j]:g} rad must be above {lower_name}[{j}] = "
+                                  f"{lower[j]:g} rad", j)
+
+
+def inertia_rows(value, name: str) -> np.ndarray | None:
+    """``value`` as (ARM_JOINTS, 6) rows [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] [kg m²] of physical
+    inertias (principal moments >= 0 meeting the triangle inequality), None when empty."""
+    rows = matrix(value, name, "kg m^2", 6, required=False)
+    for i, (ixx, iyy, izz, ixy, ixz, iyz) in enumerate([] if rows is None else rows):
+        moments = np.linalg.eigvalsh([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        tolerance = 1e-9 * max(float(np.max(np.abs(moments))), 1e-12)
+        if moments[0] < -tolerance or moments[2] > moments[0] + moments[1] + tolerance:
+            raise invalid(name, f"{name}[{i}] is not a rigid body's inertia: its principal moments "
+                                f"{', '.join(f'{m:.6g}' for m in moments)} kg m^2 must be >= 0 and each at most the sum "
+                                "of the other two", i)
+    return rows
+
+
+def link_radius(value, name: str) -> float:
+    """The links' capsule radius [m]: finite and > 0."""
+    radius = finite_array(value, name, "m", shape=())
+    if radius <= 0:
+        raise invalid(name, f"{name} must be positive [m], got {float(radius):g}")
+    return float(radius)
