@@ -75,7 +75,8 @@ def test_readme_your_arm_python_a_users_urdf_in_the_station_and_beside_a_users_p
     model = str(data_directory("models") / "ur5e.urdf")
     start = ur_eseries.HOME
     down = [np.pi, 0.0, 3 * np.pi / 4]
-    task = PajakConfig(waypoints=[[-0.134, -0.378, 0.51, *down], [0.16, -0.378, 0.51, *down]])
+    task = PajakConfig(waypoints=[[-0.134, -0.378, 0.51, *down], [0.16, -0.378, 0.51, *down]],
+                       velocity_limit=1.05, acceleration_limit=1.4)
     arm = ChainArm.from_model_file(model, name="my_arm", base_frame="base", tool_frame="tool0", acceleration_limits=1.4,
                                    home=start)
     result = simulate(make_planner_for(task, arm, start))
