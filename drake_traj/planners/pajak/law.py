@@ -21,6 +21,8 @@ docs/papers.md (Pająk 2024) and at the functions of :mod:`.kernel` that impleme
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from drake_traj.errors import Cause, PlanningError, SingularConfigurationError, joint_label
@@ -38,8 +40,9 @@ from drake_traj.planners.pajak.kernel import (
     finished_kernel,
     update_kernel,
 )
-from drake_traj.planners.pajak.parameters import PajakConfig, limits_for_robot
+from drake_traj.planners.pajak.parameters import TASK_JOINTS, PajakConfig
 from drake_traj.robots import UR10E, Robot
+from drake_traj.validation import limit_or_default
 
 __all__ = ["DISCRETE_NAMES", "PajakLaw"]
 
@@ -88,7 +91,11 @@ class PajakLaw:
         self.robot, self.kinematics = robot, kinematics
         self.tool = np.ascontiguousarray(kinematics.tool, dtype=float)  # X_FT, the kernels' ``tool``
         self.model = np.ascontiguousarray(kinematics.model, dtype=float)  # the arm, the kernels' ``model``
-        p = limits_for_robot(parameters.validate(), robot).validate()  # None limits: the robot's joint-move limits
+        p = parameters.validate()
+        velocity, acceleration = robot.joint_move_limits  # where the task gives none
+        p = replace(p, velocity_limit=limit_or_default(p.velocity_limit, velocity, "velocity_limit", TASK_JOINTS),
+                    acceleration_limit=limit_or_default(p.acceleration_limit, acceleration, "acceleration_limit",
+                                                        TASK_JOINTS))
         self.parameters = p
         self.waypoints = np.ascontiguousarray(p.waypoints)
         count = len(self.waypoints)

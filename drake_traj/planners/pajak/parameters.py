@@ -10,8 +10,7 @@ from drake_traj.robots import ur10e  # the paper's arm: its task, start and join
 from drake_traj.validation import flag, invalid, positive_vector, real_array, step_size
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
 
-__all__ = ["PAPER_METHOD", "PajakConfig", "TASK_JOINTS", "limits_for_robot", "paper_initial_configuration",
-           "paper_parameters"]
+__all__ = ["PAPER_METHOD", "PajakConfig", "TASK_JOINTS", "paper_initial_configuration", "paper_parameters"]
 
 TASK_JOINTS = 6  # the planner drives six joints, one per task coordinate [x, y, z, φ_X, φ_Y, φ_Z]
 
@@ -114,7 +113,7 @@ class PajakConfig:
 
     def validate(self) -> "PajakConfig":
         """Check every field; return a copy with arrays normalised ((w, 6) waypoints, (6,) gains
-        and limits, None limits kept: :meth:`for_robot` fills them). Raises ValueError naming the
+        and limits; None limits kept: the law takes the robot's). Raises ValueError naming the
         field."""
         n = TASK_JOINTS
         waypoints = real_array(self.waypoints, "waypoints", "m and rad, shape (w, 6)")
@@ -171,14 +170,6 @@ class PajakConfig:
         ):
             flag(getattr(self, name), name)
         return replace(self, waypoints=waypoints, vartheta=float(vartheta), **values)
-
-
-def limits_for_robot(config: PajakConfig, robot) -> PajakConfig:
-    """``config`` with a velocity or acceleration limit left out (None) taken from ``robot``'s
-    joint-move limits (:attr:`~drake_traj.robots.base.Robot.joint_move_limits`, per joint)."""
-    velocity, acceleration = robot.joint_move_limits
-    return replace(config, velocity_limit=velocity if config.velocity_limit is None else config.velocity_limit,
-                   acceleration_limit=acceleration if config.acceleration_limit is None else config.acceleration_limit)
 
 
 def paper_initial_configuration() -> np.ndarray:

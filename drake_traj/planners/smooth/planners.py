@@ -13,7 +13,6 @@ from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.planners.baselines.ruckig import jerk_limited_limits
 from drake_traj.planners.pajak import PajakConfig, PajakPlanner
-from drake_traj.planners.pajak.parameters import limits_for_robot
 from drake_traj.planners.smooth.timing import SmoothTiming, time_path
 from drake_traj.robots import Robot
 from drake_traj.validation import instance_of, positive_vector, whole_number
@@ -137,7 +136,11 @@ class RetimedPajakConfig:
 def pajak_joint_path(config: PajakConfig, robot: Robot, q_initial) -> np.ndarray:
     """The joint samples [rad] (N, n) of the Pająk planner's planned motion (its preflight, one
     sample per update period up to the finish), the path the re-timed planner times."""
-    plan = PajakPlanner(config, q_initial, robot=robot).plan()
+    return _pajak_samples(PajakPlanner(config, q_initial, robot=robot))
+
+
+def _pajak_samples(planner: PajakPlanner) -> np.ndarray:
+    plan = planner.plan()
     return plan.vector_values(plan.get_segment_times()).T
 
 
@@ -145,12 +148,10 @@ def make_retimed_pajak(config: RetimedPajakConfig, robot: Robot, q_initial) -> S
     """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]: raises what the Pająk
     preflight raises (an unreachable waypoint, a stall, ...) and what the timing raises."""
     instance_of(config.pajak, PajakConfig, "pajak")
-    samples = pajak_joint_path(config.pajak, robot, q_initial)
-    pajak = limits_for_robot(config.pajak, robot)  # the limits the Pająk planner kept
-    n = robot.num_joints
-    velocity, acceleration, jerk = jerk_limited_limits(robot, np.broadcast_to(pajak.velocity_limit, (n,)),
-                                                       np.broadcast_to(pajak.acceleration_limit, (n,)),
-                                                       config.jerk_limit)
+    pajak = PajakPlanner(config.pajak, q_initial, robot=robot)
+    samples = _pajak_samples(pajak)
+    velocity, acceleration, jerk = jerk_limited_limits(robot, pajak.velocity_limit, pajak.acceleration_limit,
+                                                       config.jerk_limit)  # the limits the Pająk planner kept
     timing = _timed(samples, "pajak", velocity, acceleration, jerk,
                     whole_number(config.grid_points, "grid_points", minimum=20))
     return SmoothPlanner(timing, velocity, acceleration, jerk,
