@@ -83,7 +83,7 @@ class TaskKinematics(NamedTuple):
         tool: X_FT (4, 4), the TCP in the flange frame (:attr:`Robot.tcp_offset`), the ``tool``
             argument of ``kinematics_into``.
         singularity_factors: ``q (n,) -> {name: (factor, meaning)}``, the factors of det J at q,
-            each in [0, 1] and 0 at its singularity (the singularity measure is the smallest),
+            each >= 0 and 0 at its singularity (the singularity measure, in [0, 1], is the smallest),
             with what that singularity is (to name it in a message).
         model: the arm's kinematic data (1-D float array), the ``model`` argument of
             ``kinematics_into``.

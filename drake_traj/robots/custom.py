@@ -31,6 +31,7 @@ from typing import Optional, Union
 from drake_traj.errors import DrakeTrajError, field_text
 from drake_traj.robots import Robot, get_robot
 from drake_traj.robots.arm_checks import ARM_JOINTS, arm_name, inertia_rows, joint_vector, link_radius, matrix, payload, ranges
+from drake_traj.robots.chain import CONVENTIONS
 from drake_traj.robots.chain_arm import ChainArm
 from drake_traj.validation import invalid
 
@@ -130,13 +131,11 @@ class DhArm:
     payload: Optional[float] = None
     source: str = ""
 
-    CONVENTIONS = ("standard", "modified")
-
     def validate(self, prefix: str = "robot") -> dict:
         """The checked values as ChainArm's keyword arguments; DrakeTrajError naming the field
         (``robot.dh[2][1]``) otherwise."""
-        if self.convention not in self.CONVENTIONS:
-            raise invalid(f"{prefix}.convention", f"{prefix}.convention must be one of {self.CONVENTIONS}, "
+        if self.convention not in CONVENTIONS:
+            raise invalid(f"{prefix}.convention", f"{prefix}.convention must be one of {CONVENTIONS}, "
                                                   f"got {self.convention!r:.40}")
         table = matrix(self.dh, f"{prefix}.dh", "m, m, rad, rad", 4, required=True)
         return dict(

@@ -18,9 +18,7 @@ from drake_traj.robots.task_space import (pose_error, rotation_from_zyx_euler, w
                                           zyx_euler_from_rotation)
 from drake_traj.robots.ur_eseries import (BASE_FRAME, DEFAULT_JOINT_MOVE_ACCELERATION,  # noqa: F401
                                           DEFAULT_JOINT_MOVE_VELOCITY, DH_ALPHA, FLANGE_FRAME, HOME,
-                                          IK_BRANCHES, IK_PATH_MAX_STEP, IK_SINGULAR_TOLERANCE, JOINT_NAMES,
-                                          NUM_JOINTS, UR10E, UR10E_DATA, UR10E_KD, UR10E_KP, UR_CLOSED_FORM,
-                                          UR10e, kinematics_into)
+                                          IK_BRANCHES, JOINT_NAMES, NUM_JOINTS, UR10E, UR10E_DATA, UR10e)
 
 __all__ = ["UR10E", "UR10e"]
 
@@ -29,7 +27,6 @@ DH_A = np.array(UR10E_DATA.a)  # [m]
 POSITION_LIMIT = np.array(UR10E_DATA.position_limit)  # [rad], symmetric
 VELOCITY_LIMIT = np.array(UR10E_DATA.velocity_limit)  # [rad/s]
 EFFORT_LIMIT = np.array(UR10E_DATA.effort_limit)  # [N m]
-DEFAULT_KP, DEFAULT_KD = UR10E_KP, UR10E_KD
 LINK_MASSES = np.array(UR10E_DATA.link_masses)  # [kg], links 1..6
 BASE_MASS = UR10E_DATA.base_mass  # [kg], approximate; the base is welded to the world.
 MODEL = UR10E.model  # [UR_CLOSED_FORM, d1, a2, a3, d4, d5, d6]

@@ -13,8 +13,8 @@ p = k(q) = [x, y, z, phi_X, phi_Y, phi_Z]: the TCP's position in metres and Z-Y-
 radians (R = Rz(phi_Z) Ry(phi_Y) Rx(phi_X)), as used by UR's software and by Pająk 2024. The TCP is
 the flange unless a ``tool`` X_FT (4x4, the TCP in the flange frame; ``Robot.with_tcp``) is given.
 
-Everything here is plain numpy so tests and planners can call it without building a plant; the
-tests check it against Drake's MultibodyPlant.
+Nothing here needs a plant (the kinematics are numpy and the compiled closed form); the tests
+check it against Drake's MultibodyPlant.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ from drake_traj.robots.task_space import (is_flange, orientation_error, pose_err
 from drake_traj.robots.ur_closed_form import UR_CLOSED_FORM, kinematics_into, kinematics_many, singularity_measure_many
 from drake_traj.validation import invalid, real_array
 
-__all__ = ["UR3E", "UR5E", "UR10E", "UR16E", "UR20", "UR_ARMS", "URArm", "URData", "UR_CLOSED_FORM", "kinematics_into"]
+__all__ = ["UR3E", "UR5E", "UR10E", "UR16E", "UR20", "UR_ARMS", "URArm", "URData"]
 
 NUM_JOINTS = 6
 DH_ALPHA = np.array([np.pi / 2, 0.0, 0.0, np.pi / 2, -np.pi / 2, 0.0])  # [rad], every e-Series arm
@@ -186,7 +186,6 @@ UR20_DATA = URData(
     velocity_limit=_degrees(120, 120, 150, 210, 210, 210), effort_limit=(738.0, 738.0, 433.0, 107.0, 107.0, 107.0),
     rated_payload=20.0, reach=1.75, tube_offsets=(0.260, 0.043), size=0.1593 / 0.11985)
 
-FAMILY_DATA = (UR3E_DATA, UR5E_DATA, UR10E_DATA, UR16E_DATA, UR20_DATA)
 
 
 
@@ -483,13 +482,11 @@ class URArm(Robot):
         return a2 * math.cos(q[1]) + a3 * math.cos(q[1] + q[2]) + d5 * math.sin(q[1] + q[2] + q[3])
 
     def singularity_factors(self, q) -> dict[str, tuple[float, str]]:
-        """The three factors of det J_g at one configuration q [rad] (6,), each in [0, 1] and zero at
-        its singularity (:meth:`singularity_measure` is the smallest), with what that singularity is:
+        """The three factors of det J_g at one configuration q [rad] (6,), each >= 0 and zero at its
+        singularity (the shoulder's may exceed 1 by d5's share) (:meth:`singularity_measure` is the smallest), with what that singularity is:
         ``elbow`` |sin q3|, ``wrist`` |sin q5|, ``shoulder`` |a2 c2 + a3 c23 + d5 s234| / (|a2| + |a3|)."""
         q = np.asarray(q, dtype=float)
-        a2, a3, d5 = self._a[1], self._a[2], self._d[4]
-        shoulder = (a2 * np.cos(q[1]) + a3 * np.cos(q[1] + q[2]) + d5 * np.sin(q[1] + q[2] + q[3])) / (
-            abs(a2) + abs(a3))
+        shoulder = self._shoulder_factor(q) / (abs(self._a[1]) + abs(self._a[2]))
         return {"elbow": (float(abs(np.sin(q[2]))), "sin q3 near 0, the arm stretched or folded"),
                 "wrist": (float(abs(np.sin(q[4]))), "sin q5 near 0, joints 4 and 6 aligned"),
                 "shoulder": (float(abs(shoulder)), "the wrist centre near the axis of joint 1")}
