@@ -8,7 +8,7 @@ configuration. Three measurements, each as the median of ``--repeats`` runs, the
 one after the other within each repeat:
 
 1. the kinematics alone: k(q), J, J̇q̇ and the singularity measure at 20000 random states, in a
-   compiled loop (``kinematics_many`` against ``chain._kinematics_many``), per call;
+   compiled loop (``compiled_kinematics.kinematics_many`` on each arm's model), per call;
 2. the law: ``evaluate_kernel`` (q̈ and c, what the simulation calls every step) from Python at
    the states of the closed form's own motion (one every 10 ms), per call;
 3. the law integrated: the compiled ``integrate_kernel`` of the whole task (RK4 at 1 ms, four
@@ -34,7 +34,7 @@ from drake_traj.planners.pajak import PajakLaw
 from drake_traj.planners.pajak.integration import integrate
 from drake_traj.planners.pajak.kernel import Discrete, Evaluation, Log, evaluate_kernel, integrate_kernel
 from drake_traj.robots import chain, ur10e
-from drake_traj.robots.ur_closed_form import kinematics_many
+from drake_traj.robots.compiled_kinematics import kinematics_many
 from drake_traj.robots.chain_arm import ChainArm
 from drake_traj.scenario import load_scenario
 
@@ -101,7 +101,7 @@ def main():
     q, qd = rng.uniform(-np.pi, np.pi, (20000, 6)), rng.uniform(-1.0, 1.0, (20000, 6))
     # warm up (compilation or the numba cache)
     kinematics_seconds(kinematics_many, ur10e.MODEL, q[:10], qd[:10])
-    kinematics_seconds(chain._kinematics_many, arm.model, q[:10], qd[:10])
+    kinematics_seconds(kinematics_many, arm.model, q[:10], qd[:10])
     law_seconds(closed_law, states[:5])
     law_seconds(chain_law, states[:5])
     path = ur10e.task_pose(q0)[:3] + np.cumsum(rng.normal(scale=4e-4, size=(200, 3)), axis=0)  # 2 ms of 0.2 m/s
@@ -110,7 +110,7 @@ def main():
     finish = []
     for _ in range(args.repeats):
         times["kinematics"][0].append(kinematics_seconds(kinematics_many, ur10e.MODEL, q, qd))
-        times["kinematics"][1].append(kinematics_seconds(chain._kinematics_many, arm.model, q, qd))
+        times["kinematics"][1].append(kinematics_seconds(kinematics_many, arm.model, q, qd))
         times["law"][0].append(law_seconds(closed_law, states))
         times["law"][1].append(law_seconds(chain_law, states))
         for k, law in enumerate((closed_law, chain_law)):

@@ -43,7 +43,7 @@ from drake_traj.robots import task_space
 from drake_traj.robots.task_space import rotation_from_zyx_euler, tcp_rows_into, velocity_product_terms, wrap_angle
 from drake_traj.validation import finite_array, invalid, real_array
 
-__all__ = ["CHAIN", "SerialChain", "chain_kinematics", "chain_kinematics_into", "chain_reach",
+__all__ = ["CHAIN", "SerialChain", "chain_kinematics_into", "chain_reach",
            "chain_singularity_factors", "dh_link_frames", "dh_table", "inverse_kinematics_all"]
 
 # The compiled functions below that call task_space's close over its digest, numba's cache key
@@ -399,44 +399,19 @@ def _chain_kinematics_into_with(dependencies):
 chain_kinematics_into = _chain_kinematics_into_with(_DEPENDENCIES)
 
 
-def _kinematics_many_with(dependencies):
-    @compiled
-    def _kinematics_many(model, q, qd, tool, pose, jac, bias, cos_pitch, measure):
-        dependencies  # noqa: B018 (numba's cache key: drake_traj.compiled.sources_digest)
-        for k in range(q.shape[0]):
-            cos_pitch[k], measure[k] = chain_kinematics_into(model, q[k], qd[k], tool, pose[k], jac[k], bias[k])
-
-    return _kinematics_many
-
-
-_kinematics_many = _kinematics_many_with(_DEPENDENCIES)
-
-
-def chain_kinematics(model, q, qd, tool=FLANGE):
-    """(k(q), J(q), J̇q̇, cos φ_Y, singularity measure) of the TCP ``tool`` (X_FT) of the packed
-    chain ``model`` for q [rad], q̇ [rad/s] of shape (..., 6): pose (..., 6) [m, rad], J (..., 6, 6),
-    bias (..., 6) [m/s², rad/s²], cos_pitch (...), measure (...) (:func:`chain_kinematics_into`)."""
-    q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
-    shape = np.broadcast_shapes(q.shape, qd.shape)
-    if shape[-1:] != (NUM_JOINTS,):
-        raise ValueError(f"q and qd must have shape (..., 6), got {q.shape} and {qd.shape}")
-    rows = np.ascontiguousarray(np.broadcast_to(q, shape).reshape(-1, NUM_JOINTS))
-    rates = np.ascontiguousarray(np.broadcast_to(qd, shape).reshape(-1, NUM_JOINTS))
-    count = rows.shape[0]
-    pose, jac, bias = np.empty((count, 6)), np.empty((count, 6, 6)), np.empty((count, 6))
-    cos_pitch, measure = np.empty(count), np.empty(count)
-    _kinematics_many(np.ascontiguousarray(model, dtype=float), rows, rates, np.ascontiguousarray(tool, dtype=float),
-                     pose, jac, bias, cos_pitch, measure)
-    lead = shape[:-1]
-    return (pose.reshape(lead + (6,)), jac.reshape(lead + (6, 6)), bias.reshape(lead + (6,)), cos_pitch.reshape(lead),
-            measure.reshape(lead))
+def _measure(model, q, tool=FLANGE) -> float:
+    """The singularity measure of the packed chain ``model`` at one configuration q [rad] (6,)
+    (:func:`chain_kinematics_into`; batches: :func:`~drake_traj.robots.compiled_kinematics.task_kinematics`)."""
+    return chain_kinematics_into(np.ascontiguousarray(model, dtype=float), np.asarray(q, dtype=float),
+                                 np.zeros(NUM_JOINTS), np.ascontiguousarray(tool, dtype=float), np.empty(6),
+                                 np.empty((6, 6)), np.empty(6))[1]
 
 
 def chain_singularity_factors(model, q) -> dict[str, tuple[float, str]]:
     """{"jacobian": (measure, meaning)} at one configuration q [rad] (6,) of the packed chain
     ``model``: its one factor, the cube root of the Hadamard ratio of the scaled geometric
     Jacobian (module docstring), in [0, 1] and zero at a singular J (the TaskKinematics contract)."""
-    measure = float(chain_kinematics(model, q, np.zeros(NUM_JOINTS))[4])
+    measure = float(_measure(model, q))
     return {"jacobian": (measure, "the six joint twists near linear dependence (|det J| / product of its scaled "
                                   "column norms near 0)")}
 
@@ -644,7 +619,7 @@ def inverse_kinematics_all(model, pose, tool=FLANGE, lower=None, upper=None) -> 
                              f"the arm reaches at most {chain_reach(model):.6g} m from it, and no solution was found "
                              f"from {len(seeds)} starts", cause=Cause.UNREACHABLE)
     found.sort(key=tuple)
-    measures = chain_kinematics(model, np.array(found), np.zeros(NUM_JOINTS), tool)[4].reshape(-1)
+    measures = [_measure(model, q, tool) for q in found]
     regular = [q for q, measure in zip(found, measures) if measure >= IK_SINGULAR_TOLERANCE]
     if not regular:
         raise SingularConfigurationError(f"{where} is reached only at singular configurations (singularity measure "
@@ -678,6 +653,6 @@ def inverse_kinematics_near(model, pose, start, tool=FLANGE, lower=None, upper=N
     if (lower is not None and np.any(q < np.asarray(lower) - 1e-12)) or \
             (upper is not None and np.any(q > np.asarray(upper) + 1e-12)):
         return None
-    if chain_kinematics(model, q, np.zeros(NUM_JOINTS), tool)[4] < IK_SINGULAR_TOLERANCE:
+    if _measure(model, q, tool) < IK_SINGULAR_TOLERANCE:
         return None
     return q

@@ -17,8 +17,9 @@ from pydrake.multibody.plant import MultibodyPlant
 from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_label
 from drake_traj.robots import ROBOT_NAMES, arm_checks
 from drake_traj.robots.base import Robot, TaskKinematics, format_point, joint_actuators
-from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_kinematics, chain_reach, chain_singularity_factors,
+from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_reach, chain_singularity_factors,
                                      inverse_kinematics_all, inverse_kinematics_near, plant_chain, plant_frame)
+from drake_traj.robots.compiled_kinematics import task_kinematics as arm_kinematics
 from drake_traj.robots.compiled_kinematics import task_kinematics_into
 from drake_traj.robots.task_space import orientation_error, pose_error, wrap_angle, wrapped
 from drake_traj.robots.urdf_writer import dh_table_urdf
@@ -286,7 +287,7 @@ class ChainArm(Robot):
 
     # ---- kinematics --------------------------------------------------------------------------
     def _kinematics(self, q, qd):
-        return chain_kinematics(self.model, q, qd, self.tcp_offset)
+        return arm_kinematics(self.model, q, qd, self.tcp_offset)
 
     def tcp_pose(self, q) -> np.ndarray:
         q = self.joint_positions(q)
@@ -399,8 +400,8 @@ def _check_agreement(chain: SerialChain, other: SerialChain) -> None:
     """DrakeTrajError unless the two chains' flange poses agree to :data:`FK_AGREEMENT` at a few
     configurations (zeros and three fixed pseudo-random ones)."""
     configurations = np.vstack([np.zeros(NUM_JOINTS), np.random.default_rng(0).uniform(-np.pi, np.pi, (3, 6))])
-    mine = chain_kinematics(chain.packed(), configurations, np.zeros(NUM_JOINTS))[0]
-    theirs = chain_kinematics(other.packed(), configurations, np.zeros(NUM_JOINTS))[0]
+    mine = arm_kinematics(chain.packed(), configurations, np.zeros(NUM_JOINTS))[0]
+    theirs = arm_kinematics(other.packed(), configurations, np.zeros(NUM_JOINTS))[0]
     gap = np.abs(mine - theirs)
     gap[:, 3:] = np.abs(wrap_angle(mine[:, 3:] - theirs[:, 3:]))
     if np.max(gap) > FK_AGREEMENT:

@@ -15,13 +15,16 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from drake_traj.compiled import compiled, sources_digest
 from drake_traj.robots import chain, task_space, ur_closed_form
+from drake_traj.robots.base import FLANGE
 from drake_traj.robots.chain import CHAIN, chain_kinematics_into
 from drake_traj.robots.ur_closed_form import UR_CLOSED_FORM
 from drake_traj.robots.ur_closed_form import kinematics_into as ur_kinematics_into
 
-__all__ = ["SOURCES", "task_kinematics_into"]
+__all__ = ["SOURCES", "kinematics_many", "task_kinematics", "task_kinematics_into"]
 
 # The source files of the compiled code behind task_kinematics_into: it and its compiled callers
 # (the Pająk kernel) close over their digest, numba's cache key (drake_traj.compiled).
@@ -49,3 +52,46 @@ def _task_kinematics_into_with(dependencies):
 
 
 task_kinematics_into = _task_kinematics_into_with(_DEPENDENCIES)
+
+def _kinematics_many_with(dependencies):
+    @compiled
+    def kinematics_many(model, q, qd, tool, pose, jac, bias, cos_pitch, measure):
+        """:func:`task_kinematics_into` for each row of q, q̇ (k, 6) into the rows of the outputs."""
+        dependencies  # noqa: B018 (numba's cache key: drake_traj.compiled.sources_digest)
+        for k in range(q.shape[0]):
+            cos_pitch[k], measure[k] = task_kinematics_into(model, q[k], qd[k], tool, pose[k], jac[k], bias[k])
+
+    return kinematics_many
+
+
+kinematics_many = _kinematics_many_with(_DEPENDENCIES)
+
+
+def task_kinematics(model, q, qd, tool=FLANGE):
+    """(k(q), J(q), J̇(q, q̇) q̇, cos φ_Y, singularity measure) of the TCP ``tool`` (X_FT, 4x4;
+    default the flange) of the arm ``model`` (:func:`task_kinematics_into`), vectorised over
+    leading dimensions: q [rad], q̇ [rad/s] of shape (..., 6).
+
+    Returns:
+        pose (..., 6) [m, rad], J (..., 6, 6), bias (..., 6) [m/s², rad/s²], cos_pitch (...),
+        measure (...); for one state, cos_pitch and measure are floats. No exception at gimbal
+        lock: callers check ``cos_pitch``.
+    """
+    model, tool = np.ascontiguousarray(model, dtype=float), np.ascontiguousarray(tool, dtype=float)
+    q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
+    if q.shape == (6,) and qd.shape == (6,):
+        pose, jac, bias = np.empty(6), np.empty((6, 6)), np.empty(6)
+        cos_pitch, measure = task_kinematics_into(model, q, qd, tool, pose, jac, bias)
+        return pose, jac, bias, cos_pitch, measure
+    shape = np.broadcast_shapes(q.shape, qd.shape)
+    if shape[-1:] != (6,):
+        raise ValueError(f"q and qd must have shape (..., 6), got {q.shape} and {qd.shape}")
+    rows = np.ascontiguousarray(np.broadcast_to(q, shape).reshape(-1, 6))
+    rates = np.ascontiguousarray(np.broadcast_to(qd, shape).reshape(-1, 6))
+    count = rows.shape[0]
+    pose, jac, bias = np.empty((count, 6)), np.empty((count, 6, 6)), np.empty((count, 6))
+    cos_pitch, measure = np.empty(count), np.empty(count)
+    kinematics_many(model, rows, rates, tool, pose, jac, bias, cos_pitch, measure)
+    lead = shape[:-1]
+    return (pose.reshape(lead + (6,)), jac.reshape(lead + (6, 6)), bias.reshape(lead + (6,)), cos_pitch.reshape(lead),
+            measure.reshape(lead))

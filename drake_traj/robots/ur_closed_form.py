@@ -13,7 +13,7 @@ from drake_traj.compiled import compiled, sources_digest
 from drake_traj.robots import task_space
 from drake_traj.robots.task_space import tcp_rows_into, velocity_product_terms
 
-__all__ = ["UR_CLOSED_FORM", "kinematics_into", "kinematics_many", "singularity_measure_many"]
+__all__ = ["UR_CLOSED_FORM", "kinematics_into", "singularity_measure_many"]
 
 # The compiled functions below that call task_space's close over its digest, numba's cache key
 # (drake_traj.compiled): an edit of task_space.py recompiles them.
@@ -97,19 +97,6 @@ def _kinematics_into_with(dependencies):
 
 
 kinematics_into = _kinematics_into_with(_DEPENDENCIES)
-
-
-def _kinematics_many_with(dependencies):
-    @compiled
-    def kinematics_many(model, q, qd, tool, pose, jac, bias, cos_pitch, measure):
-        dependencies  # noqa: B018 (numba's cache key: drake_traj.compiled.sources_digest)
-        for k in range(q.shape[0]):
-            cos_pitch[k], measure[k] = kinematics_into(model, q[k], qd[k], tool, pose[k], jac[k], bias[k])
-
-    return kinematics_many
-
-
-kinematics_many = _kinematics_many_with(_DEPENDENCIES)
 
 
 @compiled

@@ -27,10 +27,10 @@ import numpy as np
 
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError, joint_label
 from drake_traj.robots.base import FLANGE, Robot, TaskKinematics
-from drake_traj.robots.compiled_kinematics import task_kinematics_into
+from drake_traj.robots.compiled_kinematics import task_kinematics, task_kinematics_into
 from drake_traj.robots.task_space import (is_flange, orientation_error, pose_error, rotation_from_zyx_euler,
                                           wrap_angle, wrapped, zyx_euler_from_rotation)
-from drake_traj.robots.ur_closed_form import UR_CLOSED_FORM, kinematics_into, kinematics_many, singularity_measure_many
+from drake_traj.robots.ur_closed_form import UR_CLOSED_FORM, singularity_measure_many
 from drake_traj.validation import invalid, real_array
 
 __all__ = ["UR3E", "UR5E", "UR10E", "UR16E", "UR20", "UR_ARMS", "URArm", "URData"]
@@ -435,32 +435,17 @@ class URArm(Robot):
         """(k(q), J(q), J̇(q, q̇) q̇, cos φ_Y, singularity measure) of the TCP, ``tool`` (4, 4)
         X_FT in the flange frame (default: the flange itself).
 
-        The closed form of :func:`kinematics_into` (tests check it against MultibodyPlant and finite
-        differences of :meth:`task_pose`), vectorised over leading dimensions (q, q̇ of shape (..., 6)).
+        The closed form (:func:`~drake_traj.robots.ur_closed_form.kinematics_into`; tests check it
+        against MultibodyPlant and finite differences of :meth:`task_pose`) through
+        :func:`~drake_traj.robots.compiled_kinematics.task_kinematics`, vectorised over leading
+        dimensions (q, q̇ of shape (..., 6)).
 
         Returns:
             pose (..., 6), J (..., 6, 6), bias (..., 6), cos_pitch (...), measure (...), where
             ``measure`` is :meth:`singularity_measure`. No exception at gimbal lock: callers check
             ``cos_pitch``. For one state, cos_pitch and measure are floats.
         """
-        q = np.asarray(q, dtype=float)
-        qd = np.asarray(qd, dtype=float)
-        if q.shape == (6,) and qd.shape == (6,):
-            pose, jac, bias = np.empty(6), np.empty((6, 6)), np.empty(6)
-            cos_pitch, measure = kinematics_into(self.model, q, qd, tool, pose, jac, bias)
-            return pose, jac, bias, cos_pitch, measure
-        shape = np.broadcast_shapes(q.shape, qd.shape)
-        if shape[-1] != 6:
-            raise ValueError(f"q and qd must have shape (..., 6), got {q.shape} and {qd.shape}")
-        q = np.ascontiguousarray(np.broadcast_to(q, shape).reshape(-1, 6))
-        qd = np.ascontiguousarray(np.broadcast_to(qd, shape).reshape(-1, 6))
-        count = q.shape[0]
-        pose, jac, bias = np.empty((count, 6)), np.empty((count, 6, 6)), np.empty((count, 6))
-        cos_pitch, measure = np.empty(count), np.empty(count)
-        kinematics_many(self.model, q, qd, tool, pose, jac, bias, cos_pitch, measure)
-        lead = shape[:-1]
-        return pose.reshape(lead + (6,)), jac.reshape(lead + (6, 6)), bias.reshape(lead + (6,)), \
-            cos_pitch.reshape(lead), measure.reshape(lead)
+        return task_kinematics(self.model, q, qd, tool)
 
     # ---- singularities -------------------------------------------------------------------------
     def singularity_measure(self, q):

@@ -11,10 +11,10 @@ from pydrake.multibody.tree import FixedOffsetFrame, PrismaticJoint, RevoluteJoi
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
 from drake_traj.planners.pajak import PajakLaw
 from drake_traj.robots import ur10e
-from drake_traj.robots.chain import (CHAIN, SerialChain, chain_kinematics, chain_singularity_factors,
+from drake_traj.robots.chain import (CHAIN, SerialChain, chain_singularity_factors,
                                      inverse_kinematics_all, inverse_kinematics_near)
 from drake_traj.robots.chain_arm import ChainArm
-from drake_traj.robots.compiled_kinematics import task_kinematics_into
+from drake_traj.robots.compiled_kinematics import task_kinematics, task_kinematics_into
 from drake_traj.robots.task_space import wrap_angle, zyx_euler_from_rotation
 from drake_traj.scenario import load_scenario
 
@@ -38,7 +38,7 @@ def states(seed, count=40):
 
 def assert_same_kinematics(model, q, qd, tool):
     """pose, J, J̇q̇ of the chain equal the UR10e closed form's (bias relative to its size)."""
-    mine = chain_kinematics(model, q, qd, tool)
+    mine = task_kinematics(model, q, qd, tool)
     closed = ur10e.ur10e_kinematics(q, qd, tool)
     np.testing.assert_allclose(mine[0], closed[0], rtol=0, atol=1e-9)
     np.testing.assert_allclose(mine[1], closed[1], rtol=0, atol=1e-9)
@@ -73,8 +73,8 @@ def test_ur10e_urdf_chain_is_the_closed_form():
 
 def test_modified_dh_is_the_standard_chain():
     q, qd = states(5)
-    standard = chain_kinematics(SerialChain.from_dh(UR_DH).packed(), q, qd)
-    modified = chain_kinematics(SerialChain.from_dh(UR_MODIFIED, "modified").packed(), q, qd)
+    standard = task_kinematics(SerialChain.from_dh(UR_DH).packed(), q, qd)
+    modified = task_kinematics(SerialChain.from_dh(UR_MODIFIED, "modified").packed(), q, qd)
     for mine, theirs in zip(modified[:3], standard[:3]):
         np.testing.assert_allclose(mine, theirs, rtol=1e-12, atol=1e-12)
 
@@ -126,7 +126,7 @@ def test_puma_560_against_a_chain_product_and_finite_differences():
     h = 1e-4
     for _ in range(10):
         q, qd = rng.uniform(-np.pi, np.pi, 6), rng.uniform(-1.0, 1.0, 6)
-        pose, jac, bias, cos_pitch, measure = chain_kinematics(model, q, qd)
+        pose, jac, bias, cos_pitch, measure = task_kinematics(model, q, qd)
         assert cos_pitch > 0.05 and 0.0 < measure <= 1.0
         np.testing.assert_allclose(pose, puma_pose(q), atol=1e-12, rtol=0)
 
