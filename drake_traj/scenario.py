@@ -40,7 +40,8 @@ from drake_traj.result import DEFAULT_TRACKING_TOLERANCE
 from drake_traj.robots import Robot
 from drake_traj.robots.custom import RobotChoice, resolve_robot, robot_label
 from drake_traj.validation import (MAX_RUN_DURATION, flag, instance_of, invalid, log_period_check, path_argument,
-                                   real_array, realtime_rate, run_duration, settle_duration, step_size)
+                                   real_array, realtime_rate, run_duration, settle_duration, step_size,
+                                   tracking_tolerance_check)
 from drake_traj.yaml_schema import ScenarioError, checked_document, locate
 
 __all__ = [
@@ -168,7 +169,8 @@ class Scenario:
         speed_override: a speed-override profile (times [s], values in [0, 1]), like a pendant's
             speed slider; empty: none.
         tracking_tolerance: the run fails if the measured TCP is ever further than this from the
-            reference [m] (default 5 mm: 40x the shipped scenarios' worst, 0.13 mm).
+            reference [m] (default 5 mm: 40x the shipped scenarios' worst, 0.13 mm); at most half
+            ``cell.clearance`` (the margin the cell check keeps along the reference).
         settle_time: how long the run goes on after the planner finishes [s], at most 60 s.
         max_duration: the run stops with a failure if the planner has not finished by then [s],
             at most 600 s; the preflight integrates an online planner's law this far ahead.
@@ -211,7 +213,8 @@ class Scenario:
 
     def validate(self) -> None:
         """Raise ValueError naming the first field that is malformed (the message starts with
-        the field's path)."""
+        the field's path), or a ``tracking_tolerance`` above half ``cell.clearance``
+        (:func:`~drake_traj.validation.tracking_tolerance_check`)."""
         if not _PLAIN_NAME.fullmatch(self.name) or ".." in self.name:
             raise invalid("name", f"name must be a plain name (letters, digits, _ . -; no path; at most 100 characters), "
                              f"got {self.name[:120]!r}: it names the default output folder out/<name>")
@@ -263,6 +266,7 @@ class Scenario:
         self.controller.for_robot(robot)
         self.speed_override.validate()
         self.cell.validate(robot)
+        tracking_tolerance_check(self.tracking_tolerance, self.cell.clearance)
         self.robot_with_tool()
 
     def station_arguments(self) -> dict:

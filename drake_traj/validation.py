@@ -98,6 +98,28 @@ def nonnegative_scalar(value, name: str, unit: str) -> float:
     return real_scalar(value, name, unit, minimum=0.0)
 
 
+def tracking_tolerance_check(tracking_tolerance, clearance) -> None:
+    """Refuse a ``tracking_tolerance`` [m] larger than half the cell's ``clearance`` [m] (equal
+    is allowed; None, no tracking check, passes): the cell check keeps at least half the
+    clearance everywhere along the planned reference (:mod:`drake_traj.clearance`), so an arm
+    that may stray further than that from its reference may touch what the check cleared. A
+    :class:`~drake_traj.errors.DrakeTrajError` (a ValueError, ``field`` ``("tracking_tolerance",)``)
+    naming both in mm and what to change; also for either value malformed."""
+    if tracking_tolerance is None:
+        return
+    tolerance = positive_scalar(tracking_tolerance, "tracking_tolerance", "m")
+    clearance = nonnegative_scalar(clearance, "cell.clearance", "m")
+    half = 0.5 * clearance
+    if tolerance <= half * (1 + 1e-9):
+        return
+    lower = (f"lower tracking_tolerance to at most {1e3 * half:g} mm or " if half > 0 else "")
+    raise invalid("tracking_tolerance", f"tracking_tolerance = {1e3 * tolerance:g} mm is larger than half the cell's "
+                  f"clearance ({1e3 * half:g} mm of cell.clearance = {1e3 * clearance:g} mm): the check before the "
+                  "motion keeps half the clearance along the planned reference, and an arm that strays further "
+                  f"from it may touch what was checked clear; {lower}raise cell.clearance to at least "
+                  f"{2e3 * tolerance:g} mm")
+
+
 # The bounds of a run's times and pace (README "When something goes wrong"): every run ends, and
 # its log (1 ms samples by default, about 0.3 kB each) fits in memory.
 MAX_RUN_DURATION = 600.0  # [s] max_duration, and the preflight's horizon: 10 minutes of simulated motion

@@ -132,3 +132,38 @@ def test_a_bad_directive_is_refused_naming_its_entry(tmp_path, directive, words,
         scenario.cell_checker()
     assert caught.value.field == field
     assert f"{path}, line 6" in str(caught.value)  # the entry's line
+
+
+@pytest.mark.parametrize("tolerance, clearance, refused", [
+    (0.005, 0.01, False),  # the defaults: equal to half the clearance
+    (0.003, 0.01, False),
+    (0.0051, 0.01, True),
+    (0.005, 0.008, True),
+])
+def test_a_tracking_tolerance_above_half_the_clearance_is_refused_at_its_line(tmp_path, tolerance, clearance, refused):
+    path = scenario_file(tmp_path, f"cell:\n  clearance: {clearance}\ntracking_tolerance: {tolerance}\n")
+    if not refused:
+        assert load_scenario(path).tracking_tolerance == tolerance
+        return
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(path)
+    assert caught.value.field == ("tracking_tolerance",)
+    message = str(caught.value)
+    assert message.startswith(f"{path}, line 6")  # tracking_tolerance's line
+    assert f"tracking_tolerance = {tolerance * 1e3:g} mm" in message and f"({clearance * 500:g} mm of cell.clearance" in message
+    assert "lower tracking_tolerance" in message and "raise cell.clearance" in message
+
+
+def test_the_tracking_tolerance_check_for_simulate_names_the_argument():
+    from drake_traj.validation import tracking_tolerance_check
+
+    tracking_tolerance_check(0.005, 0.01)
+    tracking_tolerance_check(None, 0.0)  # no tracking check: nothing to compare
+    with pytest.raises(ValueError, match=r"tracking_tolerance = 6 mm .* \(5 mm of cell\.clearance = 10 mm\).*"
+                                         r"lower tracking_tolerance to at most 5 mm or raise cell\.clearance to at "
+                                         r"least 12 mm") as caught:
+        tracking_tolerance_check(0.006, 0.01)
+    assert isinstance(caught.value, DrakeTrajError) and caught.value.field == ("tracking_tolerance",)
+    with pytest.raises(ValueError, match=r"raise cell\.clearance to at least 10 mm") as caught:
+        tracking_tolerance_check(0.005, 0.0)
+    assert "lower" not in str(caught.value)  # no positive tolerance is at most 0
