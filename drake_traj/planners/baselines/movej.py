@@ -310,6 +310,8 @@ class MovejPlanner(TimeLawPlanner):
         robot: the robot (for the tool positions at the waypoints).
     """
 
+    target_word = "goal"  # the config's goals: a refusal is "on the way to goal k"
+
     def __init__(self, law: MovejBlendLaw, *, speed_cap: float = 1.0, update_period: float = 0.001,
                  robot: Robot = UR10E):
         instance_of(law, MovejBlendLaw, "law")

@@ -237,6 +237,8 @@ class RuckigPlanner(TimeLawPlanner):
         robot: the robot (for the tool positions at the waypoints).
     """
 
+    target_word = "goal"  # the config's goals: a refusal is "on the way to goal k"
+
     def __init__(self, law: RuckigStopLaw, *, speed_cap: float = 1.0, update_period: float = 0.001,
                  robot: Robot = UR10E):
         instance_of(law, RuckigStopLaw, "law")

@@ -20,6 +20,8 @@ class BorygaLoopPlanner(TimeLawPlanner):
         velocity_limit, acceleration_limit: per-joint limits to keep [rad/s or m/s, rad/s^2 or m/s^2].
     """
 
+    target_word = "point"  # B, M and E are points 0, 1 and 2 (task_waypoints)
+
     def __init__(self, law, velocity_limit, acceleration_limit, *, update_period: float = 0.001):
         cap, self.peaks = joint_speed_cap(law, velocity_limit, acceleration_limit)
         super().__init__(law, velocity_limit, acceleration_limit, speed_cap=cap, update_period=update_period)

@@ -22,6 +22,8 @@ class LiPathPlanner(TimeLawPlanner):
         tool_limits: (speed [m/s], acceleration [m/s^2]) of the tool.
     """
 
+    target_word = "point"  # the config's points
+
     def __init__(self, plan: LiPlan, velocity_limit, acceleration_limit, tool_motion, tool_limits):
         instance_of(plan, LiPlan, "plan")
         super().__init__(plan.law, velocity_limit, acceleration_limit)

@@ -23,6 +23,8 @@ class QuinticPtpPlanner(TimeLawPlanner):
         robot: the robot (for the tool positions at the goals).
     """
 
+    target_word = "goal"  # the config's goals: a refusal is "on the way to goal k"
+
     def __init__(self, plan: QuinticLaw, velocity_limit, acceleration_limit, *, update_period: float = 0.001,
                  robot: Robot = UR10E):
         instance_of(plan, QuinticLaw, "plan")

@@ -28,11 +28,15 @@ class SmoothPlanner(TimeLawPlanner):
         timing: the timed motion.
         velocity_limit, acceleration_limit, jerk_limit: the limits it was timed under, per joint.
         tool_waypoints: tool positions [m] the task passes through (base frame), (m, 3), for plots.
+        target_word: the task's word for them ("goal": the config's goals; "waypoint": a re-timed
+            Pająk task's), as a refusal names them ("on the way to goal k").
         speed_cap, update_period: as :class:`TimeLawPlanner`.
     """
 
+    target_word = "goal"
+
     def __init__(self, timing: SmoothTiming, velocity_limit, acceleration_limit, jerk_limit, *,
-                 tool_waypoints=None, speed_cap: float = 1.0, update_period: float = 0.001):
+                 tool_waypoints=None, target_word: str = "goal", speed_cap: float = 1.0, update_period: float = 0.001):
         instance_of(timing, SmoothTiming, "timing")
         n = len(timing.law.q_start)
         super().__init__(timing.law, positive_vector(velocity_limit, "velocity_limit", n),
@@ -41,6 +45,7 @@ class SmoothPlanner(TimeLawPlanner):
         self.timing = timing
         self.jerk_limit = positive_vector(jerk_limit, "jerk_limit", n)
         self._tool_waypoints = np.zeros((0, 3)) if tool_waypoints is None else np.asarray(tool_waypoints, float)
+        self.target_word = instance_of(target_word, str, "target_word")
 
     def task_waypoints(self) -> np.ndarray:
         return self._tool_waypoints.copy()
@@ -155,4 +160,4 @@ def make_retimed_pajak(config: RetimedPajakConfig, robot: Robot, q_initial) -> S
     timing = _timed(samples, "pajak", velocity, acceleration, jerk,
                     whole_number(config.grid_points, "grid_points", minimum=20))
     return SmoothPlanner(timing, velocity, acceleration, jerk,
-                         tool_waypoints=np.asarray(config.pajak.waypoints, dtype=float)[:, :3])
+                         tool_waypoints=np.asarray(config.pajak.waypoints, dtype=float)[:, :3], target_word="waypoint")
