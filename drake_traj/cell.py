@@ -44,7 +44,7 @@ from drake_traj.validation import invalid, real_array
 
 __all__ = [
     "Box", "Cell", "Cylinder", "DEFAULT_CLEARANCE", "NoMounting", "Obstacle", "Pedestal", "Sphere",
-    "Table", "Tool", "add_cell",
+    "Table", "Tool", "add_cell", "refuse_free_bodies",
 ]
 
 # [m] The clearance a planned motion keeps from the cell and from the arm itself. The collision
@@ -329,9 +329,13 @@ def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, robot: Robot 
     carries the payload's inertia and the tool's shapes (added only when there is either); the
     payload is checked against ``robot``'s rating.
 
-    Returns {geometry name: field path in the scenario} of the cell's own geometry, for errors
-    that name an obstacle. Raises DrakeTrajError naming the field of a malformed part, a model
-    file that is missing or cannot be parsed, or a directive naming an unknown frame or model.
+    Returns {geometry name: field path in the scenario} of the cell's own geometry (the
+    mounting's parts, the obstacles, the tool's shapes) and {body scoped name
+    (``bin::base``): ``("cell", "directives", k)``} of the bodies each directive ``k`` adds, for
+    errors that name an obstacle (:meth:`CellChecker.field_of
+    <drake_traj.clearance.CellChecker.field_of>`, :func:`refuse_free_bodies`). Raises
+    DrakeTrajError naming the field of a malformed part, a model file that is missing or cannot
+    be parsed, or a directive naming an unknown frame or model.
     """
     cell.validate(robot)
     world = plant.world_body()
@@ -347,7 +351,7 @@ def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, robot: Robot 
         _register(plant, world, _pose(obstacle.xyz, obstacle.rpy, location), obstacle.shape(location), name,
                   OBSTACLE_COLOUR)
         fields[name] = location
-    _add_directives(plant, cell.directives, directory)
+    fields.update(_add_directives(plant, cell.directives, directory))
     inertia = cell.tool.spatial_inertia()
     if inertia is not None or cell.tool.shapes:
         tool = plant.AddRigidBody(TOOL_BODY, robot_instance, inertia or SpatialInertia.Zero())
@@ -360,11 +364,12 @@ def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, robot: Robot 
     return fields
 
 
-def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], directory: Path | None) -> None:
+def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], directory: Path | None) -> dict:
     """Process Drake model directives in one call (Drake resolves a weld's frames among the
     models of the same call), each checked first so that an error names its entry of
     ``cell.directives``: a model file that is missing or cannot be parsed, a weld or frame
-    naming a frame that is neither the plant's (the world, the robot) nor an earlier entry's."""
+    naming a frame that is neither the plant's (the world, the robot) nor an earlier entry's.
+    Returns {body scoped name: ``("cell", "directives", k)``} of the bodies the entries add."""
     base = Path(directory or ".").resolve()
     known = {}  # model instance name -> its frame names, for the models the entries add
     for index, directive in enumerate(directives):
@@ -398,10 +403,56 @@ def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], dir
             if kind == "add_frame":
                 known.setdefault("", set()).add(entry.name)
     try:
-        ProcessModelDirectives(ModelDirectives(directives=directives), plant, Parser(plant))
+        added = ProcessModelDirectives(ModelDirectives(directives=directives), plant, Parser(plant))
     except (RuntimeError, ValueError) as error:
         raise DrakeTrajError(f"cell.directives: {str(error).strip()}", field=("cell", "directives"),
                              cause=Cause.INVALID) from None
+    fields = {}
+    for info in added:
+        name = ("cell", "directives") + _directive_index(directives, info.model_name)
+        for body in plant.GetBodyIndices(info.model_instance):
+            fields[str(plant.get_body(body).scoped_name())] = name
+    return fields
+
+
+def _directive_index(directives: list[ModelDirective], model: str) -> tuple:
+    """``(k,)`` of the entry of ``directives`` that adds the model instance ``model`` (its
+    ``add_model``, or the ``add_directives`` whose namespace it is in); () if none is known."""
+    for index, directive in enumerate(directives):
+        if directive.add_model is not None and directive.add_model.name == model:
+            return (index,)
+        if directive.add_model_instance is not None and directive.add_model_instance.name == model:
+            return (index,)
+        nested = directive.add_directives
+        if nested is not None and nested.model_namespace and model.startswith(f"{nested.model_namespace}::"):
+            return (index,)
+    return ()
+
+
+def refuse_free_bodies(plant: MultibodyPlant, robot_instance, fields: dict | None = None) -> None:
+    """Refuse a body of the finalized ``plant`` that is not the robot's (model instance
+    ``robot_instance``) and is joined to nothing: a floating base body, which the simulation
+    lets fall and the cell check would take for an obstacle at its model's default pose. A
+    model of ``cell.directives`` (its bodies in ``fields``, :func:`add_cell`'s return) is
+    named by its entry (``field`` ``("cell", "directives", k)``; the remedy an ``add_weld``),
+    any other (a station's ``before_finalize`` bodies) by its model (the remedy a weld before
+    the plant is finalized). DrakeTrajError, cause INVALID; the first such body in index order."""
+    fields = fields or {}
+    for index in sorted(plant.GetFloatingBaseBodies(), key=int):
+        body = plant.get_body(index)
+        if body.model_instance() == robot_instance:
+            continue
+        model, scoped = plant.GetModelInstanceName(body.model_instance()), str(body.scoped_name())
+        what = f"model {model!r} is not welded to anything (its body {body.name()!r} would fall freely)"
+        field = fields.get(scoped)
+        if field is not None and field[:2] == ("cell", "directives"):
+            raise DrakeTrajError(f"{field_text(field)}: {what}: add an add_weld {{parent: world, child: {scoped}}} "
+                                 "after it (X_PC: where it stands), or weld it to another model's frame",
+                                 field=field, cause=Cause.INVALID)
+        raise DrakeTrajError(f"{what}: weld it before the plant is finalized (in before_finalize: "
+                             f"plant.WeldFrames(plant.world_frame(), plant.GetBodyByName({body.name()!r}, "
+                             f"plant.GetModelInstanceByName({model!r})).body_frame(), X_WB)), or give it a joint",
+                             cause=Cause.INVALID)
 
 
 def _frame_known(plant: MultibodyPlant, known: dict, frame: str) -> bool:

@@ -29,11 +29,12 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import Trajectory
 
-from drake_traj.cell import Cell, add_cell
+from drake_traj.cell import Cell, add_cell, refuse_free_bodies
 from drake_traj.errors import Cause, Field, PlanningError, joint_label
 from drake_traj.robots import Robot
 
-__all__ = ["CellChecker", "CollisionError", "Contact", "JointRangeError", "MotionCheck", "geometry_owner", "joint_reach"]
+__all__ = ["CellChecker", "CollisionError", "Contact", "JointRangeError", "MotionCheck", "geometry_owner", "joint_reach",
+           "planner_target_word"]
 
 RANGE_GRID = 1e-3  # [s] joint ranges are checked at the log's period
 
@@ -41,18 +42,26 @@ RANGE_GRID = 1e-3  # [s] joint ranges are checked at the log's period
 class CollisionError(PlanningError):
     """The planned motion brings two bodies closer than the clearance (or into contact).
 
-    Attributes (besides :class:`PlanningError`'s):
-        bodies: the two bodies' names, e.g. ``("forearm_link", "table")``.
-        distance: their signed distance [m] (negative: penetration).
+    Attributes (besides :class:`PlanningError`'s; ``time`` and ``configuration`` are those of
+    the first checked sample closer than the clearance):
+        bodies: the two bodies' names at ``time``, e.g. ``("forearm_link", "table")``.
+        distance: their signed distance [m] at ``time`` (negative: penetration).
         clearance: the clearance asked for [m].
-        segment: which part of the task, e.g. ``"on the way to waypoint 2"`` (None if unknown).
+        segment: which part of the task, e.g. ``"on the way to goal 2"`` (None if unknown).
+        depth: how deep [m] the motion then goes into the same body of the cell (or the arm
+            into itself), the deepest sample of the first stretch where it does; None if it
+            does not (a near miss) or if not known.
+        depth_time: the time [s] of that sample (None with ``depth``).
     """
 
     default_cause = Cause.COLLISION
 
-    def __init__(self, message: str, *, bodies, distance: float, clearance: float, segment=None, **kwargs):
+    def __init__(self, message: str, *, bodies, distance: float, clearance: float, segment=None, depth=None,
+                 depth_time=None, **kwargs):
         super().__init__(message, **kwargs)
         self.bodies, self.distance, self.clearance, self.segment = tuple(bodies), float(distance), float(clearance), segment
+        self.depth = None if depth is None else float(depth)
+        self.depth_time = None if depth_time is None else float(depth_time)
 
 
 class JointRangeError(PlanningError):
@@ -71,13 +80,22 @@ class JointRangeError(PlanningError):
 @dataclass(frozen=True)
 class Contact:
     """Two bodies within the clearance: their names, signed distance [m], the names of the two
-    geometries (the cell's geometry names an obstacle, the mounting or a tool shape) and their
-    closest points (2, 3) [m] in the world (base) frame."""
+    geometries (the cell's geometry names an obstacle, the mounting or a tool shape), their
+    closest points (2, 3) [m] in the world (base) frame, and whether each body is the arm's (its
+    links, its tool and what is welded to them: both for a self-collision)."""
 
     distance: float
     bodies: tuple[str, str]
     geometries: tuple[str, str]
     points: np.ndarray
+    on_arm: tuple[bool, bool] = (False, False)
+
+
+def planner_target_word(planner) -> str:
+    """The planner's own word for the targets of its task (its ``target_word``: ``"goal"`` for
+    the planners through joint goals, ``"point"`` for Li's and Boryga's); ``"waypoint"`` where it
+    names none (Pająk's). A refusal says "on the way to goal 2"."""
+    return str(getattr(planner, "target_word", "waypoint"))
 
 
 def _bounding_radius(shape) -> float:
@@ -204,8 +222,24 @@ class CellChecker:
             key = tuple(sorted((body_a, body_b)))
             if key not in nearest or pair.distance < nearest[key].distance:
                 points = np.array([query.GetPoseInWorld(pair.id_A) @ pair.p_ACa, query.GetPoseInWorld(pair.id_B) @ pair.p_BCb])
-                nearest[key] = Contact(pair.distance, (body_a, body_b), (geometry_a, geometry_b), points)
+                nearest[key] = Contact(pair.distance, (body_a, body_b), (geometry_a, geometry_b), points,
+                                       (self._on_arm(pair.id_A), self._on_arm(pair.id_B)))
         return sorted(nearest.values(), key=lambda contact: contact.distance)
+
+    def _on_arm(self, geometry) -> bool:
+        """Whether the geometry's body moves with the arm: a body of the robot's model (its
+        links, its tool) or one welded to a link that is not welded to the world."""
+        arm = getattr(self, "_arm_bodies", None)
+        if arm is None:
+            plant = self.plant
+            fixed = {int(body.index()) for body in plant.GetBodiesWeldedTo(plant.world_body())}
+            arm = set()
+            for index in plant.GetBodyIndices(self.instance):
+                arm.add(int(index))
+                if int(index) not in fixed:
+                    arm.update(int(body.index()) for body in plant.GetBodiesWeldedTo(plant.get_body(index)))
+            self._arm_bodies = arm = frozenset(arm)
+        return int(self.plant.GetBodyFromFrameId(self._inspector.GetFrameId(geometry)).index()) in arm
 
     def sample_times(self, trajectory: Trajectory, spacing: float | None = None, *, grid=None, q=None) -> np.ndarray:
         """Times [s] at which to check ``trajectory`` (q(t)) so that no point of the arm moves
@@ -221,15 +255,19 @@ class CellChecker:
         times = np.interp(np.linspace(0.0, travel[-1], count + 1), travel, grid) if count else grid[:1]
         return np.unique(np.concatenate([times, grid[[0, -1]]]))
 
-    def check(self, trajectory: Trajectory, *, waypoints=None, spacing: float | None = None) -> MotionCheck:
+    def check(self, trajectory: Trajectory, *, waypoints=None, spacing: float | None = None,
+              target_word: str = "waypoint") -> MotionCheck:
         """Check the joint reference ``trajectory`` (a Drake Trajectory of q(t), e.g.
         ``planner.plan()``): every joint inside its range on a 1 ms grid, then no two bodies
         closer than the clearance at :meth:`sample_times`.
 
         ``waypoints`` (m, 3) [m], the task's tool points in order, name the segment of a
-        collision ("on the way to waypoint k"). Raises :class:`JointRangeError` or
+        collision ("on the way to waypoint k", ``target_word`` the planner's word for them:
+        :func:`planner_target_word`). Raises :class:`JointRangeError` or
         :class:`CollisionError` (time, bodies, distance, segment, configuration) for the first
-        sample that is too close; returns a :class:`MotionCheck`."""
+        sample that is too close: a motion that goes on into the same body (or the arm into
+        itself) is said to go through it, how deep and when (the samples after it are
+        scanned); returns a :class:`MotionCheck`."""
         grid = _grid(trajectory)
         q = trajectory.vector_values(grid).T
         lower, upper = self.robot.lower_limits, self.robot.upper_limits
@@ -240,15 +278,40 @@ class CellChecker:
             unit = self.robot.joint_unit(j)
             raise JointRangeError(
                 f"the planned motion takes {joint_label(j, self.robot.joint_names)} to {q[k, j]:.4f} {unit}, past its "
-                f"range [{lower[j]:.4f}, {upper[j]:.4f}] {unit}{self._segment_text(trajectory, grid[k], waypoints)}",
+                f"range [{lower[j]:.4f}, {upper[j]:.4f}] {unit}{self._segment_text(trajectory, grid[k], waypoints, target_word)}",
                 joint=j, value=q[k, j], limit=limit, time=grid[k], configuration=q[k], cause=Cause.JOINT_RANGE)
         spacing = self.default_spacing() if spacing is None else float(spacing)
         times = self.sample_times(trajectory, spacing, grid=grid, q=q)
-        for t, q_t in zip(times, trajectory.vector_values(times).T):
+        samples = trajectory.vector_values(times).T
+        for k, (t, q_t) in enumerate(zip(times, samples)):
             contacts = self.contacts(q_t)
             if contacts:
-                raise self._collision(contacts[0], t, q_t, trajectory, waypoints)
+                through = self._through(contacts[0], times[k:], samples[k:])
+                raise self._collision(contacts[0], t, q_t, trajectory, waypoints, target_word, through)
         return MotionCheck(times, spacing)
+
+    def _through(self, contact: Contact, times, samples) -> tuple[Contact, float] | None:
+        """(the deepest contact, its time [s]) of the same kind as ``contact`` (the arm in the
+        same body of the cell, or the arm in itself) in the first stretch of ``samples`` (at
+        ``times``, from ``contact``'s) where the bodies are in each other; None if they never are."""
+        kind, deepest = self._kind(contact), None
+        for t, q in zip(times, samples):
+            inside = [c for c in self.contacts(q, within=0.0) if c.distance < 0 and self._kind(c) == kind]
+            if inside and (deepest is None or inside[0].distance < deepest[0].distance):
+                deepest = (inside[0], float(t))
+            elif not inside and deepest is not None:
+                break
+        return deepest
+
+    @staticmethod
+    def _kind(contact: Contact):
+        """What a contact is with: "itself" (the arm with the arm), the cell's body (the arm with
+        it), or both bodies (neither is the arm's)."""
+        if all(contact.on_arm):
+            return "itself"
+        if any(contact.on_arm):
+            return contact.bodies[contact.on_arm.index(False)]
+        return tuple(sorted(contact.bodies))
 
     def default_spacing(self) -> float:
         """Half the clearance, at least 1 mm [m] (module docstring)."""
@@ -256,44 +319,90 @@ class CellChecker:
 
     def check_configuration(self, q, what: str = "the start configuration", field: Field = ("q_initial",)) -> None:
         """CollisionError (naming the two bodies, at ``field``) when ``q`` is in contact or
-        closer than the clearance."""
+        closer than the clearance. First, once, a body of the cell that is joined to nothing
+        (:func:`~drake_traj.cell.refuse_free_bodies`: a DrakeTrajError at its directive)."""
+        if not getattr(self, "_free_bodies_refused", False):
+            refuse_free_bodies(self.plant, self.instance, self.cell_fields)
+            self._free_bodies_refused = True
         contacts = self.contacts(q)
         if contacts:
             contact = contacts[0]
-            raise CollisionError(f"{what} {self._describe(contact)}", bodies=contact.bodies, distance=contact.distance,
-                                 clearance=self.clearance, time=0.0, configuration=q, field=field, cause=Cause.COLLISION)
+            if contact.distance < 0 and all(contact.on_arm):
+                text = f"in {what} the arm would hit itself ({' and '.join(contact.bodies)}, {self._mm(contact)} deep)"
+            elif contact.distance < 0:
+                text = f"{what} puts {' into '.join(self._arm_first(contact))} ({self._mm(contact)} deep)"
+            else:
+                text = f"{what} {self._near_miss(contact)}"
+            raise CollisionError(text, bodies=contact.bodies, distance=contact.distance, clearance=self.clearance,
+                                 time=0.0, configuration=q, field=field, cause=Cause.COLLISION)
 
     def field_of(self, contact: Contact) -> Field:
-        """The scenario field of the cell geometry in ``contact`` (an obstacle, the mounting, a
-        tool shape), or () when both bodies are the arm's."""
+        """The scenario field of the cell's part in ``contact``: an obstacle, the mounting or a
+        tool shape (by its geometry's name), a body of a ``cell.directives`` model (by its
+        scoped name: its entry ``("cell", "directives", k)``); () when there is none (the arm
+        with itself)."""
         for geometry in contact.geometries:
             if geometry in self.cell_fields:
                 return self.cell_fields[geometry]
+        for body, on_arm in zip(contact.bodies, contact.on_arm):
+            if not on_arm and body in self.cell_fields:
+                return self.cell_fields[body]
         return ()
 
-    def _describe(self, contact: Contact) -> str:
+    @staticmethod
+    def _mm(contact: Contact) -> str:
+        return f"{abs(contact.distance) * 1000:.1f} mm"
+
+    @staticmethod
+    def _arm_first(contact: Contact) -> tuple[str, str]:
+        """The two bodies, the arm's first (as given when both or neither are)."""
         a, b = contact.bodies
-        if contact.distance < 0:
-            return f"puts {a} and {b} into each other ({-contact.distance * 1000:.1f} mm deep)"
-        return (f"brings {a} and {b} within {contact.distance * 1000:.1f} mm of each other, closer than the clearance "
-                f"of {self.clearance * 1000:g} mm (cell.clearance)")
+        return (b, a) if contact.on_arm == (False, True) else (a, b)
 
-    def _collision(self, contact: Contact, t: float, q, trajectory, waypoints) -> CollisionError:
-        segment = self._segment(trajectory, t, waypoints)
+    def _near_miss(self, contact: Contact) -> str:
+        """"brings A and B within d mm of each other, closer than the clearance of c mm
+        (cell.clearance)", or "brings the arm within d mm of itself (A and B), ..."."""
+        closer = f"closer than the clearance of {self.clearance * 1000:g} mm (cell.clearance)"
+        if all(contact.on_arm):
+            return f"brings the arm within {self._mm(contact)} of itself ({' and '.join(contact.bodies)}), {closer}"
+        return f"brings {' and '.join(self._arm_first(contact))} within {self._mm(contact)} of each other, {closer}"
+
+    def _collision(self, contact: Contact, t: float, q, trajectory, waypoints, target_word: str = "waypoint",
+                   through: tuple[Contact, float] | None = None) -> CollisionError:
+        """The refusal of the first sample closer than the clearance (``contact`` at time ``t``,
+        configuration ``q``); ``through``, from :meth:`_through`: how deep the motion then goes.
+        The time is said once, by :class:`PlanningError` ("(at t = ..., q = ...)")."""
+        segment = self._segment(trajectory, t, waypoints, target_word)
         where = f" {segment}" if segment else ""
-        return CollisionError(f"the planned motion {self._describe(contact)} at t = {t:.3f} s{where}",
-                              bodies=contact.bodies, distance=contact.distance, clearance=self.clearance,
+        if through is None:
+            text = f"the planned motion {self._near_miss(contact)}"
+        else:
+            deepest, deepest_t = through
+            when = f" at t = {deepest_t:.3f} s" if deepest_t != t else ""
+            if all(deepest.on_arm):
+                text = (f"in the planned motion the arm would hit itself ({' and '.join(deepest.bodies)}, "
+                        f"{self._mm(deepest)} deep{when})")
+            elif any(deepest.on_arm):
+                arm, other = self._arm_first(deepest)
+                text = f"the planned motion goes through {other} ({arm} {self._mm(deepest)} deep{when})"
+            else:
+                text = f"the planned motion puts {' and '.join(deepest.bodies)} into each other ({self._mm(deepest)} deep{when})"
+            if contact.distance >= 0:  # the error's time is that of the first sample closer than the clearance
+                text += f", first closer than the clearance of {self.clearance * 1000:g} mm (cell.clearance)"
+        return CollisionError(text + where, bodies=contact.bodies, distance=contact.distance, clearance=self.clearance,
                               segment=segment, time=t, configuration=q, field=self.field_of(contact),
-                              cause=Cause.COLLISION)
+                              depth=None if through is None else -through[0].distance,
+                              depth_time=None if through is None else through[1], cause=Cause.COLLISION)
 
-    def _segment_text(self, trajectory, t: float, waypoints) -> str:
-        segment = self._segment(trajectory, t, waypoints)
+    def _segment_text(self, trajectory, t: float, waypoints, word: str = "waypoint") -> str:
+        segment = self._segment(trajectory, t, waypoints, word)
         return f" {segment}" if segment else ""
 
-    def _segment(self, trajectory, t: float, waypoints) -> str | None:
-        """"on the way to waypoint k" (0-based, as the scenario's lists count) for the time
-        ``t``: the first waypoint the tool has not yet passed (its closest approach, taken in
-        order along a 10 ms grid)."""
+    def _segment(self, trajectory, t: float, waypoints, word: str = "waypoint") -> str | None:
+        """"on the way to waypoint k" (0-based, as the scenario's lists count; ``word`` the
+        planner's word for its targets, :func:`planner_target_word`) for the time ``t``: the
+        first target the tool has not yet passed (its closest approach, taken in order along a
+        10 ms grid)."""
         if waypoints is None or not len(waypoints):
             return None
         points = np.asarray(waypoints, dtype=float).reshape(-1, 3)
@@ -303,9 +412,9 @@ class CellChecker:
         for k, point in enumerate(points):
             passed = start + int(np.argmin(np.linalg.norm(tool[start:] - point, axis=1)))
             if grid[passed] >= t:
-                return f"on the way to waypoint {k}"
+                return f"on the way to {word} {k}"
             start = passed
-        return "after the last waypoint"
+        return f"after the last {word}"
 
     def check_planner(self, planner, start_field: Field = ("q_initial",)) -> MotionCheck:
         """:meth:`check_configuration` of the planner's start (errors at ``start_field``), then

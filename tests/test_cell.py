@@ -167,3 +167,84 @@ def test_the_tracking_tolerance_check_for_simulate_names_the_argument():
     with pytest.raises(ValueError, match=r"raise cell\.clearance to at least 10 mm") as caught:
         tracking_tolerance_check(0.005, 0.0)
     assert "lower" not in str(caught.value)  # no positive tolerance is at most 0
+
+
+BLOCK_SDF = """\
+<?xml version="1.0"?>
+<sdf version="1.7"><model name="meshblock"><link name="block">
+  <collision name="c"><geometry><box><size>0.1 0.1 0.1</size></box></geometry></collision>
+</link></model></sdf>
+"""
+
+
+def test_a_motion_into_a_directives_model_is_refused_at_its_directive(tmp_path):
+    from drake_traj.clearance import CollisionError
+    from drake_traj.scenario import make_planner, preflight
+
+    (tmp_path / "block.sdf").write_text(BLOCK_SDF)
+    plan = make_planner(load_scenario(scenario_file(tmp_path, ""))).plan()
+    centre = UR10E.tool_position(plan.value(0.5 * plan.end_time()).ravel())  # where the tool passes
+    path = scenario_file(tmp_path, f"""\
+        cell:
+          directives:
+          - add_model: {{name: meshblock, file: block.sdf}}
+          - add_weld: {{parent: world, child: meshblock::block, X_PC: {{translation: {centre.round(4).tolist()}}}}}
+        """)
+    scenario = load_scenario(path)
+    assert scenario.cell_checker().cell_fields["meshblock::block"] == ("cell", "directives", 0)
+    with pytest.raises(CollisionError) as caught:
+        preflight(scenario, make_planner(scenario))
+    error = caught.value
+    assert "meshblock::block" in error.bodies and error.field == ("cell", "directives", 0)
+    assert str(error).startswith(f"{path}, line 6")  # the entry that adds the model, not the planner's line 2
+
+
+@pytest.mark.parametrize("cli", [False, True])
+def test_a_directives_model_welded_to_nothing_is_refused_at_its_directive(tmp_path, cli):
+    import subprocess
+    import sys
+
+    from drake_traj.scenario import check_in_cell, make_planner
+
+    (tmp_path / "block.sdf").write_text(BLOCK_SDF)
+    path = scenario_file(tmp_path, """\
+        cell:
+          directives:
+          - add_model: {name: meshblock, file: block.sdf}
+        """)
+    expected = (f"{path}, line 6, column 5: cell.directives[0]: model 'meshblock' is not welded to anything (its body "
+                "'block' would fall freely): add an add_weld {parent: world, child: meshblock::block}")
+    if cli:
+        done = subprocess.run([sys.executable, "-m", "drake_traj.cli", "run", str(path), "--out", str(tmp_path / "out")],
+                              capture_output=True, text=True, timeout=300)
+        assert done.returncode == 2 and expected in done.stderr, done.stderr
+        assert "into each other" not in done.stderr
+        return
+    scenario = load_scenario(path)
+    with pytest.raises(DrakeTrajError) as caught:
+        check_in_cell(scenario, make_planner(scenario))
+    assert str(caught.value).startswith(expected) and caught.value.field == ("cell", "directives", 0)
+    assert caught.value.cause is Cause.INVALID
+
+
+def test_a_free_body_of_ones_own_is_refused_naming_its_model():
+    """What a station's before_finalize adds unwelded (drake_traj.cell.refuse_free_bodies after
+    Finalize); the robot's own bodies and welded ones pass."""
+    from pydrake.multibody.tree import SpatialInertia
+
+    from drake_traj.cell import refuse_free_bodies
+
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, 0.0)
+    instance = UR10E.add_to_plant(plant)
+    fields = add_cell(plant, Cell(), instance)
+    welded = plant.AddRigidBody("plate", plant.AddModelInstance("fixture"), SpatialInertia.SolidCubeWithDensity(1000.0, 0.1))
+    plant.WeldFrames(plant.world_frame(), welded.body_frame())
+    plant.AddRigidBody("crate", plant.AddModelInstance("pallet"), SpatialInertia.SolidCubeWithDensity(1000.0, 0.1))
+    plant.Finalize()
+    with pytest.raises(DrakeTrajError, match=r"^model 'pallet' is not welded to anything \(its body 'crate' would fall "
+                                             r"freely\): weld it before the plant is finalized") as caught:
+        refuse_free_bodies(plant, instance, fields)
+    assert caught.value.field == () and caught.value.cause is Cause.INVALID
+    plant, instance, fields = plant_with(Cell())
+    refuse_free_bodies(plant, instance, fields)  # nothing free

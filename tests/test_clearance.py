@@ -2,6 +2,7 @@
 planned reference; and contact in the closed loop. Collision-free runs are confirmed by an
 independent query (Drake's SceneGraphCollisionChecker) at every logged sample."""
 
+import re
 import subprocess
 import sys
 import textwrap
@@ -14,7 +15,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_traj import load_scenario, make_planner, simulate
 from drake_traj.cell import Box, Cell
-from drake_traj.clearance import CellChecker, CollisionError, JointRangeError
+from drake_traj.clearance import CellChecker, CollisionError, JointRangeError, planner_target_word
 from drake_traj.errors import Cause
 from drake_traj.meshcat import draw_refusal
 from drake_traj.planners import QuinticConfig
@@ -86,13 +87,33 @@ def test_a_motion_through_the_table_is_refused_naming_the_time_the_bodies_and_th
         checker.check_planner(planner)
     error = caught.value
     assert "table" in error.bodies and error.cause is Cause.COLLISION
-    assert error.distance < checker.clearance and error.segment == "on the way to waypoint 1"
+    assert error.distance < checker.clearance
+    assert error.segment.startswith("on the way to ") and error.segment.endswith(" 1")
     assert 0 < error.time < planner.plan().end_time()
-    assert f"t = {error.time:.3f} s" in str(error) and "table" in str(error)
+    assert "table" in str(error)
     # the reported configuration is the plan's at that time, and really that close to the table
     assert np.allclose(error.configuration, planner.plan().value(error.time).ravel())
     contact = [c for c in checker.contacts(error.configuration) if "table" in c.bodies][0]
     assert contact.distance == pytest.approx(error.distance)
+
+
+def test_a_motion_that_goes_through_the_table_says_so_how_deep_and_when_with_its_time_once(checker):
+    planner = quintic([[-1.2, -1.6, -2.0, -0.9, 1.57, 0.8], [-1.2, 0.6, -0.3, -0.9, 1.57, 0.8]])
+    with pytest.raises(CollisionError) as caught:
+        checker.check_planner(planner)
+    error, message = caught.value, str(caught.value)
+    # the first sample under the clearance is a near miss; the motion then goes on into the table
+    assert 0 <= error.distance < checker.clearance and error.time < error.depth_time and error.depth > 0.1
+    arm_link = next(body for body in checker.contacts(planner.plan().value(error.depth_time).ravel(), 0.0)[0].bodies
+                    if body != "table")
+    assert message.startswith(f"the planned motion goes through table ({arm_link} {error.depth * 1000:.1f} mm deep at "
+                              f"t = {error.depth_time:.3f} s), first closer than the clearance of 10 mm")
+    assert "within" not in message
+    # each time once: the depth's, then the error's (the first sample under the clearance)
+    assert re.findall(r"t = ([0-9.]+) s", message) == [f"{error.depth_time:.3f}", f"{error.time:.4f}"]
+    # the deepest sample of that stretch, really that deep
+    contact = [c for c in checker.contacts(planner.plan().value(error.depth_time).ravel()) if "table" in c.bodies][0]
+    assert -contact.distance == pytest.approx(error.depth)
 
 
 def test_a_motion_through_the_arm_itself_is_refused(checker):
@@ -100,9 +121,51 @@ def test_a_motion_through_the_arm_itself_is_refused(checker):
     planner = quintic([[-1.57, -1.57, 2.9, -1.57, 1.57, 0.0]], q0=[-1.57, -1.57, 0.0, -1.57, 1.57, 0.0])
     with pytest.raises(CollisionError) as caught:
         checker.check_planner(planner)
-    assert "table" not in caught.value.bodies
-    assert set(caught.value.bodies) <= {"base", "shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link",
-                                        "wrist_2_link", "wrist_3_link"}
+    error = caught.value
+    assert "table" not in error.bodies
+    links = {"base", "shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link", "wrist_3_link"}
+    assert set(error.bodies) <= links
+    # said as such, with the two links that go into each other
+    hit = re.search(r"^in the planned motion the arm would hit itself \((\w+) and (\w+), ([0-9.]+) mm deep at t = ", str(error))
+    assert hit and {hit[1], hit[2]} <= links and float(hit[3]) == pytest.approx(error.depth * 1000, abs=0.05)
+    # and in a start configuration
+    q = planner.plan().value(error.depth_time).ravel()
+    with pytest.raises(CollisionError, match=rf"^in the start configuration the arm would hit itself \({hit[1]} and "
+                                             rf"{hit[2]}, [0-9.]+ mm deep\) \(at t = 0.0000 s"):
+        checker.check_configuration(q)
+
+
+def test_a_self_collision_with_the_tool_is_the_arm_hitting_itself():
+    """The tool is part of the arm: its shape in a link is a self-collision, not an obstacle."""
+    from drake_traj.cell import Cylinder, NoMounting, Tool
+
+    tool = Tool(tcp_xyz=[0, 0, 0.3], shapes=[Cylinder(name="gripper", radius=0.04, length=0.3, xyz=[0, 0, 0.15])])
+    tooled = CellChecker(UR10E, Cell(mounting=NoMounting(), tool=tool))
+    q = [0.0, -1.57, -2.71, 1.88, 2.48, 0.0]  # the elbow folded: the gripper in the forearm
+    contact = tooled.contacts(q)[0]
+    assert contact.on_arm == (True, True) and set(contact.bodies) == {"tool", "forearm_link"}, contact
+    with pytest.raises(CollisionError, match=r"^in the start configuration the arm would hit itself "
+                                             r"\((tool and forearm_link|forearm_link and tool), [0-9.]+ mm deep\)"):
+        tooled.check_configuration(q)
+
+
+def test_refusals_use_the_planners_word_for_its_targets(checker):
+    from drake_traj.planners.baselines.movej import MovejPlanner
+    from drake_traj.planners.baselines.ruckig import RuckigPlanner
+    from drake_traj.planners.boryga.system import BorygaLoopPlanner
+    from drake_traj.planners.li.system import LiPathPlanner
+    from drake_traj.planners.pajak.system import PajakPlanner
+    from drake_traj.planners.quintic.system import QuinticPtpPlanner
+    from drake_traj.planners.smooth.planners import SmoothPlanner
+
+    words = {cls: planner_target_word(cls) for cls in (QuinticPtpPlanner, RuckigPlanner, MovejPlanner, SmoothPlanner,
+                                                       LiPathPlanner, BorygaLoopPlanner, PajakPlanner)}
+    assert words == {QuinticPtpPlanner: "goal", RuckigPlanner: "goal", MovejPlanner: "goal", SmoothPlanner: "goal",
+                     LiPathPlanner: "point", BorygaLoopPlanner: "point", PajakPlanner: "waypoint"}
+    planner = quintic([[-1.2, -1.6, -2.0, -0.9, 1.57, 0.8], [-1.2, 0.6, -0.3, -0.9, 1.57, 0.8]])
+    with pytest.raises(CollisionError, match=r" on the way to goal 1 \(at t = ") as caught:
+        checker.check(planner.plan(), waypoints=planner.task_waypoints(), target_word=planner_target_word(planner))
+    assert caught.value.segment == "on the way to goal 1"
 
 
 def test_a_reference_past_the_joint_range_is_refused(checker):
@@ -158,12 +221,14 @@ def test_a_users_box_that_blocks_a_shipped_task_is_refused_at_its_line(tmp_path)
     error = caught.value
     assert "fixture" in error.bodies and error.field == ("cell", "obstacles", 0)
     assert str(error).startswith(f"{path}, line {line}")
+    assert len(re.findall(rf"t = {error.time:.3f}", str(error))) == 1  # the time once
     # the command line: exit 2, nothing simulated, the picture of the refused configuration
     out = tmp_path / "out"
     done = subprocess.run([sys.executable, "-m", "drake_traj.cli", "run", str(path), "--out", str(out)],
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 2, done.stderr
     assert "fixture" in done.stderr and f"line {line}" in done.stderr and "refusal.png" in done.stderr
+    assert len(re.findall(rf"t = {error.time:.3f}", done.stderr)) == 1
     assert (out / "refusal.png").stat().st_size > 10_000 and not (out / "result.npz").exists()
 
 
