@@ -179,8 +179,10 @@ class Failure:
 
     @classmethod
     def from_exception(cls, error: Exception, time: float) -> "Failure":
-        """The record of ``error`` raised at simulation time ``time`` [s]."""
-        message = f"{type(error).__name__} at t = {time:.4f} s: {error}"
+        """The record of ``error`` raised at simulation time ``time`` [s]: its type, the time
+        (unless a :class:`PlanningError`'s text already gives that time) and its text."""
+        said = isinstance(error, PlanningError) and error.time is not None and f"{float(error.time):.4f}" == f"{time:.4f}"
+        message = f"{type(error).__name__}: {error}" if said else f"{type(error).__name__} at t = {time:.4f} s: {error}"
         if isinstance(error, PlanningError):
             configuration = None if error.configuration is None else tuple(error.configuration.tolist())
             return cls(error.cause, message, time, configuration)

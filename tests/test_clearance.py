@@ -285,3 +285,12 @@ def test_meshcat_draws_the_refused_configuration_with_the_two_bodies(checker):
     for link in ("base", "shoulder_link", "upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link",
                  "wrist_3_link"):
         assert meshcat.HasPath(f"/drake_traj/refusal/{link}"), link
+
+
+def test_a_failure_from_a_planning_error_says_its_time_once():
+    from drake_traj.errors import Failure, PlanningError
+
+    failure = Failure.from_exception(PlanningError("the law stalled", time=1.25, configuration=HOME), 1.25)
+    assert failure.message.count("t = 1.2500 s") == 1 and failure.message.startswith("PlanningError: the law stalled")
+    other = Failure.from_exception(ValueError("singular"), 0.4)  # an error that gives no time: the run's
+    assert other.message == "ValueError at t = 0.4000 s: singular"
