@@ -20,11 +20,12 @@ default ``spacing = clearance / 2``, a motion accepted at ``clearance`` keeps at
 ``clearance / 2`` everywhere between the samples.
 """
 
+import hashlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import Box, Capsule, Cylinder, Ellipsoid, Sphere
+from pydrake.geometry import Box, Capsule, Cylinder, Ellipsoid, Role, Sphere
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import Trajectory
@@ -162,6 +163,25 @@ def _grid(trajectory: Trajectory) -> np.ndarray:
     return np.linspace(start, end, max(2, int(np.ceil((end - start) / RANGE_GRID)) + 1))
 
 
+def scene_fingerprint(plant, inspector) -> str:
+    """A digest of a finalized plant's collision scene: every geometry with a proximity role (its
+    body's scoped name, its shape and its pose in the body, 1e-9 m) and the pairs SceneGraph
+    checks (its collision filters). Two plants built from the same robot, cell and added bodies
+    have the same one; a body added to one, moved or filtered differently changes it."""
+    def body_name(frame_id) -> str:
+        body = plant.GetBodyFromFrameId(frame_id)
+        return body.scoped_name().get_full() if body is not None else inspector.GetName(frame_id)
+
+    def name(geometry) -> str:
+        return f"{body_name(inspector.GetFrameId(geometry))}/{inspector.GetName(geometry)}"
+
+    rows = sorted((name(geometry), repr(inspector.GetShape(geometry)),
+                   np.round(inspector.GetPoseInFrame(geometry).GetAsMatrix34(), 9).tolist())
+                  for geometry in inspector.GetAllGeometryIds(Role.kProximity))
+    pairs = sorted(tuple(sorted((name(a), name(b)))) for a, b in inspector.GetCollisionCandidates())
+    return hashlib.sha256(repr((rows, pairs)).encode()).hexdigest()
+
+
 @dataclass(frozen=True)
 class MotionCheck:
     """An accepted motion: the configurations checked at its sample times [s], and the bound
@@ -178,9 +198,17 @@ class CellChecker:
         robot: the robot; its model, as the station adds it.
         cell: the cell (default: :class:`~drake_traj.cell.Cell`, a table flush with the base).
         directory: the folder relative model files of ``cell.directives`` are taken from.
+        before_finalize: ``before_finalize(plant, scene_graph)``, a station's own bodies and
+            geometry (:func:`~drake_traj.station.add_station`'s), added before the plant is
+            finalized.
+
+    ``fingerprint`` names the collision scene (:func:`scene_fingerprint`): a station whose plant
+    has the same one runs the motions this checker accepted (:meth:`check_planner` records it on
+    the planner).
     """
 
-    def __init__(self, robot: Robot, cell: Cell | None = None, directory: Path | None = None):
+    def __init__(self, robot: Robot, cell: Cell | None = None, directory: Path | None = None, *,
+                 before_finalize=None):
         self.robot = robot
         self.cell = cell or Cell()
         builder = DiagramBuilder()
@@ -188,6 +216,8 @@ class CellChecker:
         self.instance = robot.add_to_plant(self.plant)
         self.cell_fields = add_cell(self.plant, self.cell, self.instance, robot=robot,
                                     directory=directory)
+        if before_finalize is not None:  # a station's own bodies (add_station's before_finalize)
+            before_finalize(self.plant, self.scene_graph)
         self.plant.Finalize()
         self._diagram = builder.Build()
         self._context = self._diagram.CreateDefaultContext()
@@ -196,6 +226,7 @@ class CellChecker:
         self._scene_context = self.scene_graph.GetMyContextFromRoot(self._context)
         self._inspector = self.scene_graph.model_inspector()
         self.reach = joint_reach(self.plant, self.scene_graph, self._plant_context, self.instance, robot.joint_names)
+        self.fingerprint = scene_fingerprint(self.plant, self._inspector)
 
     @property
     def clearance(self) -> float:
@@ -421,4 +452,7 @@ class CellChecker:
         :meth:`check` of its planned reference (``planner.plan()``, a
         :class:`~drake_traj.planners.base.PlannerSystem`) through its task waypoints."""
         self.check_configuration(planner.initial_positions(), field=start_field)
-        return self.check(planner.plan(), waypoints=planner.task_waypoints())
+        accepted = self.check(planner.plan(), waypoints=planner.task_waypoints(),
+                              target_word=planner_target_word(planner))
+        planner.checked_scenes.add(self.fingerprint)  # a station of this scene may run it (drake_traj.guard)
+        return accepted

@@ -42,9 +42,10 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, Trigg
 from pydrake.systems.primitives import (ConstantVectorSource, Demultiplexer, LogVectorOutput, MatrixGain,
                                         Multiplexer, TrajectorySource)
 
-from drake_traj.cell import Cell, add_cell
-from drake_traj.clearance import CellChecker, geometry_owner
+from drake_traj.cell import Cell, add_cell, refuse_free_bodies
+from drake_traj.clearance import CellChecker, geometry_owner, scene_fingerprint
 from drake_traj.errors import Cause, Failure
+from drake_traj.guard import MotionGuard
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
 from drake_traj.robots import UR10E, Robot
@@ -54,7 +55,8 @@ from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, check
                                  default_simulator_config)
 from drake_traj.scenario import preflight as scenario_preflight
 from drake_traj.validation import (callable_or_none, flag, instance_of, invalid, log_period_check, positive_scalar,
-                                   real_scalar, realtime_rate, run_duration, settle_duration, step_size)
+                                   real_scalar, realtime_rate, run_duration, settle_duration, step_size,
+                                   tracking_tolerance_check)
 
 __all__ = [
     "Station", "add_speed_override", "add_station", "build_station", "make_station", "run_station", "simulate",
@@ -137,6 +139,7 @@ def add_station(
     cell: Cell | None = None,
     cell_directory: Path | None = None,
     before_finalize=None,
+    check_motion: bool = True,
 ) -> Station:
     """Add ``planner``, the PD-controlled ``robot`` plant, the feed-forward, the loggers (and a
     Meshcat visualizer) to ``builder`` (see the module docstring for the wiring and the names).
@@ -155,7 +158,14 @@ def add_station(
             with the base, no tool), added to the plant (:func:`~drake_traj.cell.add_cell`).
         cell_directory: the folder relative model files of ``cell.directives`` are taken from.
         before_finalize: ``before_finalize(plant, scene_graph)`` adds one's own bodies and
-            geometry to the plant before it is finalized (the station finalizes it).
+            geometry to the plant before it is finalized (the station finalizes it). The cell
+            check calls it too, on the plant it checks in: it must add the same bodies to any
+            plant it is given.
+        check_motion: True (default): the motion starts only once the planner's plan was
+            accepted by the cell check in this station's own scene (robot, tool, cell and the
+            bodies of ``before_finalize``); where it was not, it is checked when the simulator
+            is initialized and refused with the check's error (:mod:`drake_traj.guard`). False
+            runs an unchecked plan (the run's in-loop watch stays on).
 
     A planner system is part of one diagram only (Drake owns it there): a second station needs a
     new planner (``make_planner`` again); ValueError otherwise.
@@ -171,6 +181,7 @@ def add_station(
     if cell is not None:
         instance_of(cell, Cell, "cell")
     callable_or_none(before_finalize, "before_finalize", "before_finalize(plant, scene_graph)")
+    check_motion = flag(check_motion, "check_motion")
     instance_of(gains or ControllerGains(), ControllerGains, "gains")
     gains = (gains or ControllerGains()).for_robot(robot)
     plant_config = instance_of(plant_config or default_plant_config(), MultibodyPlantConfig, "plant_config")
@@ -189,11 +200,14 @@ def add_station(
         actuators[joint_name].set_controller_gains(PdControllerGains(p=kp, d=kd))
     # the cell's geometry, the tool's body and payload: contact with them, and between the arm's
     # non-adjacent links, is simulated (and ends the run: run_station)
-    add_cell(plant, cell or Cell(), instance, robot=robot, directory=cell_directory)
+    fields = add_cell(plant, cell or Cell(), instance, robot=robot, directory=cell_directory)
     if before_finalize is not None:
         before_finalize(plant, scene_graph)
     plant.Finalize()
+    refuse_free_bodies(plant, instance, fields)  # the controller drives the robot's joints only
     plant.SetDefaultPositions(instance, planner.initial_positions())
+    planner.guard = MotionGuard(robot, cell or Cell(), cell_directory, before_finalize,
+                                scene_fingerprint(plant, scene_graph.model_inspector()), check_motion)
 
     planner.set_name("planner")
     builder.AddSystem(planner)
@@ -290,8 +304,10 @@ def build_station(planner: PlannerSystem, **kwargs) -> Diagram:
 
 def make_station(scenario: Scenario, meshcat: Meshcat | None = None) -> Diagram:
     """The station of a :class:`~drake_traj.scenario.Scenario`: its planner, robot, gains, plant
-    configuration and log period (the preflight is :func:`simulate`'s, or
-    :func:`drake_traj.scenario.preflight`).
+    configuration and log period. Its motion is checked before it starts, as :func:`simulate`
+    checks it (:func:`drake_traj.scenario.preflight`: the task, then the motion in the cell,
+    refusals located in the scenario's file), when the simulator is initialized or by
+    :func:`run_station`, whichever comes first.
 
     Simulate it with ``ApplySimulatorConfig(scenario.simulator, simulator)``: a Diagram cannot
     carry its integrator, and a plain ``Simulator`` uses Drake's default (error-controlled RK3),
@@ -305,13 +321,25 @@ def make_station(scenario: Scenario, meshcat: Meshcat | None = None) -> Diagram:
     if meshcat is not None:
         instance_of(meshcat, Meshcat, "meshcat")
     from_scenario = scenario.station_arguments()
-    return build_station(from_scenario.pop("planner"), meshcat=meshcat, **from_scenario)
+    planner = from_scenario.pop("planner")
+    station = build_station(planner, meshcat=meshcat, **from_scenario)
+    planner.guard.preflight = lambda planner, horizon: scenario_preflight(scenario, planner, horizon)
+    return station
 
 
 def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 0.5,
                 max_duration: float = 120.0, progress=None) -> Failure | None:
     """Advance ``simulator`` (over ``station``, possibly inside a larger diagram) until the
     planner has finished plus ``settle_time`` [s], or ``max_duration`` [s].
+
+    The motion starts only where the planner's plan was accepted by the cell check in the
+    station's own scene; where it was not, it is checked first, and a refusal is raised (a
+    :class:`~drake_traj.errors.PlanningError`, e.g. a
+    :class:`~drake_traj.clearance.CollisionError`) before anything moves, unless the station was
+    built with ``check_motion=False`` (:mod:`drake_traj.guard`). While it runs, the measured
+    motion is watched (:class:`~drake_traj.guard.ClearanceWatch`): closer than half the clearance
+    to anything, between logged samples included, it fails the run naming the bodies and the
+    time (cause "collision"), as contact reported by the plant does.
 
     Any exception from the simulation, and Ctrl-C (KeyboardInterrupt), is caught: the state and
     logs stay as they were when it happened. ``progress(t)`` is called with the simulated time
@@ -337,6 +365,11 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
     except RuntimeError:
         raise invalid("station", f"station {station.get_name()!r} is not part of the simulator's diagram "
                                  f"({simulator.get_system().get_name()!r})") from None
+    guard = planner.guard
+    watch = None
+    if guard is not None:
+        guard.ensure_checked(planner, max_duration)  # a refusal raised before the motion
+        watch = guard.watch(station.GetSubsystemByName("measured_logger"), root, planner.num_joints)
     chunk = min(0.01, max(settle_time, 1e-3))  # the finish and contact are checked between chunks
     end = max_duration
     try:
@@ -344,7 +377,7 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
             simulator.AdvanceTo(min(root.get_time() + chunk, end))
             if progress is not None:
                 progress(root.get_time())
-            touching = contact_failure(station, root)
+            touching = (watch.feed() if watch is not None else None) or contact_failure(station, root)
             if touching is not None:
                 return touching
             finish = planner.finish_time(planner_context)
@@ -444,7 +477,8 @@ def simulate(
             :meth:`CellChecker.check_planner <drake_traj.clearance.CellChecker.check_planner>`;
             a :class:`~drake_traj.errors.PlanningError`, e.g. a
             :class:`~drake_traj.clearance.CollisionError`, is raised before the run, not
-            recorded as a failed run; False: the run finds it).
+            recorded as a failed run; False: an unchecked run, said explicitly, where the run
+            finds what fails: the station's ``check_motion=False``).
         cell: the robot's cell and tool (a scenario's own by default; for a planner, a table
             flush with the base: :class:`~drake_traj.cell.Cell`).
         cell_directory: the folder relative model files of ``cell.directives`` are taken from
@@ -488,6 +522,7 @@ def simulate(
     settle_duration(settle_time)
     if tracking_tolerance is not None:
         positive_scalar(tracking_tolerance, "tracking_tolerance", "m")
+        tracking_tolerance_check(tracking_tolerance, (cell or Cell()).clearance)
     speed_override_source(speed_override)
     callable_or_none(progress, "progress", "progress(t)")
     callable_or_none(add_systems, "add_systems", "add_systems(builder, station)")
@@ -502,7 +537,7 @@ def simulate(
     builder = DiagramBuilder()
     station = builder.AddSystem(build_station(planner, robot=robot, gains=gains, plant_config=plant_config,
                                               log_period=log_period, meshcat=meshcat, cell=cell,
-                                              cell_directory=cell_directory))
+                                              cell_directory=cell_directory, check_motion=preflight))
     add_speed_override(builder, station, speed_override)
     if add_systems is not None:
         add_systems(builder, station)

@@ -13,6 +13,10 @@ Every planner is a LeafSystem with
   splits it with a C++ ``Demultiplexer`` for the plant and the loggers);
 - an optional input port ``speed_override`` (a value in [0, 1]; unconnected means 1).
 
+At the simulator's initialization a planner in a station checks that its plan was accepted by
+the cell check in that station's scene (``guard``, :mod:`drake_traj.guard`): an unchecked plan is
+checked there, and refused before the motion where it would collide.
+
 Subclasses implement :meth:`PlannerSystem.evaluate` (qdd and c from the context) and
 :meth:`PlannerSystem.finished`, and declare their own update events. The evaluation is cached
 per context, so the derivatives and the output ports at one context share a single call.
@@ -75,6 +79,12 @@ class PlannerSystem(LeafSystem):
         self.num_joints = n
         self._q_initial = q_initial
         self._plan = None  # the PiecewisePolynomial of plan(), made at the first call
+        # fingerprints of the collision scenes in which the cell check accepted plan()
+        # (CellChecker.check_planner), and the station's guard (drake_traj.guard.MotionGuard, set
+        # by add_station): the motion starts only where the guard finds its scene checked
+        self.checked_scenes: set[str] = set()
+        self.guard = None
+        self.DeclareInitializationPublishEvent(self._before_motion)
         self.DeclareContinuousState(BasicVector(np.concatenate([q_initial, np.zeros(n)])), n, n, 0)
         self.scaling_state_index = self.DeclareDiscreteState(
             np.array([initial_scaling, 0.0, initial_scaling])
@@ -172,6 +182,14 @@ class PlannerSystem(LeafSystem):
         return float("nan")
 
     # --- shared ------------------------------------------------------------------------------
+    def _before_motion(self, context) -> EventStatus:
+        """At the simulator's initialization: the station's guard refuses a plan that was not
+        checked in the station's scene (checking it there first; drake_traj.guard), whatever
+        started the simulation (run_station or one's own Simulator)."""
+        if self.guard is not None:
+            self.guard.ensure_checked(self, DEFAULT_PREFLIGHT_HORIZON)
+        return EventStatus.Succeeded()
+
     def finish_time(self, context) -> float:
         """When the task finished [s], as recorded by the planner's update events; NaN before."""
         return float(context.get_discrete_state(self.finish_state_index).get_value()[0])
@@ -257,6 +275,9 @@ class TimeLawPlanner(PlannerSystem):
     key (:meth:`_rates`): the derivatives, both outputs and the update of one step share one law
     evaluation.
 
+    The ``scaling`` output is c, or c_law(tau) × c for a law with a scaling of its own
+    (``law.scaling_at(tau)``, the Pająk plan's coefficient of eq. 17-18).
+
     Discrete state: ``clock`` = [tau, ċ, c, t0]: the law time, the clock's rate and c at the last
     update t0 (the clock's truth); ``scaling`` = [c, t0, c] (the contract's view of the same
     clock) and ``finish``.
@@ -299,6 +320,9 @@ class TimeLawPlanner(PlannerSystem):
         self.clock_state_index = self.DeclareDiscreteState(np.array([0.0, 0.0, self.speed_cap, 0.0]))
         self.DeclarePeriodicUnrestrictedUpdateEvent(update_period, 0.0, self._update)
         self._kept = (None, None)  # (key, _Rates) of _rates: see there why not a cache entry
+        # a law with a scaling of its own (the Pająk plan's c, eq. 17-18) reports c_law(tau) × c
+        self._law_scaling = getattr(law, "scaling_at", None)
+        self._law_finish = getattr(law, "finish_time", None)  # the task's end, before the law's (its settling)
         jumps = law.acceleration_jumps  # law times where q_law'' jumps (None: anywhere)
         self._acceleration_jumps = None if jumps is None else sorted(np.asarray(jumps, dtype=float).tolist())
 
@@ -333,10 +357,11 @@ class TimeLawPlanner(PlannerSystem):
             t, tau0, c_rate, c0, t0 = key
             tau, c = clock_at(t - t0, tau0, c0, c_rate)
             qd_law, qdd_law = self.law.rates_at(tau)
-            values = np.concatenate((qd_law * c, qdd_law * c**2 + qd_law * c_rate, (c,)))
+            scaling = c if self._law_scaling is None else c * self._law_scaling(tau)
+            values = np.concatenate((qd_law * c, qdd_law * c**2 + qd_law * c_rate, (scaling,)))
             values.flags.writeable = False
             n = self.num_joints
-            self._kept = (key, _Rates(values[: 2 * n], values[n : 2 * n], values[n:], c))
+            self._kept = (key, _Rates(values[: 2 * n], values[n : 2 * n], values[n:], scaling))
         return self._kept[1]
 
     def evaluate(self, context) -> tuple[np.ndarray, float]:
@@ -362,11 +387,16 @@ class TimeLawPlanner(PlannerSystem):
         output.SetFromVector(self._rates(context).acceleration_and_scaling)
 
     def finished(self, context) -> bool:
-        return self._clock(context)[0] >= self.law.duration
+        return self._clock(context)[0] >= self._finish_tau()
 
     def planned_duration(self) -> float:
         """The motion's duration at the speed cap, without override [s]."""
-        return self.law.duration / self.speed_cap
+        return self._finish_tau() / self.speed_cap
+
+    def _finish_tau(self) -> float:
+        """The law time [s] at which the task is complete: the law's ``duration``, or its
+        ``finish`` where it has one (a law that settles after its task is done, Pająk's)."""
+        return self.law.duration if self._law_finish is None else self._law_finish()
 
     def _plan_pieces(self) -> tuple[np.ndarray, np.ndarray]:
         """The law's pieces on the clock at the speed cap (c starts there and stays without an
@@ -400,14 +430,15 @@ class TimeLawPlanner(PlannerSystem):
         goal = self.speed_cap * self.speed_override(context)
         steady = c_rate == 0.0 and c == goal
         jumped = self._jumped(tau, clock_at(max(t - h, t0) - t0, tau0, c0, c_rate)[0])
-        if steady and not jumped and tau < self.law.duration:
+        finish = self._finish_tau()
+        if steady and not jumped and tau < finish:
             return _DID_NOTHING  # the clock runs on as it is: nothing to write (the common case)
-        finishing = tau >= self.law.duration and np.isnan(self.finish_time(context))
+        finishing = tau >= finish and np.isnan(self.finish_time(context))
         if steady and not (jumped or finishing):
             return _DID_NOTHING
         discrete = state.get_mutable_discrete_state()
-        if finishing:  # finished in (t0, t]: tau0 + c0 s + ċ s² / 2 = duration
-            roots = np.roots([0.5 * c_rate, c0, tau0 - self.law.duration]) if c_rate else [(self.law.duration - tau0) / c0]
+        if finishing:  # finished in (t0, t]: tau0 + c0 s + ċ s² / 2 = finish
+            roots = np.roots([0.5 * c_rate, c0, tau0 - finish]) if c_rate else [(finish - tau0) / c0]
             s = min(float(np.real(r)) for r in np.atleast_1d(roots) if abs(np.imag(r)) < 1e-12 and np.real(r) >= -1e-12)
             self._record_finish(discrete.get_mutable_vector(self.finish_state_index), t0 + max(s, 0.0))
         if abs(goal - c) <= 1e-9 and abs(c_rate) <= self.clock_jerk * h:

@@ -51,8 +51,9 @@ class TimeLaw(Protocol):
 
 def missing_members(law) -> list[str]:
     """The members of :class:`TimeLaw` that ``law`` lacks (empty for a time law: what the
-    Protocol's ``isinstance`` checks, named)."""
-    return [name for name in MEMBERS if not hasattr(law, name)]
+    Protocol's ``isinstance`` checks, named). A member its class defines (a property of a law
+    made at its first use) is looked up on the class, without evaluating it."""
+    return [name for name in MEMBERS if not (hasattr(type(law), name) or hasattr(law, name))]
 
 
 MEMBERS = tuple(TimeLaw.__annotations__) + tuple(

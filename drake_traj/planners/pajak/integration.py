@@ -17,7 +17,7 @@ __all__ = ["integrate"]
 
 
 def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settle_time: float = 0.0,
-              raise_on_timeout: bool = True) -> dict:
+              raise_on_timeout: bool = True, check_reach: bool = True) -> dict:
     """Integrate one task with RK4 at a fixed step, updating the discrete state every step.
 
     At every step k: discrete update at t_k, then the sample (t_k, q_k, q̇_k, q̈_k, c_k, TCP,
@@ -33,6 +33,8 @@ def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settl
         settle_time: keep integrating this long after the finish [s].
         raise_on_timeout: False returns what was computed up to t_max (T = nan) instead of
             raising (to look at the start of a motion).
+        check_reach: refuse a waypoint out of reach before integrating (False: integrate until the
+            law itself fails there, e.g. stalls; what a run without a preflight meets).
 
     Returns:
         dict of arrays: t (K,), q, qd, qdd (K, 6), c (K,), tcp (K, 6) pose, waypoint (K,),
@@ -54,7 +56,7 @@ def integrate(law: PajakLaw, q0, *, dt: float = 1e-3, t_max: float = 30.0, settl
     if not np.isfinite(settle_time) or settle_time < 0:
         raise ValueError(f"settle_time must be a non-negative number of seconds, got {settle_time}")
     q0 = finite_array(q0, "q0", "rad", shape=(law.robot.num_joints,))
-    unreachable = law.reach_failure(q0)
+    unreachable = law.reach_failure(q0) if check_reach else None
     if unreachable is not None:
         raise unreachable
     steps = int(math.ceil(t_max / dt - 1e-9))

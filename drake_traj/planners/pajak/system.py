@@ -1,36 +1,102 @@
-"""The Pająk 2024 planner as a Drake system: a thin shell around :class:`PajakLaw`."""
+"""The Pająk 2024 planner as a Drake system: the motion of :class:`PajakLaw` at speed override 1
+(the preflight's), run on a scaled clock so that an override re-times it along the same path."""
 
 from __future__ import annotations
+
+from bisect import bisect_right
 
 import numpy as np
 
 from drake_traj.errors import Cause, PlanningError
-from drake_traj.planners.base import DEFAULT_PREFLIGHT_HORIZON, PlannerSystem
-from drake_traj.planners.laws.hermite import quintic_hermite_coefficients
+from drake_traj.planners.base import DEFAULT_PREFLIGHT_HORIZON, TimeLawPlanner
+from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coefficients
 from drake_traj.planners.pajak.integration import integrate
-from drake_traj.planners.pajak.kernel import Discrete
 from drake_traj.planners.pajak.law import PajakLaw
 from drake_traj.planners.pajak.parameters import PajakConfig
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import finite_array, invalid, run_duration
 
-__all__ = ["MAX_PREFLIGHT_STEPS", "PajakPlanner", "make"]
+__all__ = ["MAX_PREFLIGHT_STEPS", "PajakPlanLaw", "PajakPlanner", "make"]
 
 # The preflight's integration steps at most: its log holds Log.SIZE values a step (54: 432 MB at
 # this bound; 600 s, the longest run, at the default 1 ms update period is 6e5 steps)
 MAX_PREFLIGHT_STEPS = 1_000_000
+SETTLE_TIME = 4.0  # [s] the law integrated on after the finish, while it settles (sim 3: 1e-6 rad/s after 2.6 s)
+REST_SPEED = 1e-6  # [rad/s] the planned motion ends where every joint is slower: at rest
 
 
-class PajakPlanner(PlannerSystem):
-    """Pająk 2024's planner as a LeafSystem: continuous [q; q̇], discrete ``scaling`` [c, t0, c0]
-    and ``task`` (the rest of :class:`~.kernel.Discrete`), updated every ``update_period``.
+class PajakPlanLaw:
+    """The Pająk law's motion at speed override 1, as a time law (:class:`~drake_traj.planners.laws.TimeLaw`):
+    the preflight's RK4 samples (t, q, q̇, q̈), one per update period up to the finish, joined by
+    quintic Hermite pieces (:class:`~drake_traj.planners.laws.HermiteLaw`; q̈ continuous), and
+    the law's scaling coefficient c (eq. 17-18) held over each period (``scaling_at``).
 
-    The acceleration (and c) are evaluated by :meth:`PajakLaw.acceleration` at every derivative
-    call, so the acceleration limit holds at every integrator stage, not only at updates. A
-    :class:`PlanningError` from the law ends the simulation; ``simulate`` keeps the log. The
-    ``speed_override`` input, sampled at the updates, is the value c relaxes to instead of 1
-    (eq. 18): c stays continuous and within the limits, and the task is still completed (at
-    0 the feedback fades out and the arm coasts: an override for slowing, not for stopping).
+    Made at its first use from the planner's preflight (run then with the default horizon where
+    none was run). Where the task fails (a run without a preflight: ``preflight=False``) it is
+    the motion up to the failure, and :attr:`failure` is the :class:`PlanningError` the planner
+    raises when its clock gets there.
+    """
+
+    acceleration_jumps = np.zeros(0)  # the Hermite pieces meet in q, q̇ and q̈
+
+    def __init__(self, planner: "PajakPlanner", q_start: np.ndarray):
+        self._planner = planner
+        self.q_start = q_start
+        self._table = None  # (HermiteLaw, times [s], c per sample, failure or None, finish [s]): at the first use
+
+    def _made(self):
+        if self._table is None:
+            self._table = self._planner._motion_table()
+            hermite = self._table[0]
+            self.rates_at, self.sample = hermite.rates_at, hermite.sample  # the hot path, without this wrapper
+        return self._table
+
+    @property
+    def duration(self) -> float:
+        """Law time [s] of the finish (of the failure, where the task fails)."""
+        return self._made()[0].duration
+
+    @property
+    def polynomial_breaks(self) -> np.ndarray:
+        return self._made()[0].polynomial_breaks
+
+    def finish_time(self) -> float:
+        """Law time [s] at which the task is complete (eq. 19's last neighbourhood reached with the
+        orientation): the motion goes on after it while the law settles to rest."""
+        return self._made()[4]
+
+    @property
+    def failure(self) -> PlanningError | None:
+        """The law's failure at the end of this motion, None where it finishes its task."""
+        return self._made()[3]
+
+    def rates_at(self, tau: float):
+        return self._made()[0].rates_at(tau)
+
+    def sample(self, tau: float):
+        return self._made()[0].sample(tau)
+
+    def scaling_at(self, tau: float) -> float:
+        """c of the law [-] over the update period that contains law time ``tau`` [s]."""
+        _, times, scaling, _, _ = self._made()
+        return float(scaling[min(max(bisect_right(times, tau) - 1, 0), len(scaling) - 1)])
+
+
+class PajakPlanner(TimeLawPlanner):
+    """Pająk 2024's planner as a LeafSystem: the law's motion at speed override 1, run on the
+    scaled clock of every time-law planner (:class:`~drake_traj.planners.base.TimeLawPlanner`).
+
+    The law (:class:`PajakLaw`, eq. 13-19) is integrated before the motion by the preflight
+    (:func:`integrate`, RK4 at ``update_period``, the motion the cell check examines); the
+    reference is that motion, :class:`PajakPlanLaw`. The ``speed_override`` input re-times it
+    along the same path, as a UR controller's speed slider does (q̈ continuous, the limits held):
+    the motion that runs is the motion that was checked, whatever the override. At override 1
+    the reference is the law's own motion (Table 2's times); the ``scaling`` output is the law's
+    c (eq. 17-18) times the clock's rate.
+
+    Without a preflight (``simulate(..., preflight=False)``) the law is integrated when the run
+    starts, with the reach check left to the law: a task that fails is run up to its failure and
+    the planner raises the law's :class:`PlanningError` there (the run's failure, with its log).
 
     Args:
         parameters: the task and the law's settings.
@@ -42,37 +108,60 @@ class PajakPlanner(PlannerSystem):
     plans_online = True
 
     def __init__(self, parameters: PajakConfig, q_initial, *, robot: Robot = UR10E):
-        self.law = PajakLaw(parameters, robot)
-        self.robot = self.law.robot
-        update_period = self.law.parameters.update_period
-        initial = self.law.initial_discrete()
-        super().__init__(finite_array(q_initial, "q_initial", "rad", shape=(robot.num_joints,)),
-                         initial_scaling=float(initial[Discrete.C]))
-        self.task_state_index = self.DeclareDiscreteState(initial[Discrete.C0 + 1:])
-        self.velocity_limit = self.law.qd_max
-        self.acceleration_limit = self.law.qdd_max
-        self.DeclarePeriodicDiscreteUpdateEvent(update_period, 0.0, self._update)
+        self.pajak_law = PajakLaw(parameters, robot)
+        self.robot = self.pajak_law.robot
+        q_initial = finite_array(q_initial, "q_initial", "rad", shape=(robot.num_joints,))
         self._run = None  # the preflight's integration (:func:`integrate`), kept once it finished
+        super().__init__(PajakPlanLaw(self, q_initial), self.pajak_law.qd_max, self.pajak_law.qdd_max,
+                         update_period=self.pajak_law.parameters.update_period)
 
-    def _law_arguments(self, context):
-        state = self.reference_state(context)
-        discrete = np.concatenate([
-            context.get_discrete_state(self.scaling_state_index).get_value(),
-            context.get_discrete_state(self.task_state_index).get_value(),
-        ])
-        return context.get_time(), state[: self.num_joints], state[self.num_joints:], discrete
+    def _motion_table(self):
+        """(HermiteLaw, sample times [s], c per sample, failure, finish [s]) of
+        :class:`PajakPlanLaw`: the preflight's integration up to rest (:meth:`_rest_index`);
+        where none was run, one with the default horizon, and where that fails, the motion up to
+        the failure with the error."""
+        failure = None
+        if self._run is None:
+            try:
+                self.preflight()
+            except PlanningError:
+                try:
+                    integrate(self.pajak_law, self.initial_positions(), dt=self.pajak_law.parameters.update_period,
+                              t_max=DEFAULT_PREFLIGHT_HORIZON, check_reach=False)
+                except PlanningError as error:
+                    failure = error
+        if failure is None:
+            end = self._rest_index() + 1
+            run = {name: self._run[name][:end] for name in ("t", "q", "qd", "qdd", "c")}
+        else:
+            run = getattr(failure, "partial", None) or {}
+            if len(run.get("t", ())) < 2:  # failed at the first step: stand still for one period
+                period, start = self.pajak_law.parameters.update_period, self.initial_positions()
+                zeros = np.zeros((2, len(start)))
+                run = {"t": np.array([0.0, period]), "q": np.stack([start, start]), "qd": zeros, "qdd": zeros,
+                       "c": np.zeros(2)}
+        samples = np.stack([run["q"], run["qd"], run["qdd"]], axis=1)
+        law = HermiteLaw(run["t"], samples, samples)
+        finish = law.duration if failure is not None else float(self._run["T"])
+        return law, np.asarray(run["t"]), np.asarray(run["c"]), failure, finish
 
-    def evaluate(self, context) -> tuple[np.ndarray, float]:
-        return self.law.acceleration(*self._law_arguments(context))
+    def _rest_index(self) -> int:
+        """The preflight's last sample of the motion: the first after the finish where every
+        joint is slower than :data:`REST_SPEED` (the law settles after its task is done, its
+        reference creeping on by 1 mrad over a second on sim 3), else the last integrated."""
+        finish = self._run["finish_index"]
+        resting = np.flatnonzero(np.abs(self._run["qd"][finish:]).max(axis=1) <= REST_SPEED)
+        return finish + int(resting[0]) if len(resting) else len(self._run["t"]) - 1
 
     def finished(self, context) -> bool:
-        _, q, qd, discrete = self._law_arguments(context)
-        return self.law.finished(q, qd, discrete)
+        return self.law.failure is None and super().finished(context)
 
-    def limit_conflicts(self, context) -> int:
-        """Updates so far at which the limits overruled the law (q̈ clipped to the box, or the
-        fallback braking; improvement 2)."""
-        return int(context.get_discrete_state(self.task_state_index).get_value()[Discrete.SATURATED - Discrete.C0 - 1])
+    def limit_conflicts(self) -> int:
+        """Update periods of the planned motion at which the limits overruled the law (q̈
+        clipped to the box, or the fallback braking; improvement 2); the preflight's."""
+        if self._run is None:
+            self.preflight()
+        return int(np.count_nonzero(self._run["saturated"][: self._run["finish_index"] + 1]))
 
     def preflight(self, horizon: float = DEFAULT_PREFLIGHT_HORIZON) -> np.ndarray:
         """Run the whole task ahead of time (:func:`integrate`, the law alone) before t = 0, up
@@ -85,21 +174,22 @@ class PajakPlanner(PlannerSystem):
         message names the waypoint). A run that finishes has reached the whole pose (position
         within ε, orientation within ``orientation_accuracy``).
 
-        The integration is kept once it finished (the law does not change): a second preflight
-        and :meth:`plan` reuse it; one that failed is run again and raises again.
+        The integration is kept once it finished (the law does not change): a second preflight,
+        :meth:`plan` and the run reuse it; one that failed is run again and raises again.
 
         Returns:
             The planned TCP path [m], (N, 3).
         """
         horizon = run_duration(horizon, "horizon")
-        update_period = self.law.parameters.update_period
+        update_period = self.pajak_law.parameters.update_period
         if horizon / update_period > MAX_PREFLIGHT_STEPS:
             raise invalid("update_period", f"update_period = {update_period:g} s would take {horizon / update_period:.3g} "
                                            f"steps to look {horizon:g} s ahead (max_duration); at most "
                                            f"{MAX_PREFLIGHT_STEPS:.0e}: raise update_period or lower max_duration")
         if self._run is None:
             try:
-                self._run = integrate(self.law, self.initial_positions(), dt=update_period, t_max=horizon)
+                self._run = integrate(self.pajak_law, self.initial_positions(), dt=update_period, t_max=horizon,
+                                      settle_time=SETTLE_TIME)
             except PlanningError as error:
                 if error.cause is not Cause.TIMEOUT:
                     raise
@@ -111,37 +201,41 @@ class PajakPlanner(PlannerSystem):
                                 "horizon (the run's max_duration)", cause=Cause.TIMEOUT)
         return self._run["tcp"][:, :3]
 
+    def planned_duration(self) -> float:
+        """The law's finish time at override 1 [s] once the preflight ran, else NaN."""
+        return float("nan") if self._run is None else float(self._run["T"])
+
     def _plan_pieces(self) -> tuple[np.ndarray, np.ndarray]:
-        """The preflight's samples (t, q, q̇, q̈) up to the finish, one every update period,
+        """The preflight's samples (t, q, q̇, q̈) up to rest after the finish (the law settling:
+        :meth:`_rest_index`; :meth:`planned_duration` is the finish), one every update period,
         joined by quintic Hermite pieces (:func:`quintic_hermite_coefficients`; q̈ the law's
-        after each step's update on both sides of its sample). The preflight's own integration
-        when one was run (with the run's horizon), else one with the default horizon."""
+        after each step's update on both sides of its sample): the reference the planner runs.
+        The preflight's own integration when one was run (with the run's horizon), else one
+        with the default horizon."""
         if self._run is None:
             self.preflight()
-        end = self._run["finish_index"] + 1
+        end = self._rest_index() + 1
         times = self._run["t"][:end]
         samples = np.stack([self._run[name][:end] for name in ("q", "qd", "qdd")], axis=1)
         return times, quintic_hermite_coefficients(times, samples, samples)
 
     def goal_pose(self) -> np.ndarray:
         """p_f, the last waypoint [m, rad]."""
-        return self.law.waypoints[-1].copy()
+        return self.pajak_law.waypoints[-1].copy()
 
     def task_waypoints(self) -> np.ndarray:
-        return self.law.tcp_positions()
+        return self.pajak_law.tcp_positions()
 
     def waypoint_neighbourhood(self) -> float:
         """ϵ [m] when the planner blends its waypoints (eq. 19), else NaN (it stops at each)."""
-        parameters = self.law.parameters
+        parameters = self.pajak_law.parameters
         return float(parameters.neighbourhood) if parameters.blend_waypoints else float("nan")
 
-    def _update(self, context, discrete_state):
-        t, q, qd, discrete = self._law_arguments(context)
-        updated = self.law.update(t, q, qd, discrete, self.speed_override(context))
-        discrete_state.get_mutable_vector(self.scaling_state_index).SetFromVector(updated[: Discrete.C0 + 1])
-        discrete_state.get_mutable_vector(self.task_state_index).SetFromVector(updated[Discrete.C0 + 1:])
-        if self.law.finished(q, qd, updated):
-            self._record_finish(discrete_state.get_mutable_vector(self.finish_state_index), t)
+    def _update(self, context, state):
+        failure = self.law.failure
+        if failure is not None and self._clock(context)[0] >= self.law.duration:
+            raise failure
+        return super()._update(context, state)
 
 
 def make(config: PajakConfig, robot: Robot, q_initial) -> PajakPlanner:

@@ -145,8 +145,10 @@ def pajak_joint_path(config: PajakConfig, robot: Robot, q_initial) -> np.ndarray
 
 
 def _pajak_samples(planner: PajakPlanner) -> np.ndarray:
+    """The planned motion's samples up to the task's finish (not the law's settling after it)."""
     plan = planner.plan()
-    return plan.vector_values(plan.get_segment_times()).T
+    times = np.asarray(plan.get_segment_times())
+    return plan.vector_values(times[times <= planner.planned_duration() + 1e-12]).T
 
 
 def make_retimed_pajak(config: RetimedPajakConfig, robot: Robot, q_initial) -> SmoothPlanner:
