@@ -178,7 +178,7 @@ class PajakPlanner(TimeLawPlanner):
         :meth:`plan` and the run reuse it; one that failed is run again and raises again.
 
         Returns:
-            The planned TCP path [m], (N, 3).
+            The planned TCP path [m], (N, 3), up to the finish.
         """
         horizon = run_duration(horizon, "horizon")
         update_period = self.pajak_law.parameters.update_period
@@ -199,7 +199,7 @@ class PajakPlanner(TimeLawPlanner):
         elif self._run["T"] > horizon:
             raise PlanningError(f"the task takes {self._run['T']:.3f} s, longer than {horizon:g} s, the preflight's "
                                 "horizon (the run's max_duration)", cause=Cause.TIMEOUT)
-        return self._run["tcp"][:, :3]
+        return self._run["tcp"][: self._run["finish_index"] + 1, :3]
 
     def planned_duration(self) -> float:
         """The law's finish time at override 1 [s] once the preflight ran, else NaN."""
