@@ -12,7 +12,7 @@ Planner configs (``PajakConfig``, ``QuinticConfig``, ...) build planners with
 
 from drake_traj.station import add_station, build_station, make_station, run_station, simulate
 from drake_traj.errors import Cause, DrakeTrajError, Failure, PlanningError, SingularConfigurationError
-from drake_traj.planners import (BorygaConfig, LiConfig, MovejConfig, PajakConfig, QuinticConfig,
+from drake_traj.planners import (BorygaConfig, FreeMotionConfig, LiConfig, MovejConfig, PajakConfig, QuinticConfig,
                                  RetimedPajakConfig, RuckigConfig, SmoothWaypointsConfig, ToppraConfig)
 from drake_traj.result import Metrics, SimulationResult
 from drake_traj.robots import Robot, get_robot
@@ -22,6 +22,7 @@ from drake_traj.version import __version__
 
 __all__ = [
     "add_station", "BorygaConfig", "build_station", "Cause", "ControllerGains", "DrakeTrajError", "Failure",
+    "FreeMotionConfig",
     "get_robot", "LiConfig", "load_scenario", "make_planner", "make_station", "Metrics", "MovejConfig",
     "PajakConfig", "PlanningError", "preflight", "QuinticConfig", "RetimedPajakConfig", "Robot", "RuckigConfig",
     "run_station", "Scenario", "simulate", "SimulationResult", "SingularConfigurationError", "SmoothWaypointsConfig",

@@ -144,6 +144,37 @@ def joint_reach(plant, scene_graph, plant_context, instance, joint_names) -> np.
     return reach
 
 
+def link_reach(plant, scene_graph, instance, joint_names) -> tuple[np.ndarray, dict]:
+    """Per-link travel bounds of a serial arm: (R [m/rad] (n + 1, n), the link of every
+    collision geometry: {GeometryId: link}, 0 for the base and everything fixed in the world).
+
+    R[i, j] bounds the distance of link i's collision geometry (the bodies welded to it, the tool
+    on the last link, included) from joint j's origin on its axis, for every joint j that moves
+    link i (j < i; joints from 0, link 0 the base): a turn Δq_j moves each of its points at most
+    R[i, j] |Δq_j|. From the link's own geometry about its joint and the joint-to-joint offsets
+    (the triangle inequality, as :func:`joint_reach`, which is the most of these over the links)."""
+    inspector = scene_graph.model_inspector()
+    context = plant.CreateDefaultContext()
+    joints = [plant.GetJointByName(name, instance) for name in joint_names]
+    n = len(joints)
+    origins = [joint.frame_on_child().CalcPoseInWorld(context) for joint in joints]
+    reach = np.zeros((n + 1, n))
+    links = {}
+    for j, joint in enumerate(joints):
+        bound = 0.0
+        for body in plant.GetBodiesWeldedTo(joint.child_body()):
+            X_OB = origins[j].InvertAndCompose(body.body_frame().CalcPoseInWorld(context))
+            for geometry in plant.GetCollisionGeometriesForBody(body):
+                links[geometry] = j + 1
+                X_OG = X_OB @ inspector.GetPoseInFrame(geometry)
+                bound = max(bound, float(np.linalg.norm(X_OG.translation())) + _bounding_radius(inspector.GetShape(geometry)))
+        reach[j + 1, j] = bound
+        for k in reversed(range(j)):  # the joints before it: its origin's offset to the next joint's, and on
+            offset = origins[k].InvertAndCompose(joints[k + 1].frame_on_parent().CalcPoseInWorld(context)).translation()
+            reach[j + 1, k] = float(np.linalg.norm(offset)) + reach[j + 1, k + 1]
+    return reach, links
+
+
 def geometry_owner(plant, inspector, geometry, robot_instance) -> tuple[str, str]:
     """(body, geometry) names of a collision geometry as messages give them: the robot's links
     by name (``forearm_link``), the cell's geometry on the world by its own name (``table``, an
@@ -232,6 +263,10 @@ class CellChecker:
     def clearance(self) -> float:
         """The cell's clearance [m]."""
         return float(self.cell.clearance)
+
+    def link_reach(self) -> tuple[np.ndarray, dict]:
+        """:func:`link_reach` of the robot in this checker's plant (per-link travel bounds)."""
+        return link_reach(self.plant, self.scene_graph, self.instance, self.robot.joint_names)
 
     def owner(self, geometry) -> tuple[str, str]:
         """(body, geometry) names of a geometry id, as messages give them (:func:`geometry_owner`)."""
@@ -451,6 +486,8 @@ class CellChecker:
         """:meth:`check_configuration` of the planner's start (errors at ``start_field``), then
         :meth:`check` of its planned reference (``planner.plan()``, a
         :class:`~drake_traj.planners.base.PlannerSystem`) through its task waypoints."""
+        if getattr(planner, "needs_cell", False):  # it plans in the cell: its search, timing and this check
+            return planner.plan_in(self)
         self.check_configuration(planner.initial_positions(), field=start_field)
         accepted = self.check(planner.plan(), waypoints=planner.task_waypoints(),
                               target_word=planner_target_word(planner))

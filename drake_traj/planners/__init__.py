@@ -8,10 +8,11 @@ from __future__ import annotations
 
 from typing import Union
 
-from drake_traj.planners import boryga, li, pajak, quintic
+from drake_traj.planners import boryga, free, li, pajak, quintic
 from drake_traj.planners.baselines import movej, ruckig, toppra
 from drake_traj.planners.base import PlannerSystem, planner_robot
 from drake_traj.planners.boryga import BorygaConfig
+from drake_traj.planners.free import FreeMotionConfig
 from drake_traj.planners.baselines.movej import MovejConfig
 from drake_traj.planners.baselines.ruckig import RuckigConfig
 from drake_traj.planners.baselines.toppra import ToppraConfig
@@ -24,7 +25,7 @@ from drake_traj.robots.base import Robot
 from drake_traj.validation import finite_array, instance_of
 
 __all__ = [
-    "BorygaConfig", "LiConfig", "MovejConfig", "PLANNER_CONFIGS", "PajakConfig", "PlannerConfig", "PlannerSystem",
+    "BorygaConfig", "FreeMotionConfig", "LiConfig", "MovejConfig", "PLANNER_CONFIGS", "PajakConfig", "PlannerConfig", "PlannerSystem",
     "QuinticConfig", "RetimedPajakConfig", "RuckigConfig", "SmoothWaypointsConfig", "ToppraConfig", "make_planner",
 ]
 
@@ -39,10 +40,11 @@ _MAKERS = {
     ToppraConfig: toppra.make,
     SmoothWaypointsConfig: smooth.make_smooth_waypoints,
     RetimedPajakConfig: smooth.make_retimed_pajak,
+    FreeMotionConfig: free.make,
 }
 PLANNER_CONFIGS = tuple(_MAKERS)
 PlannerConfig = Union[QuinticConfig, PajakConfig, BorygaConfig, LiConfig, MovejConfig, RuckigConfig, ToppraConfig,
-                      SmoothWaypointsConfig, RetimedPajakConfig]
+                      SmoothWaypointsConfig, RetimedPajakConfig, FreeMotionConfig]
 
 
 def make_planner(config: PlannerConfig, robot: Robot, q_initial) -> PlannerSystem:

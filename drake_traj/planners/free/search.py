@@ -1,0 +1,228 @@
+"""Collision-free joint paths through a cell: the Open Motion Planning Library's planners (the
+``ompl`` wheel) search, validity from SceneGraph's signed distances, our shortcutting after.
+
+Validity is the cell check's (:class:`~drake_traj.clearance.CellChecker`, duck-typed here: its
+``pose_query``, ``reach`` and ``clearance``): a configuration is valid inside the joint ranges with
+no two bodies closer than the clearance c. A straight joint segment is valid by conservative
+advancement: from a configuration where the nearest pair is d apart, no two bodies come more
+than 2.2 Σ_j R_j |Δq_j| closer (R_j the joint reach bounds, both bodies moving, the check's 1.1
+margin), so the next configuration checked is max(d - c, c/2) of that travel further: at least c
+at every configuration checked and c/2 between them, the cell check's own guarantee, with long
+steps where the arm is far from everything.
+
+The search runs in a forked child process: OMPL's random numbers are seeded once per process
+(a second seed is refused), so a child per search makes a seed reproduce its path in any process,
+and nothing OMPL does can end the caller's interpreter. Joint positions in rad.
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+import signal
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["PLANNERS", "SearchResult", "Scene", "search", "shortcut"]
+
+PLANNERS = {"rrt_connect": "RRTConnect", "aorrtc": "AORRTC", "bit_star": "BITstar", "rrt_star": "RRTstar"}
+"""The OMPL planners a config may name: RRT-Connect finds a path and stops (our default); the
+others are asymptotically optimal and use the whole budget."""
+
+LOOK_AHEAD = 0.25
+"""[m] how far a distance query looks: the longest step of the advancement is this less c."""
+
+
+class Scene:
+    """The cell as the search sees it.
+
+    Args:
+        checker: the cell check of the robot in its cell (a :class:`~drake_traj.clearance.CellChecker`).
+        lower, upper: the joint ranges [rad], (n,).
+    """
+
+    def __init__(self, checker, lower, upper):
+        self.checker = checker
+        self.clearance = float(checker.clearance)
+        self.lower, self.upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+        reach, self._links = checker.link_reach()
+        n = reach.shape[1]
+        # [m/rad] (n + 1, n + 1, n): the relative travel of a pair of links per |Δq| (1.1 margin): the
+        # joints between them turn the outer one about the inner one; the joints before both, neither
+        self._pair_travel = np.zeros((n + 1, n + 1, n))
+        for a in range(n + 1):
+            for b in range(n + 1):
+                inner, outer = sorted((a, b))
+                self._pair_travel[a, b, inner:] = 1.1 * reach[outer, inner:] if outer > inner else 0.0
+        self._any_pair = self._pair_travel.max(axis=(0, 1))  # a pair beyond the look-ahead
+        self.queries = 0
+
+    def _pairs(self, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(distances [m], inner links, outer links) of the pairs closer than :data:`LOOK_AHEAD` at ``q``."""
+        self.queries += 1
+        pairs = self.checker.pose_query(q).ComputeSignedDistancePairwiseClosestPoints(LOOK_AHEAD)
+        links = self._links
+        return (np.fromiter((pair.distance for pair in pairs), dtype=float, count=len(pairs)),
+                np.fromiter((links.get(pair.id_A, 0) for pair in pairs), dtype=int, count=len(pairs)),
+                np.fromiter((links.get(pair.id_B, 0) for pair in pairs), dtype=int, count=len(pairs)))
+
+    def distance(self, q) -> float:
+        """The smallest distance [m] between two bodies at ``q``, at most :data:`LOOK_AHEAD`."""
+        distances = self._pairs(q)[0]
+        return float(distances.min()) if len(distances) else LOOK_AHEAD
+
+    def valid(self, q) -> bool:
+        """Inside the joint ranges and no two bodies closer than the clearance."""
+        q = np.asarray(q, dtype=float)
+        return bool(np.all(q >= self.lower) and np.all(q <= self.upper)) and self.distance(q) >= self.clearance
+
+    def segment_valid(self, a, b) -> bool:
+        """The straight joint segment from ``a`` to ``b`` keeps the clearance c at every
+        configuration checked and c/2 between them; ``a`` is taken as checked. Conservative
+        advancement per pair of bodies: from a configuration where a pair is d apart, the next
+        one checked is max(d - c, c/2) of that pair's travel bound further (the joints between
+        its two links only), the least over the pairs (module docstring)."""
+        a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+        step = b - a
+        if not np.any(step):
+            return True
+        if np.any(np.minimum(a, b) < self.lower) or np.any(np.maximum(a, b) > self.upper):
+            return False  # a straight segment between two points inside a box stays inside it
+        c = self.clearance
+        for u in (1.0, 0.5, 0.25, 0.75):  # a cheap look at the end and inside first: most refusals end here
+            if self.distance(a + u * step) < c:
+                return False
+        travel = self._pair_travel @ np.abs(step)  # (n + 1, n + 1) [m] each pair's travel bound over the segment
+        beyond = (LOOK_AHEAD - c) / max(float(self._any_pair @ np.abs(step)), 1e-12)
+        u = 0.0
+        while u < 1.0:
+            distances, inner, outer = self._pairs(a + u * step)
+            if len(distances) and distances.min() < c:
+                return False
+            rates = travel[inner, outer]
+            allowed = np.maximum(distances - c, 0.5 * c) / np.maximum(rates, 1e-12)
+            u = min(1.0, u + min(float(allowed.min()) if len(allowed) else np.inf, beyond))
+        return self.distance(b) >= c
+
+
+@dataclass(frozen=True)
+class SearchResult:
+    """A search's outcome: the path's vertices (k, n) [rad] (None: none found), what it took."""
+
+    vertices: np.ndarray | None
+    planner: str
+    seconds: float  # [s] the search's own time, in the child
+    samples: int  # states OMPL sampled and checked
+    queries: int  # distance queries of the search (states and segments)
+    status: str  # OMPL's word for the outcome
+
+
+def search(scene: Scene, start, goal, *, planning_time: float, seed: int, planner: str = "rrt_connect") -> SearchResult:
+    """A collision-free joint path from ``start`` to ``goal`` by OMPL's ``planner`` within
+    ``planning_time`` [s], random numbers seeded with ``seed`` (a forked child process: module
+    docstring). Both ends must be valid (:meth:`Scene.valid`); the straight segment is tried first."""
+    start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+    if scene.segment_valid(start, goal):
+        return SearchResult(np.array([start, goal]), "straight", 0.0, 0, scene.queries, "straight segment")
+    read, write = os.pipe()
+    child = os.fork()
+    if child == 0:  # the child: search, write the result, leave without Python's exit handlers
+        code = 0
+        try:
+            os.close(read)
+            outcome = _search_here(scene, start, goal, planning_time, seed, planner)
+            with os.fdopen(write, "wb") as pipe:
+                pickle.dump(outcome, pipe)
+        except BaseException:  # noqa: BLE001 - anything at all: the parent reports no result
+            code = 1
+        finally:
+            os._exit(code)
+    os.close(write)
+    with os.fdopen(read, "rb") as pipe:
+        data = pipe.read()
+    _, status = os.waitpid(child, 0)
+    if not data:
+        reason = f"signal {os.WTERMSIG(status)}" if os.WIFSIGNALED(status) else f"exit code {os.WEXITSTATUS(status)}"
+        return SearchResult(None, planner, float("nan"), 0, 0, f"the search process ended without a result ({reason})")
+    return pickle.loads(data)
+
+
+def _search_here(scene: Scene, start, goal, planning_time: float, seed: int, planner: str) -> SearchResult:
+    """The search itself, in this process (the forked child)."""
+    from ompl import base as ob, geometric as og, util as ou  # the child's own OMPL: a fresh seed
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)  # Ctrl-C ends the child; the parent handles it
+    ou.setLogLevel(ou.LogLevel.LOG_NONE)
+    ou.RNG.setSeed(int(seed) + 1)  # OMPL refuses 0 ("use the time")
+    n = len(start)
+    space = ob.RealVectorStateSpace(n)
+    bounds = ob.RealVectorBounds(n)
+    for j in range(n):
+        bounds.setLow(j, float(scene.lower[j]))
+        bounds.setHigh(j, float(scene.upper[j]))
+    space.setBounds(bounds)
+    information = ob.SpaceInformation(space)
+    samples = [0]
+
+    def as_array(state) -> np.ndarray:
+        return np.fromiter((state[j] for j in range(n)), dtype=float, count=n)
+
+    def valid(state) -> bool:
+        samples[0] += 1
+        return scene.valid(as_array(state))
+
+    class Segments(ob.MotionValidator):
+        def checkMotion(self, *states):  # (s1, s2) or (s1, s2, last_valid): OMPL calls both
+            return scene.segment_valid(as_array(states[0]), as_array(states[1]))
+
+    information.setStateValidityChecker(valid)
+    validator = Segments(information)
+    information.setMotionValidator(validator)
+    information.setup()
+    setup = og.SimpleSetup(information)
+    ends = []
+    for values in (start, goal):
+        state = information.allocState()
+        for j in range(n):
+            state[j] = float(values[j])
+        ends.append(state)
+    setup.setStartAndGoalStates(ends[0], ends[1])
+    setup.setPlanner(getattr(og, PLANNERS[planner])(information))
+    began = time.perf_counter()
+    status = setup.solve(float(planning_time))
+    seconds = time.perf_counter() - began
+    vertices = None
+    if setup.haveExactSolutionPath():
+        path = setup.getSolutionPath()
+        vertices = np.array([as_array(path.getState(k)) for k in range(path.getStateCount())])
+    return SearchResult(vertices, planner, seconds, samples[0], scene.queries, str(status))
+
+
+def shortcut(scene: Scene, vertices, rng: np.random.Generator, *, rounds: int = 60) -> np.ndarray:
+    """The path ``vertices`` (k, n) [rad] shortened: ``rounds`` random shortcuts between two
+    points of the path (by length), each kept where its segment is valid (:meth:`Scene.segment_valid`),
+    then every vertex the segment from its predecessor to its successor makes unnecessary."""
+    path = [np.asarray(v, dtype=float) for v in vertices]
+    for _ in range(rounds):
+        if len(path) < 3:
+            break
+        lengths = np.linalg.norm(np.diff(path, axis=0), axis=1)
+        ends = np.concatenate([[0.0], np.cumsum(lengths)])
+        s0, s1 = np.sort(rng.uniform(0.0, ends[-1], 2))
+        i0, i1 = (int(np.clip(np.searchsorted(ends, s, side="right") - 1, 0, len(lengths) - 1)) for s in (s0, s1))
+        if i0 == i1:
+            continue
+        a = path[i0] + (s0 - ends[i0]) / lengths[i0] * (path[i0 + 1] - path[i0])
+        b = path[i1] + (s1 - ends[i1]) / lengths[i1] * (path[i1 + 1] - path[i1])
+        if scene.valid(a) and scene.valid(b) and scene.segment_valid(a, b):
+            path = path[: i0 + 1] + [a, b] + path[i1 + 1:]
+    k = 1
+    while k < len(path) - 1:  # drop vertices the straight segment past them makes unnecessary
+        if scene.segment_valid(path[k - 1], path[k + 1]):
+            del path[k]
+        else:
+            k += 1
+    keep = [path[0]] + [q for previous, q in zip(path, path[1:]) if np.linalg.norm(q - previous) > 1e-9]
+    return np.array(keep)
