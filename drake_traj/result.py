@@ -153,6 +153,7 @@ class Metrics:
     simulated_time_s: float
     wall_time_s: float
     real_time_factor: float | None
+    planning_time_s: float | None  # [s] the planner's planning before the run (free motion: find + shorten + time + check)
 
     def to_dict(self) -> dict:
         """Strict-JSON-ready dict with the field names as keys (None where a value is not finite)."""
@@ -185,6 +186,7 @@ class SimulationResult:
     joint_types: tuple[str, ...] = ()  # "revolute" or "prismatic" per joint; empty: all revolute
     robot: str = ""  # the robot's name (drake_traj.robots.get_robot), where known
     waypoint_neighbourhood: float = float("nan")  # [m] see PlannerSystem.waypoint_neighbourhood(); NaN: none
+    planning_time: float = float("nan")  # [s] the planner's own planning (PlannerSystem.planning_time_s); NaN: none
 
     def __post_init__(self):
         """Every array as a float array of its shape (:data:`_SHAPES`), or ValueError naming it.
@@ -311,6 +313,7 @@ class SimulationResult:
             simulated_time_s=simulated,
             wall_time_s=self.wall_time,
             real_time_factor=simulated / self.wall_time if self.wall_time > 0 else None,
+            planning_time_s=self.planning_time if np.isfinite(self.planning_time) else None,
         )
 
     @classmethod
@@ -359,6 +362,7 @@ class SimulationResult:
             joint_types=tuple(robot.joint_types),
             robot=robot.name,
             waypoint_neighbourhood=planner.waypoint_neighbourhood(),
+            planning_time=float(getattr(planner, "planning_time_s", float("nan"))),
         )
         if result.failure is None:
             result.failure = _unfinished_failure(count, station_context.get_time(), result.duration)
@@ -385,7 +389,7 @@ class SimulationResult:
         failure = None if self.failure is None else self.failure.to_dict()
         meta = {"name": self.name, "duration": self.duration, "failure": failure, "wall_time": self.wall_time,
                 "joint_types": list(self.joint_types), "robot": self.robot,
-                "waypoint_neighbourhood": self.waypoint_neighbourhood}
+                "waypoint_neighbourhood": self.waypoint_neighbourhood, "planning_time": self.planning_time}
         staging.write("result.npz", lambda path: np.savez_compressed(
             path, meta=json.dumps(_json_ready(meta), allow_nan=False), **arrays))
         staging.write("metrics.json", lambda path: path.write_text(
@@ -425,7 +429,7 @@ class SimulationResult:
             if meta["failure"] is not None:
                 meta["failure"] = Failure.from_dict(meta["failure"])
             meta["joint_types"] = tuple(meta.get("joint_types", ()))
-            for key in ("duration", "wall_time", "waypoint_neighbourhood"):  # NaN is saved as null
+            for key in ("duration", "wall_time", "waypoint_neighbourhood", "planning_time"):  # NaN is saved as null
                 if key in meta:  # (a result saved before the neighbourhood was has none)
                     meta[key] = float("nan") if meta[key] is None else float(meta[key])
         except (KeyError, TypeError, ValueError) as error:

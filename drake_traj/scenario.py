@@ -495,7 +495,7 @@ def preflight(scenario: Scenario, planner: PlannerSystem, horizon: float | None 
     cell (:func:`check_in_cell`).
 
     Returns the planned tool path [m], shape (N, 3) in the base frame, where the planner
-    computes one, else None."""
+    computes one (a planner that plans in the cell, the free-motion one: once it has), else None."""
     try:
         path = planner.preflight(scenario.max_duration if horizon is None else horizon)
     except DrakeTrajError as error:
@@ -508,6 +508,8 @@ def preflight(scenario: Scenario, planner: PlannerSystem, horizon: float | None 
     except ValueError as error:
         raise _in_planner_field(scenario, error, message_leads_with_field=False) from error
     check_in_cell(scenario, planner)
+    if path is None and getattr(planner, "needs_cell", False):  # it planned in the cell just now
+        path = planner.tool_path()
     return path
 
 
@@ -524,6 +526,8 @@ def check_in_cell(scenario: Scenario, planner: PlannerSystem, checker: CellCheck
         return checker.check_planner(planner, start_field=("q_initial",) if len(scenario.q_initial) else ("planner",))
     except DrakeTrajError as error:
         field = error.field or ("planner",)
+        if field[0] in {item.name for item in fields(scenario.planner)}:  # a planner that plans in the cell: its goals
+            field = ("planner", *field)
         raise error.relocated(field, locate_in_scenario(scenario, field, str(error))) from None
 
 

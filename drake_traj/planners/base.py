@@ -68,6 +68,7 @@ class PlannerSystem(LeafSystem):
     """
 
     plans_online = False
+    planning_time_s = float("nan")  # [s] a planner's own planning before the run, where it measures one
     robot: Robot | None = None  # the robot the planner was made for, where it knows one (a station runs it there)
 
     def __init__(self, q_initial, *, initial_scaling: float = 1.0):

@@ -11,10 +11,9 @@ moves. The search needs the cell: the planner is made without it and plans when 
 (:meth:`FreeMotionPlanner.plan_in`, which the preflight and the station's check call).
 """
 
-from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -145,6 +144,7 @@ class Leg:
     found: np.ndarray  # (k, n) [rad] OMPL's path (two rows where the straight segment was free)
     vertices: np.ndarray  # (k', n) [rad] after shortcutting
     timing: object  # SmoothTiming
+    check: object  # the cell check's MotionCheck of the timed leg
     density: float | None  # [rad] the spline's points along the segments (None: the vertices only)
     search_seconds: float
     samples: int
@@ -200,7 +200,11 @@ class FreeMotionPlanner(TimeLawPlanner):
             legs.append(leg)
         self.law.set_legs([leg.timing for leg in legs])
         self._plan = None  # plan() is made again from the new law
-        accepted = checker.check(self.plan(), waypoints=self.task_waypoints(), target_word=self.target_word)
+        # the plan is the checked legs one after the other (the same quintic pieces): their checks joined
+        offsets = np.concatenate([[0.0], np.cumsum([leg.timing.duration for leg in legs])[:-1]])
+        accepted = replace(legs[0].check, times=np.concatenate([leg.check.times + offset
+                                                                 for leg, offset in zip(legs, offsets)]),
+                           spacing=max(leg.check.spacing for leg in legs))
         self.checked_scenes.add(checker.fingerprint)  # the timed motion checked as every plan is
         self.legs = legs
         self._planned_in = (checker.fingerprint, accepted)
@@ -246,7 +250,7 @@ class FreeMotionPlanner(TimeLawPlanner):
                 goals.append(shifted)
         return sorted(goals, key=lambda q: float(np.linalg.norm(q - previous)))
 
-    def _leg(self, scene: Scene, checker, rng, k: int, start, candidates) -> tuple[Leg, np.ndarray]:
+    def _leg(self, scene: Scene, checker, rng, k: int, start, candidates) -> "tuple[Leg, np.ndarray]":
         """The timed leg from ``start`` to the first of ``candidates`` a path reaches."""
         word, field_ = ("goal", ("goals", k)) if len(self.config.goals) else ("pose", ("poses", k))
         goals = candidates if len(self.config.goals) else self._pose_goals(scene, candidates, start)
@@ -263,9 +267,9 @@ class FreeMotionPlanner(TimeLawPlanner):
                 continue
             vertices = shortcut(scene, found.vertices, rng, rounds=self.config.shortcut_rounds)
             for density in DENSITIES:
-                timing = self._smooth_and_time(checker, vertices, density)
-                if timing is not None:
-                    return Leg(found.vertices, vertices, timing, density, found.seconds, found.samples), goal
+                timed = self._smooth_and_time(checker, vertices, density)
+                if timed is not None:
+                    return Leg(found.vertices, vertices, *timed, density, found.seconds, found.samples), goal
             raise PlanningError(f"{word} {k}: a path was found ({len(vertices)} vertices) but no smooth motion along it "
                                 f"kept the clearance (points along it down to {DENSITIES[-1]} rad apart)",
                                 field=field_, cause=Cause.PLANNING)
@@ -274,23 +278,21 @@ class FreeMotionPlanner(TimeLawPlanner):
         raise PlanningError(f"no collision-free path to {word} {k} found within planning_time = "
                             f"{self.config.planning_time:g} s ({PLANNERS[self.config.planner]}, {len(tried)} "
                             f"configuration{'s' * (len(tried) > 1)} tried, {samples} states sampled: {statuses}); raise "
-                            "planning_time, or move the goal away from the obstacles", field=field_, cause=Cause.PLANNING)
+                            f"planning_time, or move the {word} away from the obstacles", field=field_, cause=Cause.PLANNING)
 
     def _smooth_and_time(self, checker, vertices, density):
-        """The timed spline through ``vertices`` (points ``density`` [rad] apart along the
-        segments), or None where the spline leaves the ranges or comes closer than the
-        clearance (the cell check on the path, its parameter taken as time)."""
-        points = _densified(vertices, density)
-        path = waypoint_path(points)
-        grid = np.linspace(path.start_time(), path.end_time(), 2001)
-        q = path.vector_values(grid).T
+        """(the timed spline through ``vertices`` (points ``density`` [rad] apart along the
+        segments), its cell check's MotionCheck), or None where the spline leaves the ranges or
+        the timed motion comes closer than the clearance."""
+        path = waypoint_path(_densified(vertices, density))
+        q = path.vector_values(np.linspace(path.start_time(), path.end_time(), 2001)).T
         if np.any(q < self.robot.lower_limits) or np.any(q > self.robot.upper_limits):
             return None
+        timing = time_path(path, self.velocity, self.acceleration, self.jerk, grid_points=self.config.grid_points)
         try:
-            checker.check(path)
+            return timing, checker.check(timing.trajectory, target_word=self.target_word)
         except PlanningError:
             return None
-        return time_path(path, self.velocity, self.acceleration, self.jerk, grid_points=self.config.grid_points)
 
     # --- the planner contract ----------------------------------------------------------------
     def preflight(self, horizon: float = 120.0):
@@ -310,6 +312,12 @@ class FreeMotionPlanner(TimeLawPlanner):
         if len(self.config.poses):
             return np.asarray(self.config.poses, dtype=float)[:, :3]
         return self.robot.tool_position(np.asarray(self.config.goals, dtype=float))
+
+    def tool_path(self) -> np.ndarray:
+        """The planned motion's TCP positions [m] (N, 3) every 10 ms (for drawing)."""
+        plan = self.plan()
+        times = np.append(np.arange(plan.start_time(), plan.end_time(), 0.01), plan.end_time())
+        return self.robot.tool_position(plan.vector_values(times).T)
 
     def found_path(self) -> np.ndarray:
         """The shortened joint paths of every leg, joined (k, n) [rad] (empty before planning)."""

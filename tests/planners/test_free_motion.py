@@ -1,0 +1,184 @@
+"""The free-motion planner: goals reached on a path found through the cell (OMPL), shortened,
+smoothed, timed, checked; its refusals; its reproducibility; its motion checked independently."""
+
+import numpy as np
+import pytest
+from pydrake.planning import RobotDiagramBuilder, SceneGraphCollisionChecker
+
+from drake_traj import FreeMotionConfig, get_robot, load_scenario, make_station, run_station, simulate
+from drake_traj.cell import Box, Cell, add_cell
+from drake_traj.clearance import CellChecker, CollisionError
+from drake_traj.errors import Cause, DrakeTrajError, PlanningError
+from drake_traj.planners import make_planner
+from drake_traj.planners.free import Scene, search
+from drake_traj.scenario import make_planner as scenario_planner
+from pydrake.systems.analysis import Simulator
+
+UR10E = get_robot("ur10e")
+SHELF = load_scenario("free_motion_shelf")
+
+
+def shelf_checker() -> CellChecker:
+    return SHELF.cell_checker()
+
+
+def independent_checker(cell: Cell) -> SceneGraphCollisionChecker:
+    """Drake's own collision checker of the UR10e in ``cell``: no padding, its own plant."""
+    builder = RobotDiagramBuilder(0.0)
+    instance = UR10E.add_to_plant(builder.plant())
+    add_cell(builder.plant(), cell, instance)
+    return SceneGraphCollisionChecker(model=builder.Build(), robot_model_instances=[instance], edge_step_size=0.01,
+                                      env_collision_padding=0.0, self_collision_padding=0.0)
+
+
+@pytest.fixture(scope="module")
+def shelf_run():
+    planner = scenario_planner(SHELF)
+    result = simulate(SHELF)
+    return planner, result
+
+
+def test_the_shelf_task_goes_round_the_boards_and_its_straight_move_would_not(shelf_run):
+    _, result = shelf_run
+    checker = shelf_checker()
+    scene = Scene(checker, UR10E.lower_limits, UR10E.upper_limits)
+    assert result.succeeded, result.failure
+    # the straight joint move between the same two configurations hits the shelf
+    assert not scene.segment_valid(result.q_ref[0], result.q_ref[-1])
+    goal = np.asarray(SHELF.planner.poses[0])
+    assert np.linalg.norm(result.tcp[-1, :3] - goal[:3]) < 1e-4  # measured at the end: the pose's position
+    assert 0.0 < result.metrics().planning_time_s < 30.0
+    metrics = result.metrics()
+    assert metrics.max_velocity_over_limit <= 1.0 + 1e-6 and metrics.max_acceleration_over_limit <= 1.0 + 1e-6
+
+
+def test_the_planned_motion_is_collision_free_at_every_millisecond_by_an_independent_query():
+    planner = scenario_planner(SHELF)
+    shelf_checker().check_planner(planner)
+    plan = planner.plan()
+    independent = independent_checker(SHELF.cell)
+    times = np.arange(plan.start_time(), plan.end_time(), 1e-3)
+    q = plan.vector_values(times).T
+    assert all(independent.CheckConfigCollisionFree(qk) for qk in q)
+    # and our clearance holds at every millisecond up to the check's between-sample bound (half of it)
+    nearest = min(shelf_checker().contacts(qk, within=0.02)[0].distance if shelf_checker().contacts(qk, within=0.02)
+                  else 0.02 for qk in q[::20])
+    assert nearest >= 0.5 * SHELF.cell.clearance
+
+
+def test_the_measured_motion_touches_nothing(shelf_run):
+    _, result = shelf_run
+    independent = independent_checker(SHELF.cell)
+    assert all(independent.CheckConfigCollisionFree(q) for q in result.q_meas)
+
+
+def test_a_seed_reproduces_its_path_and_another_seed_may_not():
+    def found(seed):
+        planner = make_planner(FreeMotionConfig(poses=SHELF.planner.poses, seed=seed), UR10E, SHELF.q_initial)
+        shelf_checker().check_planner(planner)
+        return planner.legs[0].found
+
+    first, again = found(3), found(3)
+    np.testing.assert_array_equal(first, again)
+    others = [found(seed) for seed in (4, 5, 6)]
+    assert any(other.shape != first.shape or not np.array_equal(other, first) for other in others)
+
+
+def test_the_search_alone_is_reproducible_in_one_process():
+    checker = shelf_checker()
+    scene = Scene(checker, UR10E.lower_limits, UR10E.upper_limits)
+    goal = np.atleast_2d(UR10E.task_kinematics().inverse_kinematics_all(SHELF.planner.poses[0]))
+    goal = next(q for q in goal if scene.valid(q) and not scene.segment_valid(SHELF.q_initial, q))
+    results = [search(scene, SHELF.q_initial, goal, planning_time=5.0, seed=11) for _ in range(2)]
+    assert results[0].vertices is not None
+    np.testing.assert_array_equal(results[0].vertices, results[1].vertices)
+
+
+def test_a_start_in_collision_is_refused_naming_the_bodies():
+    q = np.array(SHELF.q_initial)
+    q[1] += 0.35  # the forearm down into the lower board
+    planner = make_planner(FreeMotionConfig(poses=SHELF.planner.poses), UR10E, q)
+    with pytest.raises(CollisionError, match="start configuration") as refused:
+        shelf_checker().check_planner(planner)
+    assert refused.value.cause is Cause.COLLISION
+
+
+def test_a_goal_inside_an_obstacle_is_refused_at_the_goal():
+    goal = [-0.5, -1.2, 1.6, -1.9, -1.57, 0.0]
+    box = Box(name="crate", size=[0.2, 0.2, 0.2], xyz=UR10E.tool_position(np.array(goal)[None])[0].tolist())
+    checker = CellChecker(UR10E, Cell(obstacles=[box]))
+    nearest = checker.contacts(goal)[0]
+    assert nearest.distance < 0 and "crate" in nearest.bodies  # the wrist inside the crate
+    planner = make_planner(FreeMotionConfig(goals=[goal]), UR10E, UR10E.home_configuration)
+    with pytest.raises(CollisionError, match="goal 0") as refused:
+        checker.check_planner(planner)
+    assert refused.value.field == ("goals", 0)
+
+
+def test_a_goal_outside_the_joint_ranges_is_refused():
+    planner = make_planner(FreeMotionConfig(goals=[[0.0, -1.57, 0.0, -1.57, 0.0, 7.0]]), UR10E,
+                           UR10E.home_configuration)
+    with pytest.raises(DrakeTrajError, match=r"goals\[0\].*outside its range") as refused:
+        CellChecker(UR10E).check_planner(planner)
+    assert refused.value.cause is Cause.JOINT_RANGE and refused.value.field == ("goals", 0)
+
+
+def test_an_unreachable_pose_is_refused():
+    planner = make_planner(FreeMotionConfig(poses=[[2.5, 0.0, 0.5, 0.0, 1.57, 0.0]]), UR10E, UR10E.home_configuration)
+    with pytest.raises(DrakeTrajError, match=r"poses\[0\] cannot be reached") as refused:
+        CellChecker(UR10E).check_planner(planner)
+    assert refused.value.cause is Cause.UNREACHABLE
+
+
+def test_no_path_within_the_budget_says_what_was_tried():
+    planner = make_planner(FreeMotionConfig(poses=SHELF.planner.poses, planning_time=1e-3), UR10E, SHELF.q_initial)
+    with pytest.raises(PlanningError, match=r"no collision-free path to pose 0 found within planning_time = 0.001 s "
+                                            r"\(RRTConnect, \d+ configurations? tried, \d+ states sampled") as refused:
+        shelf_checker().check_planner(planner)
+    assert refused.value.cause is Cause.PLANNING and refused.value.field == ("poses", 0)
+
+
+def test_a_scenario_refusal_is_at_the_goals_line(tmp_path):
+    text = SHELF.source.path.read_text().replace("planning_time: 5.0", "planning_time: 0.001")
+    path = tmp_path / "tight.yaml"
+    path.write_text(text)
+    line = 1 + text.splitlines().index(next(row for row in text.splitlines() if row.strip().startswith("- [0.70")))
+    with pytest.raises(PlanningError, match=rf"tight.yaml, line {line}, column 7: no collision-free path to pose 0"):
+        simulate(load_scenario(path))
+
+
+def test_several_goals_stop_at_each_and_a_station_of_ones_own_plans_in_its_cell():
+    goals = [[-0.3, -1.2, -1.5, -1.9, 1.8, 0.2], [-0.9, -1.9, -1.9, -0.9, 1.2, 1.4]]
+    scenario = load_scenario("quintic_ptp")
+    scenario.planner = FreeMotionConfig(goals=goals)
+    station = make_station(scenario)
+    simulator = Simulator(station)
+    assert run_station(simulator, station) is None  # planned and checked when the run starts
+    planner = station.GetSubsystemByName("planner")
+    assert len(planner.legs) == 2
+    plan = planner.plan()
+    middle = planner.legs[0].timing.duration
+    np.testing.assert_allclose(plan.value(middle).ravel(), goals[0], atol=1e-9)
+    np.testing.assert_allclose(plan.derivative(1).value(middle).ravel(), 0.0, atol=1e-9)  # at rest at the goal
+
+
+@pytest.mark.parametrize("config, field", [
+    (FreeMotionConfig(), "goals"),
+    (FreeMotionConfig(goals=[[0.0] * 6], poses=[[0.5, 0, 0.5, 0, 0, 0]]), "goals"),
+    (FreeMotionConfig(goals=[[0.0] * 5]), "goals"),
+    (FreeMotionConfig(goals=[[0.0] * 6], planning_time=-1.0), "planning_time"),
+    (FreeMotionConfig(goals=[[0.0] * 6], planning_time=1e6), "planning_time"),
+    (FreeMotionConfig(goals=[[0.0] * 6], planner="prm"), "planner"),
+    (FreeMotionConfig(goals=[[0.0] * 6], seed=-3), "seed"),
+    (FreeMotionConfig(goals=[[np.nan] * 6]), "goals"),
+])
+def test_a_malformed_config_is_refused_naming_its_field(config, field):
+    with pytest.raises(ValueError, match=field) as refused:
+        make_planner(config, UR10E, UR10E.home_configuration)
+    assert refused.value.field[0] == field
+
+
+def test_the_plan_before_planning_says_so():
+    planner = make_planner(FreeMotionConfig(goals=[[0.0, -1.57, 0.0, -1.57, 0.0, 0.0]]), UR10E, UR10E.home_configuration)
+    with pytest.raises(PlanningError, match="has not planned its path yet"):
+        planner.plan()
