@@ -1,7 +1,7 @@
 """The UR e-Series family: each arm's published data and the one closed form that serves them all.
 
-Every e-Series arm (UR3e, UR5e, UR10e, UR16e, UR20) has the same kinematic structure: the
-standard-DH chain T_{i-1,i} = Rz(q_i) Tz(d_i) Tx(a_i) Rx(alpha_i) with alpha = (pi/2, 0, 0, pi/2,
+Every e-Series arm (UR3e, UR5e, UR10e, UR16e) and its successors (UR20, UR30) have the same
+kinematic structure: the standard-DH chain T_{i-1,i} = Rz(q_i) Tz(d_i) Tx(a_i) Rx(alpha_i) with alpha = (pi/2, 0, 0, pi/2,
 -pi/2, 0) and only d1, a2, a3, d4, d5, d6 differing. The closed-form k(q), analytic Jacobian, J̇q̇
 (:func:`~drake_traj.robots.ur_closed_form.kinematics_into`, compiled) and inverse kinematics below take those lengths as data
 (:class:`URData`); :class:`URArm` is one arm under the :class:`~drake_traj.robots.base.Robot`
@@ -33,7 +33,7 @@ from drake_traj.robots.task_space import (is_flange, orientation_error, pose_err
 from drake_traj.robots.ur_closed_form import UR_CLOSED_FORM, singularity_measure_many
 from drake_traj.validation import invalid, real_array
 
-__all__ = ["UR3E", "UR5E", "UR10E", "UR16E", "UR20", "UR_ARMS", "URArm", "URData"]
+__all__ = ["UR3E", "UR5E", "UR10E", "UR16E", "UR20", "UR30", "UR_ARMS", "URArm", "URData"]
 
 NUM_JOINTS = 6
 DH_ALPHA = np.array([np.pi / 2, 0.0, 0.0, np.pi / 2, -np.pi / 2, 0.0])  # [rad], every e-Series arm
@@ -174,9 +174,11 @@ UR16E_DATA = URData(
 UR20_DATA = URData(
     name="ur20", title="UR20",
     d=(0.2363, 0.0, 0.0, 0.201, 0.1593, 0.1543), a=(0.0, -0.862, -0.7287, 0.0, 0.0, 0.0),
-    link_masses=(16.343, 29.632, 7.879, 3.054, 3.126, 0.926),
+    # link 6: UR's DH article as updated in 2025 (0.846 kg, [0, -0.0003, -0.0318]; the ROS 2 description 2.4.5
+    # still has 0.926 kg, [0, 0, -0.0293])
+    link_masses=(16.343, 29.632, 7.879, 3.054, 3.126, 0.846),
     centers_of_mass=((0.0, -0.061, 0.0062), (0.5226, 0.0, 0.2098), (0.3234, 0.0, 0.0604), (0.0, -0.0026, 0.0393),
-                     (0.0, 0.0024, 0.0379), (0.0, 0.0, -0.0293)),
+                     (0.0, 0.0024, 0.0379), (0.0, -0.0003, -0.0318)),
     inertias=((0.08866, -0.00011, -0.00011, 0.07632, 0.0072, 0.08418),
               (0.1467, 0.00019, -0.05163, 4.6659, 0.00004, 4.6348),
               (0.02612, -0.00005, -0.02898, 0.75763, -0.00001, 0.75327),
@@ -185,6 +187,36 @@ UR20_DATA = URData(
               (0.00092, 0.0, 0.0, 0.00091, 0.0, 0.00117)),
     velocity_limit=_degrees(120, 120, 150, 210, 210, 210), effort_limit=(738.0, 738.0, 433.0, 107.0, 107.0, 107.0),
     rated_payload=20.0, reach=1.75, tube_offsets=(0.260, 0.043), size=0.1593 / 0.11985)
+
+
+def _shortened_tube(tensor, mass_ratio: float, length_ratio: float) -> tuple[float, ...]:
+    """A tube link's tensor (ixx, ixy, ixz, iyy, iyz, izz) in its DH frame (x along the tube, z
+    the joint axis) carried over to a link of the same cross-section, ``mass_ratio`` times the
+    mass and ``length_ratio`` times the length: the moment about the tube (ixx) and iyz scale with
+    the mass, ixy and ixz with mass x length, the two moments across it (iyy, izz) with mass x
+    length²; rounded to 5 significant digits like UR's tables."""
+    ixx, ixy, ixz, iyy, iyz, izz = tensor
+    m, l = mass_ratio, length_ratio
+    return tuple(float(f"{v:.5g}") for v in (ixx * m, ixy * m * l, ixz * m * l, iyy * m * l * l, iyz * m, izz * m * l * l))
+
+
+# The UR30 is the UR20's base, shoulder and wrist (d1, d4, d5, d6, and the masses of links 1, 4, 5
+# and 6 are the UR20's) with a shorter upper arm and forearm. UR publishes no UR30 tensors we could
+# read (the ROS 2 description's are the UR16e's digit for digit, a placeholder): links 1, 4, 5, 6
+# take the UR20's measured tensors, links 2 and 3 the UR20's scaled to the UR30's mass and length
+# (:func:`_shortened_tube`). Estimates, not UR's: docs/ur_family.md.
+UR30_DATA = URData(
+    name="ur30", title="UR30",
+    d=(0.2363, 0.0, 0.0, 0.201, 0.1593, 0.1543), a=(0.0, -0.637, -0.5037, 0.0, 0.0, 0.0),
+    link_masses=(16.343, 28.542, 7.156, 3.054, 3.126, 0.926),
+    centers_of_mass=((-0.0001, -0.06, 0.0069), (0.3894, 0.0, 0.2103), (0.2257, 0.0, 0.0629), (0.0, -0.0048, 0.0353),
+                     (0.0, 0.0046, 0.0341), (0.0, 0.0, -0.0293)),
+    inertias=(UR20_DATA.inertias[0],
+              _shortened_tube(UR20_DATA.inertias[1], 28.542 / 29.632, 0.637 / 0.862),
+              _shortened_tube(UR20_DATA.inertias[2], 7.156 / 7.879, 0.5037 / 0.7287),
+              *UR20_DATA.inertias[3:]),
+    velocity_limit=_degrees(120, 120, 150, 210, 210, 210), effort_limit=(738.0, 738.0, 433.0, 107.0, 107.0, 107.0),
+    rated_payload=30.0, reach=1.3, tube_offsets=(0.260, 0.043), size=0.1593 / 0.11985)
 
 
 
@@ -750,7 +782,7 @@ class URArm(Robot):
                                tool=self.tcp_offset)
 
 
-UR3E, UR5E, UR16E, UR20 = (URArm(data) for data in (UR3E_DATA, UR5E_DATA, UR16E_DATA, UR20_DATA))
+UR3E, UR5E, UR16E, UR20, UR30 = (URArm(data) for data in (UR3E_DATA, UR5E_DATA, UR16E_DATA, UR20_DATA, UR30_DATA))
 
 
 class UR10e(URArm):
@@ -761,4 +793,4 @@ class UR10e(URArm):
 
 
 UR10E = UR10e()
-UR_ARMS = (UR3E, UR5E, UR10E, UR16E, UR20)  # in the order of their size
+UR_ARMS = (UR3E, UR5E, UR10E, UR16E, UR20, UR30)  # in the order of their payload

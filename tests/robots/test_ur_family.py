@@ -44,11 +44,11 @@ def random_configurations(arm, count, seed):
 
 
 def test_the_family_is_registered_and_an_unknown_name_lists_the_known_ones():
-    assert [arm.name for arm in UR_ARMS] == ["ur3e", "ur5e", "ur10e", "ur16e", "ur20"]
+    assert [arm.name for arm in UR_ARMS] == ["ur3e", "ur5e", "ur10e", "ur16e", "ur20", "ur30"]
     for arm in UR_ARMS:
         assert get_robot(arm.name) is arm and arm.name in ROBOT_NAMES
     assert get_robot("ur10e") is UR10E
-    with pytest.raises(ValueError, match=r"robot must be one of the known robots, got 'ur7e'; known: .*ur3e .*ur5e .*ur16e .*ur20 "):
+    with pytest.raises(ValueError, match=r"robot must be one of the known robots, got 'ur7e'; known: .*ur3e .*ur5e .*ur16e .*ur20 .*ur30 "):
         get_robot("ur7e")
 
 
@@ -146,7 +146,8 @@ def test_limits_and_effort_limits_read_back_from_the_plant(name):
 def test_each_arm_has_its_own_published_numbers():
     # rated payloads [kg] and published reaches [m] (data sheets, docs/ur_family.md)
     assert {a.name: (a.rated_payload, a.data.reach) for a in UR_ARMS} == {
-        "ur3e": (3.0, 0.5), "ur5e": (5.0, 0.85), "ur10e": (12.5, 1.3), "ur16e": (16.0, 0.9), "ur20": (20.0, 1.75)}
+        "ur3e": (3.0, 0.5), "ur5e": (5.0, 0.85), "ur10e": (12.5, 1.3), "ur16e": (16.0, 0.9), "ur20": (20.0, 1.75),
+        "ur30": (30.0, 1.3)}
     assert ARMS["ur5e"].effort_limits.tolist() == [150, 150, 150, 28, 28, 28]
     assert ARMS["ur3e"].velocity_limits[3:].tolist() == [2 * np.pi] * 3  # 360 deg/s wrists
     for arm in UR_ARMS:
@@ -155,6 +156,35 @@ def test_each_arm_has_its_own_published_numbers():
         assert np.array_equal(speed, np.minimum(1.05, arm.velocity_limits)) and np.all(acceleration == 1.40)
         assert np.array_equal(arm.task_kinematics().model, [0.0, arm.data.d[0], arm.data.a[1], arm.data.a[2],
                                                             *arm.data.d[3:]])
+
+
+def test_the_ur30_is_ur_s_table_on_the_ur20_s_platform_and_its_tensors_are_marked_estimates():
+    ur30, ur20 = ARMS["ur30"].data, ARMS["ur20"].data
+    # UR's DH table (ROS 2 description, default_kinematics.yaml): the UR20's d, shorter a2 and a3
+    assert (ur30.d, ur30.a) == ((0.2363, 0.0, 0.0, 0.201, 0.1593, 0.1543), (0.0, -0.637, -0.5037, 0.0, 0.0, 0.0))
+    assert ur30.d == ur20.d and ur30.size == ur20.size and ur30.tube_offsets == ur20.tube_offsets
+    assert ur30.link_masses == (16.343, 28.542, 7.156, 3.054, 3.126, 0.926)
+    assert ARMS["ur30"].effort_limits.tolist() == [738, 738, 433, 107, 107, 107]
+    assert np.allclose(np.degrees(ARMS["ur30"].velocity_limits), [120, 120, 150, 210, 210, 210], rtol=1e-12, atol=0)
+    # links 1, 4, 5, 6: the UR20's tensors; links 2, 3: the UR20's scaled to the shorter tubes,
+    # each a rigid body's (principal moments >= 0, each at most the sum of the other two)
+    assert ur30.inertias[0] == ur20.inertias[0] and ur30.inertias[3:] == ur20.inertias[3:]
+    assert ur30.inertias[1] == (0.1413, 0.00013524, -0.03675, 2.4543, 3.8529e-05, 2.4379)
+    assert ur30.inertias[2] == (0.023723, -3.139e-05, -0.018194, 0.32878, -9.0824e-06, 0.32689)
+    for ixx, ixy, ixz, iyy, iyz, izz in ur30.inertias:
+        moments = np.linalg.eigvalsh([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        assert moments[0] > 0 and moments[2] <= moments[0] + moments[1]
+    # not the ROS 2 description's placeholder (the UR16e's tensors)
+    assert not set(ur30.inertias) & set(ARMS["ur16e"].data.inertias)
+    # the reach figure an unreachable pose names: the wrist centre's farthest from the shoulder
+    with pytest.raises(DrakeTrajError, match=rf"the UR30 reaches at most {np.hypot(0.637 + 0.5037 + 0.1593, 0.201):.6g} m"):
+        ARMS["ur30"].inverse_kinematics([2.0, 0.0, 0.3, np.pi, 0.0, 0.0])
+
+
+def test_the_ur20s_wrist_3_is_urs_2025_table():
+    # UR's DH article, updated 2025: link 6 0.846 kg at [0, -0.0003, -0.0318] (was 0.926 kg, [0, 0, -0.0293])
+    data = ARMS["ur20"].data
+    assert data.link_masses[5] == 0.846 and data.centers_of_mass[5] == (0.0, -0.0003, -0.0318)
 
 
 def test_the_payload_is_checked_against_each_arms_rating():
