@@ -25,13 +25,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import Box, Capsule, Cylinder, Ellipsoid, Role, Sphere
+from pydrake.geometry import Box, Capsule, Convex, Cylinder, Ellipsoid, Mesh, Role, Sphere
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import Trajectory
 
 from drake_traj.cell import Cell, add_cell, refuse_free_bodies
-from drake_traj.errors import Cause, Field, PlanningError, joint_label
+from drake_traj.errors import Cause, DrakeTrajError, Field, PlanningError, joint_label
 from drake_traj.robots import Robot
 
 __all__ = ["CellChecker", "CollisionError", "Contact", "JointRangeError", "MotionCheck", "geometry_owner", "joint_reach",
@@ -111,7 +111,36 @@ def _bounding_radius(shape) -> float:
         return shape.radius() + 0.5 * shape.length()
     if isinstance(shape, Ellipsoid):
         return max(shape.a(), shape.b(), shape.c())
-    raise TypeError(f"no bounding radius for a {type(shape).__name__} on the robot: use primitive shapes")
+    if isinstance(shape, (Mesh, Convex)):  # checked as its convex hull (Drake's): the hull's farthest vertex
+        hull = shape.GetConvexHull()
+        return max(float(np.linalg.norm(hull.vertex(k))) for k in range(hull.num_vertices()))
+    raise TypeError(f"no bounding radius for a {type(shape).__name__} on the robot: use primitive shapes or meshes")
+
+
+def unprotected_links(plant, instance, joint_names) -> list[str]:
+    """The links of a finalized plant's arm (each joint's child and the bodies welded to it) that
+    have no collision geometry: the self and cell checks cannot see them."""
+    missing = []
+    for name in joint_names:
+        link = plant.GetJointByName(name, instance).child_body()
+        if not any(plant.GetCollisionGeometriesForBody(body) for body in plant.GetBodiesWeldedTo(link)):
+            missing.append(link.name())
+    return missing
+
+
+def refuse_unprotected_links(robot, missing: list[str]) -> None:
+    """DrakeTrajError (at ``robot.unchecked_links``) unless every link in ``missing`` (no
+    collision shapes) is one the robot says may run unprotected (its ``unchecked_links``; "all":
+    every link)."""
+    allowed = set(getattr(robot, "unchecked_links", ()))
+    uncovered = [link for link in missing if "all" not in allowed and link not in allowed]
+    if uncovered:
+        listed = ", ".join(uncovered)
+        raise DrakeTrajError(
+            f"the {robot.name} model's links {listed} have no collision shapes: the self and cell checks would not see "
+            "them, and a motion through the table would pass. Give them collision geometry (a mesh is checked as its "
+            f"convex hull), or say that they run unprotected: robot.unchecked_links: [{listed}] (or [all]; the run's "
+            "metrics then name them)", field=("robot", "unchecked_links"), cause=Cause.COLLISION)
 
 
 def joint_reach(plant, scene_graph, plant_context, instance, joint_names) -> np.ndarray:
@@ -250,6 +279,8 @@ class CellChecker:
         if before_finalize is not None:  # a station's own bodies (add_station's before_finalize)
             before_finalize(self.plant, self.scene_graph)
         self.plant.Finalize()
+        self.unprotected_links = unprotected_links(self.plant, self.instance, robot.joint_names)
+        refuse_unprotected_links(robot, self.unprotected_links)
         self._diagram = builder.Build()
         self._context = self._diagram.CreateDefaultContext()
         self._plant_context = self.plant.GetMyMutableContextFromRoot(self._context)

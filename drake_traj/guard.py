@@ -54,6 +54,8 @@ class MotionGuard:
         before_finalize: the station's ``before_finalize(plant, scene_graph)``, or None.
         fingerprint: the station plant's collision scene (:func:`~drake_traj.clearance.scene_fingerprint`).
         check_motion: False only where the user asked for an unchecked run.
+        unprotected_links: the robot's links without collision shapes, which the robot says may run
+            unprotected (the cell check refuses any other: :func:`~drake_traj.clearance.refuse_unprotected_links`).
         preflight: ``preflight(planner, horizon)``, the scenario's preflight and cell check where
             the station was made from a scenario (a refusal then located in its file:
             :func:`drake_traj.scenario.preflight`), or None.
@@ -66,6 +68,7 @@ class MotionGuard:
     fingerprint: str
     check_motion: bool = True
     preflight: object = None
+    unprotected_links: tuple = ()  # the robot's links without collision shapes (said to run unprotected)
     _checker: CellChecker | None = field(default=None, repr=False)
 
     def checker(self) -> CellChecker:

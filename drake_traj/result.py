@@ -154,6 +154,7 @@ class Metrics:
     wall_time_s: float
     real_time_factor: float | None
     planning_time_s: float | None  # [s] the planner's planning before the run (free motion: find + shorten + time + check)
+    unchecked_links: list[str]  # links without collision shapes: the self and cell checks were off for them
 
     def to_dict(self) -> dict:
         """Strict-JSON-ready dict with the field names as keys (None where a value is not finite)."""
@@ -187,6 +188,7 @@ class SimulationResult:
     robot: str = ""  # the robot's name (drake_traj.robots.get_robot), where known
     waypoint_neighbourhood: float = float("nan")  # [m] see PlannerSystem.waypoint_neighbourhood(); NaN: none
     planning_time: float = float("nan")  # [s] the planner's own planning (PlannerSystem.planning_time_s); NaN: none
+    unchecked_links: tuple[str, ...] = ()  # the robot's links without collision shapes: no self or cell check saw them
 
     def __post_init__(self):
         """Every array as a float array of its shape (:data:`_SHAPES`), or ValueError naming it.
@@ -314,6 +316,7 @@ class SimulationResult:
             wall_time_s=self.wall_time,
             real_time_factor=simulated / self.wall_time if self.wall_time > 0 else None,
             planning_time_s=self.planning_time if np.isfinite(self.planning_time) else None,
+            unchecked_links=list(self.unchecked_links),
         )
 
     @classmethod
@@ -363,6 +366,7 @@ class SimulationResult:
             robot=robot.name,
             waypoint_neighbourhood=planner.waypoint_neighbourhood(),
             planning_time=float(getattr(planner, "planning_time_s", float("nan"))),
+            unchecked_links=tuple(getattr(planner.guard, "unprotected_links", ())),
         )
         if result.failure is None:
             result.failure = _unfinished_failure(count, station_context.get_time(), result.duration)
@@ -389,7 +393,8 @@ class SimulationResult:
         failure = None if self.failure is None else self.failure.to_dict()
         meta = {"name": self.name, "duration": self.duration, "failure": failure, "wall_time": self.wall_time,
                 "joint_types": list(self.joint_types), "robot": self.robot,
-                "waypoint_neighbourhood": self.waypoint_neighbourhood, "planning_time": self.planning_time}
+                "waypoint_neighbourhood": self.waypoint_neighbourhood, "planning_time": self.planning_time,
+                "unchecked_links": list(self.unchecked_links)}
         staging.write("result.npz", lambda path: np.savez_compressed(
             path, meta=json.dumps(_json_ready(meta), allow_nan=False), **arrays))
         staging.write("metrics.json", lambda path: path.write_text(
@@ -429,6 +434,7 @@ class SimulationResult:
             if meta["failure"] is not None:
                 meta["failure"] = Failure.from_dict(meta["failure"])
             meta["joint_types"] = tuple(meta.get("joint_types", ()))
+            meta["unchecked_links"] = tuple(meta.get("unchecked_links", ()))
             for key in ("duration", "wall_time", "waypoint_neighbourhood", "planning_time"):  # NaN is saved as null
                 if key in meta:  # (a result saved before the neighbourhood was has none)
                     meta[key] = float("nan") if meta[key] is None else float(meta[key])

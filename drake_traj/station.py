@@ -43,7 +43,7 @@ from pydrake.systems.primitives import (ConstantVectorSource, Demultiplexer, Log
                                         Multiplexer, TrajectorySource)
 
 from drake_traj.cell import Cell, add_cell, refuse_free_bodies
-from drake_traj.clearance import CellChecker, geometry_owner, scene_fingerprint
+from drake_traj.clearance import CellChecker, geometry_owner, scene_fingerprint, unprotected_links
 from drake_traj.errors import Cause, Failure
 from drake_traj.guard import MotionGuard
 from drake_traj.planners.base import PlannerSystem
@@ -207,7 +207,8 @@ def add_station(
     refuse_free_bodies(plant, instance, fields)  # the controller drives the robot's joints only
     plant.SetDefaultPositions(instance, planner.initial_positions())
     planner.guard = MotionGuard(robot, cell or Cell(), cell_directory, before_finalize,
-                                scene_fingerprint(plant, scene_graph.model_inspector()), check_motion)
+                                scene_fingerprint(plant, scene_graph.model_inspector()), check_motion,
+                                unprotected_links=tuple(unprotected_links(plant, instance, robot.joint_names)))
 
     planner.set_name("planner")
     builder.AddSystem(planner)

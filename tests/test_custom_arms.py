@@ -474,7 +474,8 @@ def test_an_sdf_arm_and_an_arm_with_its_own_actuator_names_run_in_the_closed_loo
         text, goal = text.replace('_actuator">', '_motor">'), [0.6, 0.4, -2.2, -0.3, -1.1, 0.5]
     (tmp_path / model).write_text(text)
     path = tmp_path / "arm.yaml"
-    path.write_text(f"name: own_actuators\nrobot: !CustomArm\n  model_file: {model}\n  name: my_arm\n"
+    unchecked = "  unchecked_links: [all]\n" if model.endswith(".sdf") else ""  # the SDF arm has no collision shapes
+    path.write_text(f"name: own_actuators\nrobot: !CustomArm\n  model_file: {model}\n  name: my_arm\n{unchecked}"
                     "  acceleration_limits: [2, 2, 2, 2, 2, 2]\n"
                     f"q_initial: {[0.2, 0.6, -2.5, 0.2, -0.9, 0.1] if model.endswith('.urdf') else [0.0] * 6}\n"
                     f"planner: !QuinticConfig\n  goals: [{goal}]\n")
@@ -486,6 +487,7 @@ def test_an_sdf_arm_and_an_arm_with_its_own_actuator_names_run_in_the_closed_loo
     assert names == ([f"j{i}" for i in range(1, 7)] if model.endswith(".sdf") else [f"joint_{i}_motor" for i in range(1, 7)])
     result = simulate(scenario)
     assert result.succeeded and result.robot == "my_arm"
+    assert result.metrics().unchecked_links == ([f"link{i}" for i in range(1, 7)] if model.endswith(".sdf") else [])
     assert np.max(np.abs(result.q_meas[-1] - goal)) < 1e-3
     assert np.max(np.abs(result.qd_ref)) <= (2.0 if model.endswith(".sdf") else 1.0) * (1 + LIMIT_TOLERANCE)
 

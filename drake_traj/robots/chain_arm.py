@@ -12,9 +12,11 @@ from pathlib import Path
 
 import numpy as np
 from pydrake.multibody.parsing import Parser
-from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
+from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_label
+from drake_traj.model_files import add_model_file
 from drake_traj.robots import ROBOT_NAMES, arm_checks
 from drake_traj.robots.base import Robot, TaskKinematics, format_point, joint_actuators
 from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_reach, chain_singularity_factors,
@@ -38,7 +40,8 @@ __all__ = ["ChainArm"]
 KP_PER_EFFORT = 4000.0 / 330.0  # [1/rad]
 KD_PER_KP = 0.05  # [s]
 LIMIT_ARGUMENTS = ("lower_limits", "upper_limits", "velocity_limits", "acceleration_limits", "effort_limits",
-                   "rated_payload", "home", "data_source")  # the **limits of the constructors
+                   "rated_payload", "home", "data_source", "unchecked_links")  # the **limits of the constructors
+WORLD_POSE_TOLERANCE = 1e-9  # [m, rad] a model's own weld of its base to the world must be the identity
 FK_AGREEMENT = 1e-6  # [m and rad], a DH table and its model file must agree to this
 
 
@@ -66,6 +69,14 @@ class ChainArm(Robot):
         data_source: where the numbers come from.
         model_text: the model as URDF text (an arm written from its DH table), parsed by
             :meth:`add_to_plant` instead of a file.
+        packages: {package name: folder} for the model's ``package://`` URLs (with those of
+            ``ROS_PACKAGE_PATH``: :mod:`drake_traj.model_files`).
+        xacro_args: a ``.xacro`` model's arguments.
+        base_welded: the model welds ``base_frame`` to its world itself (at the world's origin);
+            :meth:`add_to_plant` then uses that weld instead of adding one.
+        unchecked_links: links without collision shapes that may run unprotected, said
+            explicitly (``("all",)``: every link); the cell check refuses an arm with such a link
+            otherwise, and a run's metrics name them.
 
     Its :attr:`reach` is the chain's bound :func:`~drake_traj.robots.chain.chain_reach` [m].
     """
@@ -74,7 +85,9 @@ class ChainArm(Robot):
 
     def __init__(self, chain: SerialChain, *, name: str, model_file, base_frame: str, tool_frame: str, joint_names,
                  lower_limits, upper_limits, velocity_limits, acceleration_limits, effort_limits,
-                 rated_payload: float | None = None, home=None, data_source: str = "", model_text: str | None = None):
+                 rated_payload: float | None = None, home=None, data_source: str = "", model_text: str | None = None,
+                 packages: dict | None = None, xacro_args: dict | None = None, base_welded: bool = False,
+                 unchecked_links=()):
         if not isinstance(chain, SerialChain):
             raise TypeError(f"chain must be a SerialChain, got {type(chain).__name__}")
         arm_checks.arm_name(name, "name", plain=False)
@@ -84,6 +97,10 @@ class ChainArm(Robot):
         self.chain, self.name, self.joint_names = chain, name, names
         self.model_file = None if model_file is None else path_argument(model_file, "model_file").resolve()
         self.model_text = model_text
+        self.packages = {str(k): Path(v) for k, v in (packages or {}).items()}
+        self.xacro_args = dict(xacro_args or {})
+        self.base_welded = bool(base_welded)
+        self.unchecked_links = tuple(str(link) for link in unchecked_links)
         self.base_frame, self.tool_frame = str(base_frame), str(tool_frame)
         given = dict(lower_limits=lower_limits, upper_limits=upper_limits, velocity_limits=velocity_limits,
                      acceleration_limits=acceleration_limits, effort_limits=effort_limits)
@@ -113,27 +130,33 @@ class ChainArm(Robot):
     # ---- constructors ------------------------------------------------------------------------
     @classmethod
     def from_model_file(cls, path, *, base_frame: str, tool_frame: str, name: str | None = None,
-                        **limits) -> "ChainArm":
+                        packages: dict | None = None, xacro_args: dict | None = None, **limits) -> "ChainArm":
         """The arm of a URDF/SDF file: the chain between ``base_frame`` and ``tool_frame`` read
         through MultibodyPlant (:meth:`SerialChain.from_plant`), the joint names and the
         position, velocity and effort limits from the file where it has them. ``limits`` (the
         keyword arguments of :class:`ChainArm`: lower_limits, upper_limits, velocity_limits,
         acceleration_limits, effort_limits, rated_payload, home, data_source) override the file;
-        acceleration_limits must be given (URDF has none).
+        acceleration_limits must be given (URDF has none). ``packages`` ({name: folder}) and
+        ``ROS_PACKAGE_PATH`` resolve ``package://`` URLs; a ``.xacro`` file is expanded with
+        ``xacro_args`` (:mod:`drake_traj.model_files`). A model that welds its base to a
+        ``world`` link itself is used as it is (that weld at the world's origin).
 
         Raises:
             DrakeTrajError: the file unreadable, the chain not six revolute joints, a limit
                 neither in the file nor given (naming the field).
         """
         path = path_argument(path, "model_file")
-        name = _default_name(name, path.stem, f"the model file's name {path.name!r}")
-        plant = _parsed(path)
+        name = _default_name(name, path.stem.removesuffix(".urdf"), f"the model file's name {path.name!r}")
+        packages = {str(k): Path(v) for k, v in (packages or {}).items()}
+        plant = _parsed(path, packages, xacro_args)
         return cls.from_plant(plant, base_frame=base_frame, tool_frame=tool_frame, model_file=path,
-                              name=name, **limits)
+                              name=name, packages=packages, xacro_args=xacro_args,
+                              base_welded=_base_welded(plant, base_frame), **limits)
 
     @classmethod
     def from_plant(cls, plant: MultibodyPlant, *, base_frame, tool_frame, name: str | None = None, model_file=None,
-                   chain: SerialChain | None = None, model_text: str | None = None, **limits) -> "ChainArm":
+                   chain: SerialChain | None = None, model_text: str | None = None, packages: dict | None = None,
+                   xacro_args: dict | None = None, base_welded: bool = False, **limits) -> "ChainArm":
         """The arm of a finalized ``plant`` (a user's own, beside which a planner built from this
         arm runs): the chain from ``base_frame`` to ``tool_frame`` (Frames or names), the joint
         names, and the limits the plant has (position and velocity limits of the joints, effort
@@ -164,8 +187,9 @@ class ChainArm(Robot):
         name = _default_name(name, plant.GetModelInstanceName(tool.model_instance()), "the tool body's model instance")
         return cls(chain or from_plant, name=name,
                    model_file=model_file, base_frame=base.name(), tool_frame=tool.name(),
-                   joint_names=[j.name() for j in joints], model_text=model_text,
-                   **{key: limits.get(key) for key in LIMIT_ARGUMENTS})
+                   joint_names=[j.name() for j in joints], model_text=model_text, packages=packages,
+                   xacro_args=xacro_args, base_welded=base_welded, unchecked_links=limits.get("unchecked_links") or (),
+                   **{key: limits.get(key) for key in LIMIT_ARGUMENTS if key != "unchecked_links"})
 
     @classmethod
     def from_dh(cls, name: str, table, convention: str = "standard", *, model_file=None, base_frame: str = "base",
@@ -272,8 +296,9 @@ class ChainArm(Robot):
         if self.model_text is not None:
             (instance,) = Parser(plant).AddModelsFromString(self.model_text, "urdf")
         else:
-            (instance,) = Parser(plant).AddModels(str(self.model_path()))
-        plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(self.base_frame, instance))
+            (instance,) = add_model_file(plant, self.model_path(), self.packages, xacro_args=self.xacro_args)
+        if not self.base_welded:  # a model that welds its base to a world link has its weld already
+            plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(self.base_frame, instance))
         actuated = joint_actuators(plant, instance)
         for joint_name, effort in zip(self.joint_names, self._effort):
             actuator = actuated.get(joint_name)
@@ -356,17 +381,46 @@ class ChainArm(Robot):
                               functools.partial(chain_singularity_factors, self.model), self.model)
 
 
-def _parsed(path: Path) -> MultibodyPlant:
-    """A finalized plant of the model file ``path`` alone."""
+def _parsed(path: Path, packages: dict | None = None, xacro_args: dict | None = None) -> MultibodyPlant:
+    """A finalized plant of the model file ``path`` alone (its packages, xacro arguments:
+    :func:`~drake_traj.model_files.add_model_file`), with SceneGraph, so that a ``package://``
+    URL that resolves nowhere is found here."""
     if not path.is_file():
         raise invalid("model_file", f"model file not found: {path}")
-    plant = MultibodyPlant(0.0)
+    builder = DiagramBuilder()
+    plant, _ = AddMultibodyPlantSceneGraph(builder, 0.0)
     try:
-        Parser(plant).AddModels(str(path))
+        add_model_file(plant, path, packages, xacro_args=xacro_args)
         plant.Finalize()
     except (RuntimeError, SystemExit) as error:  # Drake's parser exits on some bad data (a limit's lower > upper)
         raise invalid("model_file", f"the model file {path} could not be read: {_drake_reason(error)}") from None
     return plant
+
+
+def _base_welded(plant: MultibodyPlant, base_frame: str) -> bool:
+    """True where the model welds ``base_frame`` to the world itself (a ``world`` link and a fixed
+    joint, as ROS descriptions do), at the world's origin; DrakeTrajError naming ``base_frame``
+    where it puts it elsewhere or joins it to the world by a moving joint."""
+    frame = plant_frame(plant, base_frame, "base_frame")
+    world = plant.world_body()
+    welded = {body.index() for body in plant.GetBodiesWeldedTo(world)}
+    if frame.body().index() in welded:
+        pose = frame.CalcPoseInWorld(plant.CreateDefaultContext())
+        offset = max(float(np.abs(pose.translation()).max()), float(np.abs(pose.rotation().matrix() - np.eye(3)).max()))
+        if offset > WORLD_POSE_TOLERANCE:
+            raise invalid("base_frame", f"the model welds base_frame {base_frame!r} to its world at "
+                                        f"xyz {np.round(pose.translation(), 6).tolist()} (and a rotation): poses and the "
+                                        "cell are given in the base frame at the world's origin; name the link the "
+                                        "model welds to the world at its origin as base_frame, or remove the offset")
+        return True
+    for index in plant.GetJointIndices():
+        joint = plant.get_joint(index)
+        if (joint.child_body().index() == frame.body().index() and joint.parent_body().index() == world.index()
+                and not joint.type_name().endswith("floating")):  # Finalize's own floating joint of a free base
+            raise invalid("base_frame", f"the model joins base_frame {base_frame!r} to its world by a {joint.type_name()} "
+                                        f"joint {joint.name()!r}: an arm's base must be fixed (remove the joint or make "
+                                        "it fixed)")
+    return False
 
 
 def _parsed_text(text: str) -> MultibodyPlant:

@@ -69,6 +69,11 @@ class CustomArm:
             carry none).
         effort_limits: joint torque limits [N m]; empty: the model's.
         payload: the rated payload [kg]; absent: not rated (then the arm takes no tool mass).
+        packages: {package name: folder} for the model's ``package://`` URLs (folders relative to
+            the scenario file's; with those on ``ROS_PACKAGE_PATH``).
+        xacro_args: a ``.xacro`` model file's arguments ({name: value}).
+        unchecked_links: links without collision shapes that may run without the self and cell
+            checks, said explicitly (``[all]``: every link); otherwise such an arm is refused.
     """
 
     model_file: str = ""
@@ -81,16 +86,26 @@ class CustomArm:
     acceleration_limits: list[float] = field(default_factory=list)
     effort_limits: list[float] = field(default_factory=list)
     payload: Optional[float] = None
+    packages: dict[str, str] = field(default_factory=dict)
+    xacro_args: dict[str, str] = field(default_factory=dict)
+    unchecked_links: list[str] = field(default_factory=list)
 
     def validate(self, prefix: str = "robot") -> dict:
         """The checked values as ChainArm's keyword arguments (arrays, None where not given);
         DrakeTrajError naming the field (``robot.acceleration_limits``) otherwise."""
+        for key, mapping in (("packages", self.packages), ("xacro_args", self.xacro_args)):
+            if not all(isinstance(k, str) and k and isinstance(v, str) and v for k, v in mapping.items()):
+                raise invalid(f"{prefix}.{key}", f"{prefix}.{key} must map names to non-empty texts, got {mapping!r:.200}")
+        if not all(isinstance(link, str) and link for link in self.unchecked_links):
+            raise invalid(f"{prefix}.unchecked_links", f"{prefix}.unchecked_links must be link names (or all), got "
+                                                       f"{self.unchecked_links!r:.200}")
         for key in ("model_file", "base_frame", "tool_frame"):
             value = getattr(self, key)
             if not isinstance(value, str) or not value.strip():
                 raise invalid(f"{prefix}.{key}", f"{prefix}.{key} is missing: give the model's "
                                                  f"{'file' if key == 'model_file' else key.replace('_', ' ')}")
         return dict(name=arm_name(self.name, f"{prefix}.name"), base_frame=self.base_frame, tool_frame=self.tool_frame,
+                    xacro_args=dict(self.xacro_args), unchecked_links=tuple(self.unchecked_links),
                     **_joint_data(self, prefix, required=False))
 
 
@@ -176,6 +191,14 @@ def resolve_robot(choice: RobotChoice, directory: Path | None = None, scenario_f
         if not path.is_file():
             raise invalid("robot.model_file", f"robot.model_file {str(path)[:200]} is not a file")
         arguments["model_file"] = path
+        packages = {}
+        for name, folder in choice.packages.items():
+            folder = Path(folder) if Path(folder).is_absolute() or directory is None else Path(directory) / folder
+            if not folder.is_dir():
+                raise DrakeTrajError(f"robot.packages.{name}: {str(folder)[:200]} is not a folder",
+                                     field=("robot", "packages", name))
+            packages[name] = folder
+        arguments["packages"] = packages
     origin = f"the model file {path}" if isinstance(choice, CustomArm) else (choice.source or "its DH table")
     return build_chain_arm(choice, arguments, origin if scenario_file is None else f"{origin} (scenario {scenario_file})")
 

@@ -1,0 +1,207 @@
+"""Robot and cell description files as engineers have them: ``package://`` URLs, xacro, meshes.
+
+- **Packages.** A parser's package map holds the folders of ``ROS_PACKAGE_PATH`` (every package
+  under them), then the packages a scenario names (``packages: {name: folder}``), which win. Drake
+  also finds the package a model file itself sits in (its ``package.xml``). A ``package://`` URL
+  of a package found nowhere is refused naming the package and how to give it; nothing is ever
+  fetched.
+- **Xacro.** A ``.xacro`` model is expanded with the ``xacro`` package (no ROS install): its
+  ``$(find pkg)`` resolves through an ament index made for the packages of the map, its
+  ``$(arg name)`` from the scenario's ``xacro_args``.
+- **Meshes.** Collision meshes that Drake cannot take as convex hulls (STL, and COLLADA where
+  ``pycollada`` is installed) are converted to OBJ with ``trimesh`` into a cache folder
+  (``~/.cache/drake_traj/meshes``, or a temporary one), and the URDF text names the OBJ; visual
+  meshes are left as they are. Relative mesh paths are made absolute (the text is parsed from a
+  string). Drake checks a mesh collision shape as its convex hull.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import tempfile
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+from pydrake.multibody.parsing import Parser
+
+from drake_traj.errors import Cause, DrakeTrajError
+
+__all__ = ["CONVERTED_MESH_TYPES", "add_model_file", "model_parser", "model_text", "refusal_for"]
+
+CONVERTED_MESH_TYPES = (".stl", ".dae")
+"""Collision mesh files converted to OBJ before Drake reads them (it takes OBJ, VTK and glTF)."""
+
+_UNKNOWN_PACKAGE = re.compile(r"URI '([^']*)' refers to unknown package '([^']*)'")
+
+
+def model_parser(plant, packages: dict[str, Path] | None = None) -> Parser:
+    """A Drake Parser for ``plant`` whose package map holds ``ROS_PACKAGE_PATH``'s packages and
+    ``packages`` ({name: folder}, winning over the environment's)."""
+    parser = Parser(plant)
+    package_map = parser.package_map()
+    if os.environ.get("ROS_PACKAGE_PATH"):
+        package_map.PopulateFromRosPackagePath()
+    for name, folder in (packages or {}).items():
+        if package_map.Contains(name):
+            package_map.Remove(name)
+        package_map.Add(name, str(folder))
+    return parser
+
+
+def _add_own_package(parser: Parser, path: Path) -> None:
+    """The package the model file sits in (the nearest ``package.xml`` above it), as Drake finds
+    it for a file it parses itself (this text may be parsed from a string)."""
+    for folder in Path(path).resolve().parents:
+        manifest = folder / "package.xml"
+        if manifest.is_file():
+            try:
+                parser.package_map().AddPackageXml(str(manifest))
+            except RuntimeError:  # the map has a package of that name already (given, or on the path)
+                pass
+            return
+
+
+def refusal_for(error: BaseException, field: tuple, label: str) -> DrakeTrajError | None:
+    """The clear error for a Drake parser failure on an unknown ``package://`` package (naming
+    it and how to give it, at ``field``), else None."""
+    found = _UNKNOWN_PACKAGE.search(str(error))
+    if found is None:
+        return None
+    url, package = found.groups()
+    return DrakeTrajError(
+        f"{label}: the model refers to the package {package!r} ({url}), which is on no package path here: give its "
+        f"folder in packages: {{{package}: path/to/{package}}} (relative to the scenario file) or put its parent "
+        "folder on ROS_PACKAGE_PATH; nothing is downloaded", field=field, cause=Cause.INVALID)
+
+
+def _resolve(url: str, base: Path, parser: Parser) -> Path | None:
+    """The file of a mesh ``url`` (``package://``, ``file://``, absolute or relative to ``base``);
+    None for a package the map does not know (the parser then says so)."""
+    if url.startswith("package://"):
+        package, _, rest = url[len("package://"):].partition("/")
+        package_map = parser.package_map()
+        if not package_map.Contains(package):
+            return None
+        return Path(package_map.GetPath(package)) / rest
+    if url.startswith("file://"):
+        return Path(url[len("file://"):])
+    path = Path(url)
+    return path if path.is_absolute() else base / path
+
+
+def _cache_folder() -> Path:
+    folder = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "drake_traj" / "meshes"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / ".write_test"
+        probe.write_text("")
+        probe.unlink()
+        return folder
+    except OSError:
+        return Path(tempfile.mkdtemp(prefix="drake_traj_meshes_"))
+
+
+def _as_obj(path: Path, field: tuple, label: str) -> Path:
+    """``path`` (an STL or COLLADA mesh) converted to OBJ in the cache (named by its content)."""
+    import trimesh  # a dependency of this conversion only
+
+    data = path.read_bytes()
+    target = _cache_folder() / f"{path.stem}-{hashlib.sha256(data).hexdigest()[:16]}.obj"
+    if not target.is_file():
+        try:
+            mesh = trimesh.load(str(path), force="mesh")
+        except Exception as error:  # noqa: BLE001 - trimesh raises many kinds; each is the same refusal
+            hint = " (COLLADA needs the pycollada package: pip install pycollada)" if path.suffix.lower() == ".dae" else ""
+            raise DrakeTrajError(f"{label}: the collision mesh {path} cannot be read{hint}: {error}", field=field,
+                                 cause=Cause.INVALID) from None
+        if not len(mesh.vertices):
+            raise DrakeTrajError(f"{label}: the collision mesh {path} has no vertices", field=field, cause=Cause.INVALID)
+        mesh.export(str(target))
+    return target
+
+
+def model_text(path: Path, parser: Parser, *, xacro_args: dict | None = None, field: tuple = ("model_file",),
+               label: str = "model_file") -> str | None:
+    """The URDF text to parse for the model file ``path``: a ``.xacro`` expanded, relative mesh
+    paths made absolute and STL/COLLADA collision meshes converted to OBJ; None where the file
+    needs none of that (Drake parses it as it is)."""
+    if path.suffix == ".xacro":
+        text = _expand_xacro(path, parser, xacro_args or {}, field, label)
+    elif path.suffix.lower() == ".urdf":
+        text = path.read_text()
+        if not any(kind in text.lower() for kind in CONVERTED_MESH_TYPES):
+            return None
+    else:
+        return None
+    try:
+        root = ElementTree.fromstring(text)
+    except ElementTree.ParseError as error:
+        raise DrakeTrajError(f"{label}: {path} is not well-formed XML: {error}", field=field, cause=Cause.INVALID) from None
+    for kind in ("collision", "visual"):
+        for mesh in root.iter():
+            if mesh.tag != kind:
+                continue
+            for element in mesh.iter("mesh"):
+                url = element.get("filename", "")
+                file = _resolve(url, path.parent, parser)
+                if file is None:
+                    continue  # an unknown package: the parser refuses it, naming it
+                if kind == "collision" and file.suffix.lower() in CONVERTED_MESH_TYPES:
+                    element.set("filename", str(_as_obj(file, field, label)))
+                elif not url.startswith("package://"):
+                    element.set("filename", str(file.resolve()))
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def _expand_xacro(path: Path, parser: Parser, arguments: dict, field: tuple, label: str) -> str:
+    """The URDF text of the xacro file ``path`` with ``arguments`` ($(arg ...)); $(find pkg)
+    from the parser's package map (an ament index made for it, as ROS 2 would have)."""
+    import xacro  # the xacro package from the index: no ROS install
+
+    package_map = parser.package_map()
+    with tempfile.TemporaryDirectory(prefix="drake_traj_ament_") as prefix:
+        index = Path(prefix) / "share" / "ament_index" / "resource_index" / "packages"
+        index.mkdir(parents=True)
+        for name in package_map.GetPackageNames():
+            (index / name).write_text("")
+            (Path(prefix) / "share" / name).symlink_to(Path(package_map.GetPath(name)).resolve())
+        previous = os.environ.get("AMENT_PREFIX_PATH")
+        os.environ["AMENT_PREFIX_PATH"] = prefix + (os.pathsep + previous if previous else "")
+        try:
+            document = xacro.process_file(str(path), mappings={str(k): str(v) for k, v in arguments.items()})
+        except Exception as error:  # noqa: BLE001 - xacro raises its own and Python's: each is this refusal
+            package = re.search(r"package '([^']*)' not found|PackageNotFoundError: ?\"?([^\"\s]+)", str(error))
+            hint = ""
+            if package or type(error).__name__ == "PackageNotFoundError":
+                name = next((g for g in (package.groups() if package else ()) if g), str(error))
+                hint = (f" (the package {name!r} is on no package path here: give its folder in packages: "
+                        f"{{{name}: path/to/{name}}} or put its parent folder on ROS_PACKAGE_PATH)")
+            raise DrakeTrajError(f"{label}: the xacro file {path} cannot be expanded: {type(error).__name__}: "
+                                 f"{error}{hint}", field=field, cause=Cause.INVALID) from None
+        finally:
+            if previous is None:
+                os.environ.pop("AMENT_PREFIX_PATH", None)
+            else:
+                os.environ["AMENT_PREFIX_PATH"] = previous
+    return document.toxml()
+
+
+def add_model_file(plant, path: Path, packages: dict[str, Path] | None = None, *, xacro_args: dict | None = None,
+                   field: tuple = ("model_file",), label: str = "model_file") -> list:
+    """Parse the model file ``path`` (URDF, SDF, xacro) into ``plant`` with the package map of
+    :func:`model_parser`; the model instances. Raises the clear refusal of an unknown package
+    (:func:`refusal_for`) and lets the parser's other errors through."""
+    parser = model_parser(plant, packages)
+    _add_own_package(parser, path)
+    text = model_text(path, parser, xacro_args=xacro_args, field=field, label=label)
+    try:
+        if text is None:
+            return parser.AddModels(str(path))
+        return parser.AddModelsFromString(text, "urdf")
+    except (RuntimeError, SystemExit) as error:
+        refusal = refusal_for(error.code if isinstance(error, SystemExit) else error, field, label)
+        if refusal is not None:
+            raise refusal from None
+        raise
