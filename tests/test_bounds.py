@@ -346,7 +346,7 @@ def test_variant_with_a_shipped_scenario_name(capsys):
     assert cli.main(["show", "pajak_sim3", "--variant", "sim1"]) == cli.EXIT_OK
     capsys.readouterr()
     clean_refusal(cli.main(["show", "pajak_sim3", "--variant", "sim4"]), capsys,
-                  r"there is no variant 'sim4'; its variants are \['sim1', 'sim2', 'sim3', 'ur3e', 'ur5e', 'ur16e', 'ur20'\]")
+                  r"there is no variant 'sim4'; its variants are \['sim1', 'sim2', 'sim3', 'ur3e', 'ur5e', 'ur16e', 'ur20', 'ur30'\]")
 
 
 def other_simulator():

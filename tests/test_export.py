@@ -102,7 +102,7 @@ def test_urscript_refuses_a_reference_beyond_the_ur10e(result, tmp_path):
     with pytest.raises(ExportError, match=r"joint \d \(\w+\) speed .* beyond the UR10e's"):
         fast.export(tmp_path / "x.script", "urscript")
     other = SimulationResult(**{**vars(result), "robot": "scara"})
-    with pytest.raises(ExportError, match="URScript runs on a UR3e, UR5e, UR10e, UR16e or UR20 controller; the run 'quintic_ptp' is on scara"):
+    with pytest.raises(ExportError, match="URScript runs on a UR3e, UR5e, UR10e, UR16e, UR20 or UR30 controller; the run 'quintic_ptp' is on scara"):
         other.export(tmp_path / "x.script", "urscript")
     assert not (tmp_path / "x.script").exists()
 
@@ -201,8 +201,8 @@ def test_urscript_refuses_an_arm_no_ur_controller_drives(result, tmp_path, robot
 
 def test_the_ur_controller_arms_are_the_registered_e_series_arms():
     assert set(UR_CONTROLLER_ARMS) <= set(ROBOT_NAMES)
-    assert {"ur3e", "ur5e", "ur10e", "ur16e", "ur20"} <= set(UR_CONTROLLER_ARMS)
-    assert not {"li_4dof", "ur30"} & set(UR_CONTROLLER_ARMS)
+    assert {"ur3e", "ur5e", "ur10e", "ur16e", "ur20", "ur30"} <= set(UR_CONTROLLER_ARMS)
+    assert not {"li_4dof", "scara"} & set(UR_CONTROLLER_ARMS)
 
 
 @pytest.mark.parametrize("robot, ur_driver", [("ur10e", True), ("ur3e", True), ("puma_like", False), ("li_4dof", False)])

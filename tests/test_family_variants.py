@@ -1,5 +1,5 @@
-"""The shipped e-Series variants (diagrams/pajak.yaml ur3e..ur20, diagrams/quintic.yaml
-ptp_ur3e..ptp_ur20): each on its own arm with that arm's limits and default gains, its task
+"""The shipped e-Series variants (diagrams/pajak.yaml ur3e..ur30, diagrams/quintic.yaml
+ptp_ur3e..ptp_ur30): each on its own arm with that arm's limits and default gains, its task
 accepted by the preflight (the Pająk law integrated, the cell check), and one closed-loop run per
 arm with the limits held at every logged sample and the goal reached; and the README's "Your
 arm" Python (a user's URDF in the station and beside the user's plant)."""
@@ -21,7 +21,7 @@ from drake_traj.robots.task_space import wrap_angle
 from drake_traj.scenario import load_scenario, make_planner, preflight, shipped_scenarios
 from drake_traj.station import simulate
 
-ARMS = ("ur3e", "ur5e", "ur16e", "ur20")
+ARMS = ("ur3e", "ur5e", "ur16e", "ur20", "ur30")
 VARIANTS = [f"pajak_{arm}" for arm in ARMS] + [f"quintic_ptp_{arm}" for arm in ARMS]
 
 
@@ -47,7 +47,7 @@ def test_variant_runs_its_own_arm_and_passes_the_preflight(name):
         assert np.all(np.linalg.norm(waypoints - arm.tcp_pose(arm.home_configuration)[:3], axis=1) < arm.reach)
 
 
-@pytest.mark.parametrize("name", ["pajak_ur3e", "quintic_ptp_ur5e", "pajak_ur16e", "quintic_ptp_ur20"])
+@pytest.mark.parametrize("name", ["pajak_ur3e", "quintic_ptp_ur5e", "pajak_ur16e", "quintic_ptp_ur20", "pajak_ur30"])
 def test_closed_loop_holds_the_arms_limits_and_reaches_the_goal(name):
     scenario = load_scenario(name)
     arm = get_robot(scenario.robot)

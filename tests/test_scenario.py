@@ -95,7 +95,7 @@ def test_scenario_defaults_are_the_papers_start_and_ur_limits():
 
 
 def test_variants_are_chosen_by_name(tmp_path):
-    assert scenario_variants(DIAGRAMS / "pajak.yaml") == ["sim1", "sim2", "sim3", "ur3e", "ur5e", "ur16e", "ur20"]
+    assert scenario_variants(DIAGRAMS / "pajak.yaml") == ["sim1", "sim2", "sim3", "ur3e", "ur5e", "ur16e", "ur20", "ur30"]
     assert scenario_variants(DIAGRAMS / "quintic_ptp.yaml") == []
     assert load_scenario(DIAGRAMS / "pajak.yaml", "sim2").planner.limit_acceleration is False
     with pytest.raises(ValueError, match=r"no variant was given; its variants are \['sim1', 'sim2', 'sim3', 'ur3e',"):
