@@ -1,5 +1,5 @@
 """Robots under one contract (:class:`Robot`): the UR e-Series arms (UR3e, UR5e, UR10e, UR16e,
-UR20), the three example robots of Boryga and the 4-DOF robot of Li et al. 2019.
+UR20, UR30), the three example robots of Boryga and the 4-DOF robot of Li et al. 2019.
 ``get_robot(name)`` returns one by its scenario name."""
 
 from drake_traj.robots.base import PointRobot, Robot
