@@ -34,11 +34,13 @@ from pydrake.geometry import Cylinder as CylinderShape
 from pydrake.geometry import AddContactMaterial, ProximityProperties, Rgba
 from pydrake.geometry import Sphere as SphereShape
 from pydrake.math import RigidTransform, RollPitchYaw
-from pydrake.multibody.parsing import ModelDirective, ModelDirectives, Parser, ProcessModelDirectives
-from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
+from pydrake.multibody.parsing import ModelDirective, ModelDirectives, ProcessModelDirectives
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import RotationalInertia, SpatialInertia
+from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj.errors import Cause, DrakeTrajError, Field, field_text
+from drake_traj.model_files import model_parser, refusal_for
 from drake_traj.robots import UR10E, PointRobot, Robot
 from drake_traj.validation import invalid, real_array
 
@@ -242,7 +244,9 @@ class Cell:
         obstacles: boxes, cylinders and spheres posed in the world (base) frame.
         directives: Drake ``ModelDirective``s (``add_model``, ``add_weld``, ...) for the user's own
             model files; a relative ``file`` is taken from the scenario file's folder. Offline
-            only: ``package://`` URLs of packages not on this machine fail.
+            only: a ``package://`` URL resolves through ``packages`` and ``ROS_PACKAGE_PATH``.
+        packages: {package name: folder} for the directives' ``package://`` URLs (folders
+            relative to the scenario file's; :mod:`drake_traj.model_files`).
         tool: the tool on the flange.
         clearance: the distance [m] a planned motion keeps from the cell and from the arm itself
             (default :data:`DEFAULT_CLEARANCE`).
@@ -251,6 +255,7 @@ class Cell:
     mounting: Mounting = field(default_factory=Table)
     obstacles: list[Obstacle] = field(default_factory=list)
     directives: list[ModelDirective] = field(default_factory=list)
+    packages: dict[str, str] = field(default_factory=dict)
     tool: Tool = field(default_factory=Tool)
     clearance: float = DEFAULT_CLEARANCE
 
@@ -351,7 +356,7 @@ def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, robot: Robot 
         _register(plant, world, _pose(obstacle.xyz, obstacle.rpy, location), obstacle.shape(location), name,
                   OBSTACLE_COLOUR)
         fields[name] = location
-    fields.update(_add_directives(plant, cell.directives, directory))
+    fields.update(_add_directives(plant, cell.directives, directory, _packages(cell.packages, directory)))
     inertia = cell.tool.spatial_inertia()
     if inertia is not None or cell.tool.shapes:
         tool = plant.AddRigidBody(TOOL_BODY, robot_instance, inertia or SpatialInertia.Zero())
@@ -364,7 +369,21 @@ def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, robot: Robot 
     return fields
 
 
-def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], directory: Path | None) -> dict:
+def _packages(packages: dict, directory: Path | None) -> dict[str, Path]:
+    """``cell.packages`` as {name: folder}, relative folders from ``directory``; DrakeTrajError
+    naming ``cell.packages.NAME`` for a folder that does not exist."""
+    found = {}
+    for name, folder in packages.items():
+        path = Path(folder) if Path(folder).is_absolute() else Path(directory or ".") / folder
+        if not isinstance(name, str) or not name or not path.is_dir():
+            raise DrakeTrajError(f"cell.packages.{name}: {str(path)[:200]} is not a folder", field=("cell", "packages", name),
+                                 cause=Cause.INVALID)
+        found[name] = path
+    return found
+
+
+def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], directory: Path | None,
+                    packages: dict[str, Path] | None = None) -> dict:
     """Process Drake model directives in one call (Drake resolves a weld's frames among the
     models of the same call), each checked first so that an error names its entry of
     ``cell.directives``: a model file that is missing or cannot be parsed, a weld or frame
@@ -382,10 +401,14 @@ def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], dir
                     raise DrakeTrajError(f"cell.directives[{index}].add_model.file: no model file {model.file!r} "
                                          f"(looked for {path})", field=name + ("add_model", "file"), cause=Cause.INVALID)
                 model.file = path.as_uri()
-            scratch = MultibodyPlant(0.0)
+            scratch_builder = DiagramBuilder()  # with SceneGraph: its meshes' package:// URLs are resolved here
+            scratch, _ = AddMultibodyPlantSceneGraph(scratch_builder, 0.0)
             try:
-                (instance,) = Parser(scratch).AddModels(url=model.file)
+                (instance,) = model_parser(scratch, packages).AddModels(url=model.file)
             except (RuntimeError, ValueError) as error:
+                refusal = refusal_for(error, name + ("add_model", "file"), f"cell.directives[{index}].add_model.file")
+                if refusal is not None:
+                    raise refusal from None
                 raise DrakeTrajError(f"cell.directives[{index}].add_model: {model.file} cannot be used: "
                                      f"{str(error).strip()}", field=name + ("add_model", "file"), cause=Cause.INVALID) from None
             known[model.name] = {scratch.get_frame(frame).name() for frame in scratch.GetFrameIndices(instance)}
@@ -403,7 +426,7 @@ def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], dir
             if kind == "add_frame":
                 known.setdefault("", set()).add(entry.name)
     try:
-        added = ProcessModelDirectives(ModelDirectives(directives=directives), plant, Parser(plant))
+        added = ProcessModelDirectives(ModelDirectives(directives=directives), plant, model_parser(plant, packages))
     except (RuntimeError, ValueError) as error:
         raise DrakeTrajError(f"cell.directives: {str(error).strip()}", field=("cell", "directives"),
                              cause=Cause.INVALID) from None

@@ -24,7 +24,7 @@ import tempfile
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
-from pydrake.multibody.parsing import Parser
+from pydrake.multibody.parsing import PackageMap, Parser
 
 from drake_traj.errors import Cause, DrakeTrajError
 
@@ -32,6 +32,13 @@ __all__ = ["CONVERTED_MESH_TYPES", "add_model_file", "model_parser", "model_text
 
 CONVERTED_MESH_TYPES = (".stl", ".dae")
 """Collision mesh files converted to OBJ before Drake reads them (it takes OBJ, VTK and glTF)."""
+
+# Drake's parser reads its own tags by their prefix (drake:...): a rewritten text must keep it
+ElementTree.register_namespace("drake", "http://drake.mit.edu")
+
+# the packages every Drake parser knows (drake, and drake_models, fetched from the internet on
+# first use: never looked up here); a given package of the same name is still used
+_DRAKES_OWN = frozenset(PackageMap().GetPackageNames())
 
 _UNKNOWN_PACKAGE = re.compile(r"URI '([^']*)' refers to unknown package '([^']*)'")
 
@@ -149,9 +156,9 @@ def model_text(path: Path, parser: Parser, *, xacro_args: dict | None = None, fi
                 if file is None:
                     continue  # an unknown package: the parser refuses it, naming it
                 if kind == "collision" and file.suffix.lower() in CONVERTED_MESH_TYPES:
-                    element.set("filename", str(_as_obj(file, field, label)))
-                elif not url.startswith("package://"):
-                    element.set("filename", str(file.resolve()))
+                    element.set("filename", _as_obj(file, field, label).resolve().as_uri())
+                elif not url.startswith("package://"):  # a text parsed from a string takes file:// URLs only
+                    element.set("filename", file.resolve().as_uri())
     return ElementTree.tostring(root, encoding="unicode")
 
 
@@ -164,9 +171,12 @@ def _expand_xacro(path: Path, parser: Parser, arguments: dict, field: tuple, lab
     with tempfile.TemporaryDirectory(prefix="drake_traj_ament_") as prefix:
         index = Path(prefix) / "share" / "ament_index" / "resource_index" / "packages"
         index.mkdir(parents=True)
-        for name in package_map.GetPackageNames():
+        links = {}  # the index's folder of each package -> the package's own folder
+        for name in sorted(set(package_map.GetPackageNames()) - _DRAKES_OWN):
             (index / name).write_text("")
-            (Path(prefix) / "share" / name).symlink_to(Path(package_map.GetPath(name)).resolve())
+            link, folder = Path(prefix) / "share" / name, Path(package_map.GetPath(name)).resolve()
+            link.symlink_to(folder)
+            links[str(link)] = str(folder)
         previous = os.environ.get("AMENT_PREFIX_PATH")
         os.environ["AMENT_PREFIX_PATH"] = prefix + (os.pathsep + previous if previous else "")
         try:
@@ -185,7 +195,10 @@ def _expand_xacro(path: Path, parser: Parser, arguments: dict, field: tuple, lab
                 os.environ.pop("AMENT_PREFIX_PATH", None)
             else:
                 os.environ["AMENT_PREFIX_PATH"] = previous
-    return document.toxml()
+    text = document.toxml()
+    for link, folder in links.items():  # $(find pkg) gave the index's temporary folder: the package's own
+        text = text.replace(link, folder)
+    return text
 
 
 def add_model_file(plant, path: Path, packages: dict[str, Path] | None = None, *, xacro_args: dict | None = None,
