@@ -13,8 +13,10 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj import QuinticConfig, cli, load_scenario, simulate
 from drake_traj.clearance import CellChecker
+from drake_traj.errors import DrakeTrajError
 from drake_traj.planners import make_planner
 from drake_traj.robots.chain import SerialChain
+from drake_traj.robots import arm_checks
 from drake_traj.robots.chain_arm import ChainArm
 from drake_traj.robots.custom import DhArm, resolve_robot
 from drake_traj.robots.task_space import orientation_error
@@ -299,7 +301,7 @@ def test_bad_custom_arms_are_refused_at_their_line_naming_the_field(tmp_path):
         ("prismatic.urdf", model.replace('<joint name="joint_3" type="revolute">', '<joint name="joint_3" type="prismatic">'),
          "", r"robot.model_file: joint 'joint_3' is PrismaticJoint: a 6-axis arm has revolute joints only"),
         ("no_speeds.urdf", model.replace(' velocity="1.0"', ""), "",
-         r"robot.velocity_limits: velocity_limits missing for the custom arm 'custom_arm'"),
+         r"robot.velocity_limits: (velocity_limits )?missing for the custom arm 'custom_arm'"),
     ]
     for name, urdf, extra, message in cases:
         (tmp_path / name).write_text(urdf)
@@ -309,6 +311,65 @@ def test_bad_custom_arms_are_refused_at_their_line_naming_the_field(tmp_path):
             load_scenario(path)
         field = caught.value.field
         assert field[0] == "robot" and f"bad.yaml, line {line_of(path.read_text(), field[1] + ':') if field[1] == 'model_file' else 2}," in str(caught.value)
+
+
+def continuous_joint_2(tmp_path):
+    """The PUMA's written model with joint 2 continuous (no position range; speed and torque kept)."""
+    model = load_scenario(PUMA, "quintic").base_robot().model_text
+    start = model.index('<joint name="joint_2" type="revolute">')
+    limit = model.index("<limit ", start)
+    end = model.index("/>", limit) + 2
+    speed_and_torque = " ".join(part for part in model[limit:end].split() if part.startswith(("velocity=", "effort=")))
+    path = tmp_path / "continuous.urdf"
+    path.write_text(model[:start] + model[start:limit].replace('type="revolute"', 'type="continuous"')
+                    + f"<limit {speed_and_torque.removesuffix('/>')}/>" + model[end:])
+    return path
+
+
+def test_a_missing_limit_names_the_continuous_joints_and_what_to_give_in_each_way_in():
+    error = arm_checks.missing_limit("lower_limits", "my_arm", ("joint_2",))
+    assert error.field == ("lower_limits",) and error.unbounded_joints == ("joint_2",)
+    assert str(error) == ("lower_limits missing for the custom arm 'my_arm': its model gives joint 'joint_2' no finite "
+                          "position range (a continuous joint, or limits of ±inf), which a planner needs; give "
+                          "lower_limits= and upper_limits= (6 values each [rad])")
+    fields = {"lower_limits": "lower", "upper_limits": "upper"}
+    scenario = arm_checks.scenario_message(error, lambda key: "robot." + fields.get(key, key))
+    assert scenario.startswith("missing for the custom arm 'my_arm': its model gives joint 'joint_2' no finite")
+    assert scenario.endswith("give robot.lower and robot.upper (6 values each [rad])")
+    assert "lower_limits" not in scenario
+    plain = arm_checks.missing_limit("velocity_limits", "my_arm")
+    assert arm_checks.scenario_message(plain, lambda key: "robot." + key) == (
+        "missing for the custom arm 'my_arm': neither its model nor the scenario gives it (give robot.velocity_limits, "
+        "6 values [rad/s])")
+    assert arm_checks.scenario_message(DrakeTrajError("other", field=("x",)), str.upper) == "other"
+    assert arm_checks.unbounded_joints([-1.0, -np.inf, 0.0, np.nan], ["a", "b", "c", "d"]) == ("b", "d")
+
+
+def test_a_continuous_joint_runs_once_the_scenario_gives_its_range(tmp_path):
+    model = continuous_joint_2(tmp_path)
+    path = tmp_path / "ranged.yaml"
+    path.write_text(custom_arm_yaml(model.name, "  lower: [-3, -3, -3, -3, -3, -3]\n  upper: [3, 3, 3, 3, 3, 3]\n"))
+    arm = load_scenario(path).base_robot()
+    assert arm.lower_limits.tolist() == [-3.0] * 6 and arm.upper_limits.tolist() == [3.0] * 6
+
+
+@pytest.mark.xfail(strict=True, reason="needs the change to chain_arm.py (ChainArm.from_plant, __init__) and custom.py "
+                                       "(build_chain_arm) described with arm_checks.missing_limit; then drop this mark")
+def test_a_continuous_joint_is_refused_naming_the_scenarios_range_fields(tmp_path):
+    model = continuous_joint_2(tmp_path)
+    path = tmp_path / "bad.yaml"
+    path.write_text(custom_arm_yaml(model.name))
+    with pytest.raises(ScenarioError, match=r"bad.yaml, line 2, column \d+: robot.lower: missing for the custom arm "
+                                            r"'custom_arm': its model gives joint 'joint_2' no finite position range "
+                                            r"\(a continuous joint, or limits of ±inf\), which a planner needs; give "
+                                            r"robot.lower and robot.upper \(6 values each \[rad\]\)$") as caught:
+        load_scenario(path).base_robot()
+    assert caught.value.field == ("robot", "lower") and "lower_limits" not in str(caught.value)
+    # from Python, the same error names the keywords
+    with pytest.raises(DrakeTrajError, match=r"^lower_limits missing for the custom arm 'arm': its model gives joint "
+                                             r"'joint_2' no finite position range .*give lower_limits= and "
+                                             r"upper_limits= \(6 values each \[rad\]\)$"):
+        ChainArm.from_model_file(model, name="arm", base_frame="base", tool_frame="tool0", acceleration_limits=[2.0] * 6)
 
 
 def test_a_bad_dh_table_is_refused_by_the_command_line(tmp_path, capsys):

@@ -10,10 +10,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from collections.abc import Callable, Sequence
+
+from drake_traj.errors import DrakeTrajError
 from drake_traj.robots import ROBOT_NAMES
 from drake_traj.validation import finite_array, invalid, real_array
 
-__all__ = ["ARM_JOINTS", "arm_name", "inertia_rows", "joint_vector", "link_radius", "matrix", "payload", "ranges"]
+__all__ = ["ARM_JOINTS", "arm_name", "inertia_rows", "joint_vector", "link_radius", "matrix", "missing_limit",
+           "payload", "ranges", "scenario_message", "unbounded_joints"]
 
 ARM_JOINTS = 6  # a custom arm has six revolute joints
 _NAME_CHARACTERS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-")
@@ -104,3 +108,59 @@ def link_radius(value, name: str) -> float:
     if radius <= 0:
         raise invalid(name, f"{name} must be positive [m], got {float(radius):g}")
     return float(radius)
+
+
+# a limit's unit, for the messages of missing_limit
+_LIMIT_UNITS = dict(lower_limits="rad", upper_limits="rad", velocity_limits="rad/s", acceleration_limits="rad/s^2",
+                    effort_limits="N m")
+_RANGE = ("lower_limits", "upper_limits")
+
+
+def _keyword(key: str) -> str:
+    return f"{key}="
+
+
+def unbounded_joints(values, joint_names: Sequence[str]) -> tuple[str, ...]:
+    """The names of the joints whose ``values`` (a model's per-joint limits) are not finite: a
+    continuous joint's range (±inf), a joint without a speed or torque limit."""
+    return tuple(str(name) for name, value in zip(joint_names, np.asarray(values, dtype=float)) if not np.isfinite(value))
+
+
+def missing_limit(key: str, arm: str, unbounded: Sequence[str] = (), *,
+                  name: Callable[[str], str] = _keyword, given_by: str = "the arguments give") -> DrakeTrajError:
+    """The error for a custom arm's limit ``key`` (``lower_limits``, ...) that neither its model
+    nor ``given_by`` it (``"the arguments give"``), at the field ``(key,)``. ``unbounded``: the joints the model leaves
+    without a finite value (:func:`unbounded_joints`; for the position range: continuous joints);
+    ``name(key)``: how the message tells the user to give it (``lower_limits=`` for Python;
+    ``robot.lower`` for a scenario, :func:`scenario_message`). The error keeps ``key``, ``arm`` and
+    ``unbounded`` (attributes ``limit``, ``arm``, ``unbounded_joints``) so that a caller can word
+    it in its own terms."""
+    unit = _LIMIT_UNITS.get(key, "")
+    give = f"{name(_RANGE[0])} and {name(_RANGE[1])}" if key in _RANGE else name(key)
+    count = f"{ARM_JOINTS} values each" if key in _RANGE else f"{ARM_JOINTS} values"
+    if unbounded:
+        joints = ", ".join(repr(j) for j in unbounded)
+        plural = "s" if len(unbounded) > 1 else ""
+        if key in _RANGE:
+            why = (f"its model gives joint{plural} {joints} no finite position range (a continuous joint, or limits "
+                   "of ±inf), which a planner needs")
+        else:
+            why = f"its model gives joint{plural} {joints} no finite {key.replace('_limits', '').replace('_', ' ')} limit"
+        message = f"{key} missing for the custom arm {arm!r}: {why}; give {give} ({count} [{unit}])"
+    else:
+        message = (f"{key} missing for the custom arm {arm!r}: neither its model nor {given_by} it "
+                   f"(give {give}, {count} [{unit}])")
+    error = DrakeTrajError(message, field=(key,))
+    error.limit, error.arm, error.unbounded_joints = key, arm, tuple(unbounded)
+    return error
+
+
+def scenario_message(error: DrakeTrajError, name: Callable[[str], str]) -> str:
+    """``error``'s text as a scenario's reader needs it: a :func:`missing_limit` error worded
+    again with the scenario's fields (``name("lower_limits")`` -> ``robot.lower``); any other
+    error's text as it is."""
+    key = getattr(error, "limit", None)
+    if key is None:
+        return str(error)
+    reworded = missing_limit(key, error.arm, error.unbounded_joints, name=name, given_by="the scenario gives")
+    return str(reworded).replace(f"{key} missing", "missing", 1)
