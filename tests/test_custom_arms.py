@@ -353,8 +353,6 @@ def test_a_continuous_joint_runs_once_the_scenario_gives_its_range(tmp_path):
     assert arm.lower_limits.tolist() == [-3.0] * 6 and arm.upper_limits.tolist() == [3.0] * 6
 
 
-@pytest.mark.xfail(strict=True, reason="needs the change to chain_arm.py (ChainArm.from_plant, __init__) and custom.py "
-                                       "(build_chain_arm) described with arm_checks.missing_limit; then drop this mark")
 def test_a_continuous_joint_is_refused_naming_the_scenarios_range_fields(tmp_path):
     model = continuous_joint_2(tmp_path)
     path = tmp_path / "bad.yaml"

@@ -106,8 +106,7 @@ class ChainArm(Robot):
                      acceleration_limits=acceleration_limits, effort_limits=effort_limits)
         for key, value in given.items():
             if value is None:
-                raise DrakeTrajError(f"{key} missing for the custom arm {name!r}: neither its model nor the "
-                                     f"arguments give it (pass {key}=)", field=(key,))
+                raise arm_checks.missing_limit(key, name)
         self._lower = joint_bound(lower_limits, "lower_limits", NUM_JOINTS, "rad")
         self._upper = joint_bound(upper_limits, "upper_limits", NUM_JOINTS, "rad")
         arm_checks.ranges(self._lower, self._upper, "lower_limits", "upper_limits")
@@ -181,10 +180,12 @@ class ChainArm(Robot):
                      upper_limits=[j.position_upper_limits()[0] for j in joints],
                      velocity_limits=[j.velocity_upper_limits()[0] for j in joints],
                      effort_limits=[efforts.get(j.index(), np.inf) for j in joints])
-        for key, values in found.items():
-            if limits.get(key) is None and np.all(np.isfinite(values)):
-                limits[key] = np.array(values)
         name = _default_name(name, plant.GetModelInstanceName(tool.model_instance()), "the tool body's model instance")
+        for key, values in found.items():
+            if limits.get(key) is None:
+                if not np.all(np.isfinite(values)):
+                    raise arm_checks.missing_limit(key, name, arm_checks.unbounded_joints(values, [j.name() for j in joints]))
+                limits[key] = np.array(values)
         return cls(chain or from_plant, name=name,
                    model_file=model_file, base_frame=base.name(), tool_frame=tool.name(),
                    joint_names=[j.name() for j in joints], model_text=model_text, packages=packages,

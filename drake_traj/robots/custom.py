@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Optional, Union
 
 from drake_traj.errors import DrakeTrajError, field_text
+from drake_traj.robots import arm_checks
 from drake_traj.robots import Robot, get_robot
 from drake_traj.robots.arm_checks import ARM_JOINTS, arm_name, inertia_rows, joint_vector, link_radius, matrix, payload, ranges
 from drake_traj.robots.chain import CONVENTIONS
@@ -227,4 +228,5 @@ def build_chain_arm(choice: CustomArm | DhArm, arguments: dict, data_source: str
     except DrakeTrajError as error:
         head = _FIELDS.get(error.field[0], error.field[0]) if error.field else "model_file"
         field = ("robot", head, *error.field[1:])
-        raise error.relocated(field, f"{field_text(field)}: {error}") from None
+        message = arm_checks.scenario_message(error, lambda key: field_text(("robot", _FIELDS.get(key, key))))
+        raise error.relocated(field, f"{field_text(field)}: {message}") from None
