@@ -25,10 +25,11 @@ import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 from pydrake.multibody.parsing import PackageMap, Parser
+from pydrake.multibody.plant import MultibodyPlant
 
 from drake_traj.errors import Cause, DrakeTrajError
 
-__all__ = ["CONVERTED_MESH_TYPES", "add_model_file", "model_parser", "model_text", "refusal_for"]
+__all__ = ["CONVERTED_MESH_TYPES", "add_model_file", "joint_efforts", "model_parser", "model_text", "refusal_for"]
 
 CONVERTED_MESH_TYPES = (".stl", ".dae")
 """Collision mesh files converted to OBJ before Drake reads them (it takes OBJ, VTK and glTF)."""
@@ -199,6 +200,29 @@ def _expand_xacro(path: Path, parser: Parser, arguments: dict, field: tuple, lab
     for link, folder in links.items():  # $(find pkg) gave the index's temporary folder: the package's own
         text = text.replace(link, folder)
     return text
+
+
+def joint_efforts(path: Path, packages: dict[str, Path] | None = None, *, xacro_args: dict | None = None) -> dict:
+    """{joint name: effort limit [N m or N]} from a URDF's (or expanded xacro's) ``<limit effort>``
+    tags: Drake keeps them only for joints with a ``<transmission>``, and ROS 2 descriptions
+    declare their drives with ``ros2_control`` instead. Empty for other files."""
+    if path.suffix not in (".urdf", ".xacro"):
+        return {}
+    if path.suffix == ".xacro":
+        parser = model_parser(MultibodyPlant(0.0), packages)
+        _add_own_package(parser, path)
+        text = _expand_xacro(path, parser, xacro_args or {}, ("model_file",), "model_file")
+    else:
+        text = path.read_text()
+    efforts = {}
+    for joint in ElementTree.fromstring(text).iter("joint"):
+        limit = joint.find("limit")
+        if limit is not None and limit.get("effort") is not None:
+            try:
+                efforts[joint.get("name")] = float(limit.get("effort"))
+            except ValueError:
+                continue
+    return efforts
 
 
 def add_model_file(plant, path: Path, packages: dict[str, Path] | None = None, *, xacro_args: dict | None = None,

@@ -196,3 +196,17 @@ def test_a_directives_model_from_a_package(tmp_path):
         simulate(load_scenario(tmp_path / "other" / "cell.yaml"))
     (tmp_path / "other" / "cell.yaml").write_text(scenario_text + "  packages: {fixtures_pkg: ../fixtures_pkg}\n")
     assert simulate(load_scenario(tmp_path / "other" / "cell.yaml")).succeeded
+
+
+def test_effort_limits_from_limit_tags_where_no_transmission_declares_a_drive(tmp_path):
+    """ROS 2 descriptions declare drives with ros2_control, not <transmission>: Drake then makes no
+    actuator and keeps no effort limit; the arm takes them from the joints' <limit effort>."""
+    folder = copy_description(tmp_path)
+    text = (folder / "urdf" / "example_arm.urdf").read_text()
+    while "<transmission" in text:
+        start = text.index("<transmission")
+        text = text[:start] + text[text.index("</transmission>", start) + len("</transmission>"):]
+    (folder / "urdf" / "no_drives.urdf").write_text(text)
+    arm = ChainArm.from_model_file(folder / "urdf" / "no_drives.urdf", base_frame="base", tool_frame="tool0",
+                                   name="no_drives", acceleration_limits=1.4)
+    np.testing.assert_array_equal(arm.effort_limits, UR5E.effort_limits)  # 150 150 150 28 28 28 N m

@@ -16,7 +16,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_label
-from drake_traj.model_files import add_model_file
+from drake_traj.model_files import add_model_file, joint_efforts
 from drake_traj.robots import ROBOT_NAMES, arm_checks
 from drake_traj.robots.base import Robot, TaskKinematics, format_point, joint_actuators
 from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_reach, chain_singularity_factors,
@@ -148,6 +148,11 @@ class ChainArm(Robot):
         name = _default_name(name, path.stem.removesuffix(".urdf"), f"the model file's name {path.name!r}")
         packages = {str(k): Path(v) for k, v in (packages or {}).items()}
         plant = _parsed(path, packages, xacro_args)
+        if limits.get("effort_limits") is None:  # the file's <limit effort> where it gives no actuators
+            efforts = joint_efforts(path, packages, xacro_args=xacro_args)
+            joints = plant_chain(plant, base_frame, tool_frame)[2]
+            if efforts and all(np.isfinite(efforts.get(j.name(), np.inf)) and efforts.get(j.name(), 0) > 0 for j in joints):
+                limits["effort_limits"] = np.array([efforts[j.name()] for j in joints])
         return cls.from_plant(plant, base_frame=base_frame, tool_frame=tool_frame, model_file=path,
                               name=name, packages=packages, xacro_args=xacro_args,
                               base_welded=_base_welded(plant, base_frame), **limits)
