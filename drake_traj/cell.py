@@ -40,7 +40,7 @@ from pydrake.multibody.tree import RotationalInertia, SpatialInertia
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj.errors import Cause, DrakeTrajError, Field, field_text
-from drake_traj.model_files import model_parser, refusal_for
+from drake_traj.model_files import missing_package, model_parser
 from drake_traj.robots import UR10E, PointRobot, Robot
 from drake_traj.validation import invalid, real_array
 
@@ -382,6 +382,21 @@ def _packages(packages: dict, directory: Path | None) -> dict[str, Path]:
     return found
 
 
+def _missing_package_of(url: str, parser, field: tuple, label: str) -> DrakeTrajError | None:
+    """:func:`~drake_traj.model_files.missing_package` of a directive's model file: its own URL's
+    package, then the ``package://`` URLs inside the file."""
+    refusal = missing_package(url, parser, field, label)
+    if refusal is not None:
+        return refusal
+    if url.startswith("package://") or url.startswith("file://"):
+        try:
+            path = Path(parser.package_map().ResolveUrl(url)) if url.startswith("package://") else Path(url[len("file://"):])
+            return missing_package(path.read_text(errors="replace"), parser, field, label) if path.is_file() else None
+        except RuntimeError:
+            return None
+    return None
+
+
 def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], directory: Path | None,
                     packages: dict[str, Path] | None = None) -> dict:
     """Process Drake model directives in one call (Drake resolves a weld's frames among the
@@ -403,12 +418,14 @@ def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], dir
                 model.file = path.as_uri()
             scratch_builder = DiagramBuilder()  # with SceneGraph: its meshes' package:// URLs are resolved here
             scratch, _ = AddMultibodyPlantSceneGraph(scratch_builder, 0.0)
+            parser = model_parser(scratch, packages)
+            refusal = _missing_package_of(model.file, parser, name + ("add_model", "file"),
+                                          f"cell.directives[{index}].add_model.file")
+            if refusal is not None:
+                raise refusal
             try:
-                (instance,) = model_parser(scratch, packages).AddModels(url=model.file)
+                (instance,) = parser.AddModels(url=model.file)
             except (RuntimeError, ValueError) as error:
-                refusal = refusal_for(error, name + ("add_model", "file"), f"cell.directives[{index}].add_model.file")
-                if refusal is not None:
-                    raise refusal from None
                 raise DrakeTrajError(f"cell.directives[{index}].add_model: {model.file} cannot be used: "
                                      f"{str(error).strip()}", field=name + ("add_model", "file"), cause=Cause.INVALID) from None
             known[model.name] = {scratch.get_frame(frame).name() for frame in scratch.GetFrameIndices(instance)}

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import re
 import tempfile
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
@@ -29,7 +28,7 @@ from pydrake.multibody.plant import MultibodyPlant
 
 from drake_traj.errors import Cause, DrakeTrajError
 
-__all__ = ["CONVERTED_MESH_TYPES", "add_model_file", "joint_efforts", "model_parser", "model_text", "refusal_for"]
+__all__ = ["CONVERTED_MESH_TYPES", "add_model_file", "joint_efforts", "missing_package", "model_parser", "model_text"]
 
 CONVERTED_MESH_TYPES = (".stl", ".dae")
 """Collision mesh files converted to OBJ before Drake reads them (it takes OBJ, VTK and glTF)."""
@@ -40,8 +39,6 @@ ElementTree.register_namespace("drake", "http://drake.mit.edu")
 # the packages every Drake parser knows (drake, and drake_models, fetched from the internet on
 # first use: never looked up here); a given package of the same name is still used
 _DRAKES_OWN = frozenset(PackageMap().GetPackageNames())
-
-_UNKNOWN_PACKAGE = re.compile(r"URI '([^']*)' refers to unknown package '([^']*)'")
 
 
 def model_parser(plant, packages: dict[str, Path] | None = None) -> Parser:
@@ -71,17 +68,22 @@ def _add_own_package(parser: Parser, path: Path) -> None:
             return
 
 
-def refusal_for(error: BaseException, field: tuple, label: str) -> DrakeTrajError | None:
-    """The clear error for a Drake parser failure on an unknown ``package://`` package (naming
-    it and how to give it, at ``field``), else None."""
-    found = _UNKNOWN_PACKAGE.search(str(error))
-    if found is None:
-        return None
-    url, package = found.groups()
-    return DrakeTrajError(
-        f"{label}: the model refers to the package {package!r} ({url}), which is on no package path here: give its "
-        f"folder in packages: {{{package}: path/to/{package}}} (relative to the scenario file) or put its parent "
-        "folder on ROS_PACKAGE_PATH; nothing is downloaded", field=field, cause=Cause.INVALID)
+def missing_package(text: str, parser: Parser, field: tuple, label: str) -> DrakeTrajError | None:
+    """The clear error for the first ``package://`` URL in ``text`` whose package the parser's
+    map does not hold (naming it and how to give it, at ``field``), else None. Checked before
+    Drake parses the text, which would fail on it with its own words."""
+    package_map = parser.package_map()
+    start = 0
+    while (found := text.find("package://", start)) >= 0:
+        url = text[found:].split('"', 1)[0].split("'", 1)[0].split("<", 1)[0].strip()
+        package = url[len("package://"):].split("/", 1)[0]
+        start = found + len("package://")
+        if package and not package_map.Contains(package):
+            return DrakeTrajError(
+                f"{label}: the model refers to the package {package!r} ({url}), which is on no package path here: give "
+                f"its folder in packages: {{{package}: path/to/{package}}} (relative to the scenario file) or put its "
+                "parent folder on ROS_PACKAGE_PATH; nothing is downloaded", field=field, cause=Cause.INVALID)
+    return None
 
 
 def _resolve(url: str, base: Path, parser: Parser) -> Path | None:
@@ -183,10 +185,9 @@ def _expand_xacro(path: Path, parser: Parser, arguments: dict, field: tuple, lab
         try:
             document = xacro.process_file(str(path), mappings={str(k): str(v) for k, v in arguments.items()})
         except Exception as error:  # noqa: BLE001 - xacro raises its own and Python's: each is this refusal
-            package = re.search(r"package '([^']*)' not found|PackageNotFoundError: ?\"?([^\"\s]+)", str(error))
             hint = ""
-            if package or type(error).__name__ == "PackageNotFoundError":
-                name = next((g for g in (package.groups() if package else ()) if g), str(error))
+            if type(error).__name__ == "PackageNotFoundError":  # ament's, for a $(find pkg) of no package here
+                name = str(error).strip("'\" ")
                 hint = (f" (the package {name!r} is on no package path here: give its folder in packages: "
                         f"{{{name}: path/to/{name}}} or put its parent folder on ROS_PACKAGE_PATH)")
             raise DrakeTrajError(f"{label}: the xacro file {path} cannot be expanded: {type(error).__name__}: "
@@ -229,16 +230,13 @@ def add_model_file(plant, path: Path, packages: dict[str, Path] | None = None, *
                    field: tuple = ("model_file",), label: str = "model_file") -> list:
     """Parse the model file ``path`` (URDF, SDF, xacro) into ``plant`` with the package map of
     :func:`model_parser`; the model instances. Raises the clear refusal of an unknown package
-    (:func:`refusal_for`) and lets the parser's other errors through."""
+    (:func:`missing_package`, checked before Drake parses) and lets the parser's other errors through."""
     parser = model_parser(plant, packages)
     _add_own_package(parser, path)
     text = model_text(path, parser, xacro_args=xacro_args, field=field, label=label)
-    try:
-        if text is None:
-            return parser.AddModels(str(path))
-        return parser.AddModelsFromString(text, "urdf")
-    except (RuntimeError, SystemExit) as error:
-        refusal = refusal_for(error.code if isinstance(error, SystemExit) else error, field, label)
-        if refusal is not None:
-            raise refusal from None
-        raise
+    refusal = missing_package(path.read_text(errors="replace") if text is None else text, parser, field, label)
+    if refusal is not None:
+        raise refusal
+    if text is None:
+        return parser.AddModels(str(path))
+    return parser.AddModelsFromString(text, "urdf")
