@@ -10,7 +10,7 @@ from pydrake.multibody.tree import FixedOffsetFrame, PrismaticJoint, RevoluteJoi
 
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
 from drake_traj.planners.pajak import PajakLaw
-from drake_traj.robots import ur10e
+from drake_traj.robots import get_robot, ur10e
 from drake_traj.robots.chain import (CHAIN, SerialChain, chain_singularity_factors,
                                      inverse_kinematics_all, inverse_kinematics_near)
 from drake_traj.robots.chain_arm import ChainArm
@@ -212,14 +212,16 @@ def test_bad_input():
 
 
 def test_add_to_plant_gives_every_joint_its_actuator(tmp_path):
-    """A model file without transmissions: the arm adds {joint}_actuator with its effort limits;
+    """A model file without transmissions: the effort limits of its <limit> tags, or those given;
+    the arm adds {joint}_actuator with its effort limits;
     a plant-built arm plans but has no model to add."""
     text = ur10e.model_path().read_text()
     start, end = text.index("<transmission"), text.rindex("</transmission>") + len("</transmission>")
     bare = tmp_path / "bare.urdf"
     bare.write_text(text[:start] + text[end:])
-    with pytest.raises(DrakeTrajError, match=r"effort_limits missing for the custom arm 'bare'"):
-        ChainArm.from_model_file(bare, base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
+    # no drive declared: the joints' <limit effort> (ROS 2 descriptions declare drives by ros2_control)
+    from_tags = ChainArm.from_model_file(bare, base_frame="base", tool_frame="tool0", acceleration_limits=1.4)
+    np.testing.assert_array_equal(from_tags.effort_limits, get_robot("ur10e").effort_limits)
     efforts = np.array([300.0, 300.0, 140.0, 50.0, 50.0, 50.0])
     arm = ChainArm.from_model_file(bare, base_frame="base", tool_frame="tool0", acceleration_limits=1.4,
                                    effort_limits=efforts)
