@@ -198,14 +198,15 @@ def limit_or_default(value, default, name: str, n: int) -> np.ndarray:
     return positive_vector(value, name, n)
 
 
-def whole_number(value, name: str, *, minimum: int) -> int:
-    """``value`` as an int >= ``minimum`` (an int, or a float with no fraction), else ValueError
-    naming ``name``."""
+def whole_number(value, name: str, *, minimum: int, maximum: int | None = None) -> int:
+    """``value`` as an int in [``minimum``, ``maximum``] (an int, or a float with no fraction),
+    else ValueError naming ``name``."""
+    within = f">= {minimum}" if maximum is None else f"in [{minimum}, {maximum}]"
     if (isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) or not np.isfinite(value)
             or value != int(value)):
-        raise invalid(name, f"{name} must be a whole number >= {minimum}, got {value!r:.80}")
-    if int(value) < minimum:
-        raise invalid(name, f"{name} must be a whole number >= {minimum}, got {int(value)}")
+        raise invalid(name, f"{name} must be a whole number {within}, got {value!r:.80}")
+    if int(value) < minimum or (maximum is not None and int(value) > maximum):
+        raise invalid(name, f"{name} must be a whole number {within}, got {int(value)}")
     return int(value)
 
 

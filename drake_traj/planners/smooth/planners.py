@@ -13,9 +13,11 @@ from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.planners.baselines.ruckig import jerk_limited_limits
 from drake_traj.planners.pajak import PajakConfig, PajakPlanner
-from drake_traj.planners.smooth.timing import SmoothTiming, time_path
+from drake_traj.planners.smooth.timing import MAX_GRID_POINTS, SmoothTiming, time_path
 from drake_traj.robots import Robot
 from drake_traj.validation import instance_of, positive_vector, whole_number
+
+MAX_GOALS = 2000  # goals of one smooth-waypoints task at most (0.05 rad apart: 100 rad of motion)
 
 __all__ = ["RetimedPajakConfig", "SmoothPlanner", "SmoothWaypointsConfig", "make_retimed_pajak",
            "make_smooth_waypoints", "waypoint_path"]
@@ -112,12 +114,15 @@ class SmoothWaypointsConfig:
 def make_smooth_waypoints(config: SmoothWaypointsConfig, robot: Robot, q_initial) -> SmoothPlanner:
     """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]."""
     q = start_and_goals(q_initial, config.goals, robot.num_joints)
+    if len(q) - 1 > MAX_GOALS:
+        raise DrakeTrajError(f"goals: {len(q) - 1} goals, at most {MAX_GOALS} (each is a knot of the path and a node of "
+                             "the timing's programs): thin them out", field=("goals",))
     velocity, acceleration, jerk = jerk_limited_limits(robot, config.velocity_limit, config.acceleration_limit,
                                                        config.jerk_limit)
     path = waypoint_path(q)
     _check_joint_range(path, robot, "goals")
     timing = _timed(path, "goals", velocity, acceleration, jerk,
-                    whole_number(config.grid_points, "grid_points", minimum=20))
+                    whole_number(config.grid_points, "grid_points", minimum=20, maximum=MAX_GRID_POINTS))
     return SmoothPlanner(timing, velocity, acceleration, jerk, tool_waypoints=robot.tool_position(q[1:]))
 
 
@@ -160,6 +165,6 @@ def make_retimed_pajak(config: RetimedPajakConfig, robot: Robot, q_initial) -> S
     velocity, acceleration, jerk = jerk_limited_limits(robot, pajak.velocity_limit, pajak.acceleration_limit,
                                                        config.jerk_limit)  # the limits the Pająk planner kept
     timing = _timed(samples, "pajak", velocity, acceleration, jerk,
-                    whole_number(config.grid_points, "grid_points", minimum=20))
+                    whole_number(config.grid_points, "grid_points", minimum=20, maximum=MAX_GRID_POINTS))
     return SmoothPlanner(timing, velocity, acceleration, jerk,
                          tool_waypoints=np.asarray(config.pajak.waypoints, dtype=float)[:, :3], target_word="waypoint")

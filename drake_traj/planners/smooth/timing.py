@@ -36,7 +36,7 @@ from drake_traj.planners.baselines.ruckig import default_jerk_limit
 from drake_traj.planners.baselines.toppra import time_optimal_along_path
 from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coefficients, sigma_derivatives
 from drake_traj.planners.laws.polynomials import rate_peaks
-from drake_traj.validation import positive_scalar, positive_vector, real_array, require_finite
+from drake_traj.validation import positive_scalar, positive_vector, real_array, require_finite, whole_number
 
 __all__ = ["InfeasibleTimingError", "SmoothTiming", "check_path", "exact_peaks", "time_path"]
 
@@ -49,6 +49,11 @@ END_JERK_MARGIN = 0.93
 TRUST_REGION = 1.3
 """x may grow by at most this factor from one linear program to the next (where √x is frozen)."""
 _REVERSAL_COSINE = -0.5  # consecutive sample steps turning by more than 120°: a reversal
+
+
+MAX_GRID_POINTS = 4000
+"""Nodes of the timing's linear programs at most (a program of N nodes has 2N variables and about
+4nN constraints; 4000 nodes take seconds, a million would not finish)."""
 
 
 class InfeasibleTimingError(DrakeTrajError):
@@ -200,7 +205,11 @@ def _check_corners(path: Trajectory, name: str) -> None:
         for s in breaks:
             left, right = path.EvalDerivative(s - delta, order).ravel(), path.EvalDerivative(s + delta, order).ravel()
             jump = np.abs(right - left).max()
-            if jump > 1e-6 * scale:
+            # what the next derivative moves it by over the 2 delta between the two looks: a dense
+            # spline's third derivative is large (knots 0.05 rad apart), and that is no corner
+            drift = 2 * delta * max(np.abs(path.EvalDerivative(s - delta, order + 1)).max(),
+                                    np.abs(path.EvalDerivative(s + delta, order + 1)).max())
+            if jump > 1e-6 * scale + 2 * drift:
                 turn = np.dot(path.EvalDerivative(s - delta, 1).ravel(), path.EvalDerivative(s + delta, 1).ravel())
                 kind = "turns back" if turn < 0 else "is not C2"
                 raise InfeasibleTimingError(
@@ -240,7 +249,7 @@ def _grid(path, velocity, acceleration, jerk, points: int) -> np.ndarray:
     evenly spaced in s takes its place."""
     breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
     points = max(points - len(breaks), points // 2)
-    even = np.unique(np.concatenate([np.linspace(path.start_time(), path.end_time(), points), breaks]))
+    even = _merged(np.linspace(path.start_time(), path.end_time(), points), breaks)
     try:
         optimal, trajectory = time_optimal_along_path(path, velocity, acceleration, grid_points=even)
         s_of_t = trajectory.time_scaling()
@@ -261,6 +270,22 @@ def _grid(path, velocity, acceleration, jerk, points: int) -> np.ndarray:
     s = s[keep]
     s[-1] = path.end_time()
     return s
+
+
+def _merged(nodes: np.ndarray, breaks: np.ndarray) -> np.ndarray:
+    """``nodes`` and the path's ``breaks`` in order, a node within 1e-9 of the path's length of a
+    break (or of the node before it) dropped: nodes a rounding apart (a break 1e-16 from an even
+    node) abort Drake's trajectories (their breaks must be 1e-10 s apart at least)."""
+    tolerance = 1e-9 * max(nodes[-1] - nodes[0], 1e-300)
+    if len(breaks):
+        near = np.abs(nodes[:, None] - breaks[None, :]).min(axis=1) < tolerance
+        near[[0, -1]] = False
+        nodes = np.concatenate([nodes[~near], breaks])
+    nodes = np.sort(nodes)
+    keep = np.concatenate([[True], np.diff(nodes) >= tolerance])
+    merged = nodes[keep]
+    merged[-1] = nodes[-1]
+    return merged
 
 
 def _path_derivatives(derivatives, s):
@@ -518,17 +543,41 @@ def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid
             path (a motion longer than ``max_duration``), a linear program that fails, or a
             motion that leaves the path by more than :data:`PATH_TOLERANCE`.
         DrakeTrajError: malformed limits (naming the limit and the joint) or path.
+
+    Any abort of Drake's on the way (a ``SystemExit``, which would end the caller's interpreter) is
+    turned into an :class:`InfeasibleTimingError` naming the path: the inputs that reach one are
+    checked first, this is the net under them.
     """
+    try:
+        return _time_path(path, velocity_limit, acceleration_limit, jerk_limit, grid_points=grid_points,
+                          iterations=iterations, max_duration=max_duration)
+    except SystemExit as error:
+        raise InfeasibleTimingError(f"the path cannot be timed: Drake refused it ({str(error.code).strip()[:300]})",
+                                    field=("path",)) from None
+
+
+def _time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 250,
+               iterations: int = 8, max_duration: float = 600.0) -> SmoothTiming:
+    """The work of :func:`time_path`."""
+    grid_points = whole_number(grid_points, "grid_points", minimum=20, maximum=MAX_GRID_POINTS)
     path, fit = check_path(path)
     velocity, acceleration, jerk = _limits(path, velocity_limit, acceleration_limit, jerk_limit)
     max_duration = positive_scalar(max_duration, "max_duration", "s")
     s_all = np.linspace(path.start_time(), path.end_time(), 2001)
     travel = np.trapezoid(np.abs(path.MakeDerivative(1).vector_values(s_all)), s_all, axis=1)  # per joint [rad]
-    if not np.max(travel / velocity) <= max_duration:  # the velocity limit alone takes longer
-        j = int(np.argmax(travel / velocity))
-        raise InfeasibleTimingError(
-            f"the limits are too small for the path: {joint_label(j)} travels {travel[j]:.4g} rad at most "
-            f"{velocity[j]:.4g} rad/s (velocity_limit), longer than max_duration {max_duration:g} s", field=("path",))
+    # Lower bounds on T from each limit alone: a joint's travel D is made of rest-to-rest pieces (it
+    # stops where it turns back), each at least d / v, 2 sqrt(d / a) and (32 d / j)^(1/3) long, and
+    # the sums are at least those of D (the roots are concave). Checked before any array is made.
+    bounds = {"velocity_limit": (travel / velocity, velocity, "rad/s"),
+              "acceleration_limit": (2 * np.sqrt(travel / acceleration), acceleration, "rad/s²"),
+              "jerk_limit": (np.cbrt(32 * travel / jerk), jerk, "rad/s³")}
+    for name, (least, limit, unit) in bounds.items():
+        if not np.max(least) <= max_duration:
+            j = int(np.argmax(least))
+            raise InfeasibleTimingError(
+                f"the limits are too small for the path: {joint_label(j)} travels {travel[j]:.4g} rad with at most "
+                f"{limit[j]:.4g} {unit} ({name}): at least {least[j]:.4g} s, longer than max_duration {max_duration:g} s",
+                field=("path",))
     s = _grid(path, velocity, acceleration, jerk, grid_points)
     program = _Program(path, s, velocity, acceleration, jerk)
     x, p = program.solve(None, np.inf)
