@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Union
 
 import numpy as np
+import yaml
 from pydrake.geometry import Box as BoxShape
 from pydrake.geometry import Cylinder as CylinderShape
 from pydrake.geometry import AddContactMaterial, ProximityProperties, Rgba
@@ -411,11 +412,13 @@ def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], dir
         if directive.add_model is not None:
             model = directive.add_model
             if "://" not in model.file:
-                path = (base / model.file).resolve()
-                if not path.is_file():
+                path = base / model.file
+                if not path.is_file():  # False for a symbolic link that loops or leads nowhere
+                    what = " (a symbolic link that loops or leads nowhere)" if path.is_symlink() else ""
                     raise DrakeTrajError(f"cell.directives[{index}].add_model.file: no model file {model.file!r} "
-                                         f"(looked for {path})", field=name + ("add_model", "file"), cause=Cause.INVALID)
-                model.file = path.as_uri()
+                                         f"(looked for {path}{what})", field=name + ("add_model", "file"),
+                                         cause=Cause.INVALID)
+                model.file = path.resolve().as_uri()
             scratch_builder = DiagramBuilder()  # with SceneGraph: its meshes' package:// URLs are resolved here
             scratch, _ = AddMultibodyPlantSceneGraph(scratch_builder, 0.0)
             parser = model_parser(scratch, packages)
@@ -442,6 +445,8 @@ def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], dir
                                          field=name + (kind,), cause=Cause.INVALID)
             if kind == "add_frame":
                 known.setdefault("", set()).add(entry.name)
+        if directive.add_directives is not None:
+            _refuse_include_cycle(directive.add_directives.file, name + ("add_directives", "file"), packages, base)
     try:
         added = ProcessModelDirectives(ModelDirectives(directives=directives), plant, model_parser(plant, packages))
     except (RuntimeError, ValueError) as error:
@@ -453,6 +458,69 @@ def _add_directives(plant: MultibodyPlant, directives: list[ModelDirective], dir
         for body in plant.GetBodyIndices(info.model_instance):
             fields[str(plant.get_body(body).scoped_name())] = name
     return fields
+
+
+MAX_DIRECTIVES_DEPTH = 100  # add_directives files included in one another, at most this deep
+
+
+def _directives_path(url: str, packages: dict[str, Path] | None, base: Path) -> Path | None:
+    """The file of an ``add_directives`` URL (``file://``, ``package://`` through ``packages``
+    and ``ROS_PACKAGE_PATH``, or a plain path from ``base``), None where it cannot be found
+    (Drake then says why)."""
+    try:
+        if url.startswith("package://"):
+            scratch = MultibodyPlant(0.0)
+            return Path(model_parser(scratch, packages).package_map().ResolveUrl(url))
+        path = Path(url[len("file://"):]) if url.startswith("file://") else Path(url)
+        return path if path.is_absolute() else base / path
+    except (RuntimeError, ValueError):
+        return None
+
+
+def _refuse_include_cycle(url: str, field: Field, packages: dict[str, Path] | None, base: Path) -> None:
+    """Follow the ``add_directives`` includes from ``url`` (the files read here, before Drake
+    reads them: Drake recurses without end on a cycle, until it crashes) and refuse a file that
+    includes itself, directly or through others, naming the chain of files at ``field``; also a
+    file that is a symbolic link loop, and includes nested deeper than
+    :data:`MAX_DIRECTIVES_DEPTH`. A file that cannot be read or is not a directives file is left
+    to Drake's own message."""
+    label = field_text(field)
+
+    def follow(url: str, chain: list[str], seen: list[Path]) -> None:
+        path = _directives_path(url, packages, base)
+        if path is None:
+            return
+        if path.is_symlink() and not path.is_file():
+            raise DrakeTrajError(f"{label}: the directives file {url!r} is a symbolic link that loops or leads nowhere "
+                                 f"({path})", field=field, cause=Cause.INVALID)
+        try:
+            real = path.resolve(strict=True)
+            text = real.read_text(errors="replace")
+        except (OSError, RuntimeError):
+            return
+        chain = chain + [url]
+        if real in seen:
+            raise DrakeTrajError(f"{label}: the directives files include each other in a cycle: "
+                                 f"{' -> '.join(chain)} (a file must not include itself, directly or through others)",
+                                 field=field, cause=Cause.INVALID)
+        if len(chain) > MAX_DIRECTIVES_DEPTH:
+            raise DrakeTrajError(f"{label}: the directives files are included more than {MAX_DIRECTIVES_DEPTH} deep "
+                                 f"({' -> '.join(chain[:3])} -> ...)", field=field, cause=Cause.INVALID)
+        if real in done:  # its includes were followed already, without a cycle
+            return
+        try:
+            document = yaml.safe_load(text)
+        except yaml.YAMLError:
+            return
+        entries = document.get("directives") if isinstance(document, dict) else None
+        for entry in entries if isinstance(entries, list) else []:
+            nested = entry.get("add_directives") if isinstance(entry, dict) else None
+            if isinstance(nested, dict) and isinstance(nested.get("file"), str):
+                follow(nested["file"], chain, seen + [real])
+        done.add(real)
+
+    done = set()
+    follow(url, [], [])
 
 
 def _directive_index(directives: list[ModelDirective], model: str) -> tuple:

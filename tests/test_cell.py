@@ -248,3 +248,41 @@ def test_a_free_body_of_ones_own_is_refused_naming_its_model():
     assert caught.value.field == () and caught.value.cause is Cause.INVALID
     plant, instance, fields = plant_with(Cell())
     refuse_free_bodies(plant, instance, fields)  # nothing free
+
+
+@pytest.mark.parametrize("through", [False, True])
+def test_directives_files_that_include_each_other_are_refused_naming_the_chain(tmp_path, through):
+    """Drake follows add_directives without end on a cycle until it crashes (segmentation
+    fault): the files are followed first, the cycle named at the entry's line."""
+    first, second = tmp_path / "first.dmd.yaml", tmp_path / "second.dmd.yaml"
+    first.write_text(f"directives:\n- add_directives: {{file: {(second if through else first).as_uri()}}}\n")
+    second.write_text(f"directives:\n- add_directives: {{file: {first.as_uri()}}}\n")
+    path = scenario_file(tmp_path, f"cell:\n  directives:\n  - add_directives: {{file: {first.as_uri()}}}\n")
+    chain = [first.as_uri(), second.as_uri(), first.as_uri()] if through else [first.as_uri(), first.as_uri()]
+    with pytest.raises(ScenarioError, match="include each other in a cycle") as caught:
+        load_scenario(path).cell_checker()
+    assert caught.value.field == ("cell", "directives", 0, "add_directives", "file")
+    assert str(caught.value).startswith(f"{path}, line 6") and " -> ".join(chain) in str(caught.value)
+
+
+def test_directives_files_included_twice_without_a_cycle_are_used(tmp_path):
+    (tmp_path / "block.sdf").write_text(BLOCK_SDF)
+    inner = tmp_path / "inner.dmd.yaml"
+    inner.write_text(f"directives:\n- add_model: {{name: meshblock, file: {(tmp_path / 'block.sdf').as_uri()}}}\n"
+                     "- add_weld: {parent: world, child: meshblock::block, X_PC: {translation: [0.0, 1.0, 0.1]}}\n")
+    outer = tmp_path / "outer.dmd.yaml"
+    outer.write_text("directives:\n- add_model_instance: {name: a}\n- add_model_instance: {name: b}\n"
+                     f"- add_directives: {{file: {inner.as_uri()}, model_namespace: a}}\n"
+                     f"- add_directives: {{file: {inner.as_uri()}, model_namespace: b}}\n")
+    path = scenario_file(tmp_path, f"cell:\n  directives:\n  - add_directives: {{file: {outer.as_uri()}}}\n")
+    plant = load_scenario(path).cell_checker().plant
+    assert plant.HasModelInstanceNamed("a::meshblock") and plant.HasModelInstanceNamed("b::meshblock")
+
+
+def test_a_directive_model_file_that_is_a_symbolic_link_loop_is_refused_at_its_entry(tmp_path):
+    (tmp_path / "loop.sdf").symlink_to(tmp_path / "loop.sdf")
+    path = scenario_file(tmp_path, "cell:\n  directives:\n  - add_model: {name: post, file: loop.sdf}\n")
+    with pytest.raises(ScenarioError, match=r"no model file 'loop.sdf' .*symbolic link that loops") as caught:
+        load_scenario(path).cell_checker()
+    assert caught.value.field == ("cell", "directives", 0, "add_model", "file")
+    assert str(caught.value).startswith(f"{path}, line 6")
