@@ -544,8 +544,36 @@ def refuse_free_bodies(plant: MultibodyPlant, robot_instance, fields: dict | Non
     model of ``cell.directives`` (its bodies in ``fields``, :func:`add_cell`'s return) is
     named by its entry (``field`` ``("cell", "directives", k)``; the remedy an ``add_weld``),
     any other (a station's ``before_finalize`` bodies) by its model (the remedy a weld before
-    the plant is finalized). DrakeTrajError, cause INVALID; the first such body in index order."""
+    the plant is finalized). DrakeTrajError, cause INVALID; the first such body in index order.
+
+    Then a model other than the robot's with joints that move (a second arm welded beside the
+    robot): the station drives and feeds forward the robot's joints only (its controller sees
+    the robot's state, not the plant's), nothing would drive those joints, and the cell check
+    would take the model for an obstacle at its default pose. Refused naming the model and its
+    joints, at its directive where it has one."""
     fields = fields or {}
+    _refuse_floating(plant, robot_instance, fields)
+    moving = {}  # model instance -> its joints with a degree of freedom, in index order
+    for index in plant.GetJointIndices():
+        joint = plant.get_joint(index)
+        if joint.model_instance() != robot_instance and joint.num_velocities() > 0:
+            moving.setdefault(joint.model_instance(), []).append(joint)
+    for instance, joints in sorted(moving.items(), key=lambda item: int(item[0])):
+        model = plant.GetModelInstanceName(instance)
+        names = ", ".join(repr(joint.name()) for joint in joints)
+        what = (f"model {model!r} has joints that move ({names}): the station drives the robot's joints only, nothing "
+                "would hold these, and the cell check would take the model for an obstacle at its default pose")
+        field = next((fields[str(plant.get_body(body).scoped_name())] for body in plant.GetBodyIndices(instance)
+                      if str(plant.get_body(body).scoped_name()) in fields), None)
+        if field is not None and field[:2] == ("cell", "directives"):
+            raise DrakeTrajError(f"{field_text(field)}: {what}: give a model whose joints are fixed (URDF type "
+                                 "\"fixed\") for a second arm that stands still", field=field, cause=Cause.INVALID)
+        raise DrakeTrajError(f"{what}: add it with fixed joints (URDF type \"fixed\", or weld its bodies) before the "
+                             "plant is finalized", cause=Cause.INVALID)
+
+
+def _refuse_floating(plant: MultibodyPlant, robot_instance, fields: dict) -> None:
+    """:func:`refuse_free_bodies`' floating base bodies."""
     for index in sorted(plant.GetFloatingBaseBodies(), key=int):
         body = plant.get_body(index)
         if body.model_instance() == robot_instance:
@@ -559,7 +587,7 @@ def refuse_free_bodies(plant: MultibodyPlant, robot_instance, fields: dict | Non
                                  field=field, cause=Cause.INVALID)
         raise DrakeTrajError(f"{what}: weld it before the plant is finalized (in before_finalize: "
                              f"plant.WeldFrames(plant.world_frame(), plant.GetBodyByName({body.name()!r}, "
-                             f"plant.GetModelInstanceByName({model!r})).body_frame(), X_WB)), or give it a joint",
+                             f"plant.GetModelInstanceByName({model!r})).body_frame(), X_WB))",
                              cause=Cause.INVALID)
 
 

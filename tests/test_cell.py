@@ -286,3 +286,61 @@ def test_a_directive_model_file_that_is_a_symbolic_link_loop_is_refused_at_its_e
         load_scenario(path).cell_checker()
     assert caught.value.field == ("cell", "directives", 0, "add_model", "file")
     assert str(caught.value).startswith(f"{path}, line 6")
+
+
+def _second_arm(plant, scene_graph=None):
+    """A second arm (Boryga's 3-joint anthropomorphic model) welded 2 m beside the robot."""
+    from pydrake.math import RigidTransform
+    from pydrake.multibody.parsing import Parser
+
+    from drake_traj.data import data_directory
+
+    MODELS = data_directory("models")
+
+    (arm,) = Parser(plant, "second").AddModels(str(MODELS / "boryga_anthropomorphic.urdf"))
+    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("base", arm), RigidTransform([0.0, 2.0, 0.0]))
+
+
+def _free_crate(plant, scene_graph=None):
+    from pydrake.multibody.tree import SpatialInertia
+
+    plant.AddRigidBody("crate", plant.AddModelInstance("pallet"), SpatialInertia.SolidCubeWithDensity(1000.0, 0.1))
+
+
+@pytest.mark.parametrize("before_finalize, words", [
+    (_second_arm, r"^model 'second::boryga_anthropomorphic' has joints that move \('waist_joint', 'shoulder_joint', 'elbow_joint'\): the station "
+                  r"drives the robot's joints only"),
+    (_free_crate, r"^model 'pallet' is not welded to anything"),
+])
+def test_a_station_refuses_models_its_controller_does_not_drive(before_finalize, words):
+    """Was "DiagramBuilder::Connect: Mismatched vector sizes" (the feed-forward's inverse
+    dynamics takes the whole plant's state, the robot's port gives the robot's)."""
+    from drake_traj.scenario import make_planner
+    from drake_traj.station import build_station
+
+    planner = make_planner(load_scenario("quintic_ptp"))
+    with pytest.raises(DrakeTrajError, match=words) as caught:
+        build_station(planner, before_finalize=before_finalize)
+    assert caught.value.field == () and caught.value.cause is Cause.INVALID
+
+
+@pytest.mark.parametrize("weld, words", [
+    ("- add_weld: {parent: world, child: arm2::base, X_PC: {translation: [0.0, 2.0, 0.0]}}\n",
+     r"cell\.directives\[0\]: model 'arm2' has joints that move \('waist_joint', 'shoulder_joint', 'elbow_joint'\)"),
+    ("", r"cell\.directives\[0\]: model 'arm2' is not welded to anything"),
+])
+@pytest.mark.parametrize("how", ["check", "simulate"])
+def test_a_directives_arm_beside_the_robot_is_refused_at_its_directive(tmp_path, weld, words, how):
+    from drake_traj import simulate
+    from drake_traj.data import data_directory
+
+    MODELS = data_directory("models")
+    from drake_traj.scenario import check_in_cell, make_planner
+
+    path = scenario_file(tmp_path, f"cell:\n  directives:\n  - add_model: {{name: arm2, file: "
+                                   f"{MODELS / 'boryga_anthropomorphic.urdf'}}}\n  " + weld)
+    scenario = load_scenario(path)
+    with pytest.raises(DrakeTrajError, match=words) as caught:
+        check_in_cell(scenario, make_planner(scenario)) if how == "check" else simulate(scenario)
+    assert caught.value.field == ("cell", "directives", 0)
+    assert str(caught.value).startswith(f"{path}, line 6")
