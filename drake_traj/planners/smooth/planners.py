@@ -13,7 +13,7 @@ from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.planners.baselines.ruckig import jerk_limited_limits
 from drake_traj.planners.pajak import PajakConfig, PajakPlanner
-from drake_traj.planners.smooth.timing import MAX_GRID_POINTS, SmoothTiming, time_path
+from drake_traj.planners.smooth.timing import MAX_GRID_POINTS, SmoothTiming, line_timing, time_path
 from drake_traj.robots import Robot
 from drake_traj.validation import instance_of, positive_vector, whole_number
 
@@ -112,7 +112,9 @@ class SmoothWaypointsConfig:
 
 
 def make_smooth_waypoints(config: SmoothWaypointsConfig, robot: Robot, q_initial) -> SmoothPlanner:
-    """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]."""
+    """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]: one move is the
+    time-optimal jerk-limited profile along its straight line (:func:`line_timing`), several the
+    smooth timing of the spline through them (:func:`time_path`)."""
     q = start_and_goals(q_initial, config.goals, robot.num_joints)
     if len(q) - 1 > MAX_GOALS:
         raise DrakeTrajError(f"goals: {len(q) - 1} goals, at most {MAX_GOALS} (each is a knot of the path and a node of "
@@ -121,8 +123,15 @@ def make_smooth_waypoints(config: SmoothWaypointsConfig, robot: Robot, q_initial
                                                        config.jerk_limit)
     path = waypoint_path(q)
     _check_joint_range(path, robot, "goals")
-    timing = _timed(path, "goals", velocity, acceleration, jerk,
-                    whole_number(config.grid_points, "grid_points", minimum=20, maximum=MAX_GRID_POINTS))
+    grid_points = whole_number(config.grid_points, "grid_points", minimum=20, maximum=MAX_GRID_POINTS)
+    if path.get_number_of_segments() == 1 and path.get_segment_times()[-1] > 0:  # one straight move: its optimum
+        ends = path.vector_values([path.start_time(), path.end_time()]).T
+        try:
+            timing = line_timing(ends[0], ends[1], velocity, acceleration, jerk)
+        except DrakeTrajError as error:
+            raise error.relocated(("goals",), f"goals: {error}") from None
+    else:
+        timing = _timed(path, "goals", velocity, acceleration, jerk, grid_points)
     return SmoothPlanner(timing, velocity, acceleration, jerk, tool_waypoints=robot.tool_position(q[1:]))
 
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import ruckig
 import scipy.sparse
 from scipy.optimize._highspy import _core as highs  # HiGHS's own bindings, as scipy ships them
 from pydrake.trajectories import PiecewisePolynomial, Trajectory
@@ -519,6 +520,54 @@ def _deviation(path, knots, joint_coefficients, path_samples) -> float:
     q = np.einsum("kfp,kpn->kfn", powers, joint_coefficients).reshape(-1, joint_coefficients.shape[2])
     s = np.clip(np.einsum("kfp,kp->kf", powers, s_coefficients[:, :, 0]).ravel(), path.start_time(), path.end_time())
     return float(np.abs(q - path.vector_values(s).T).max())
+
+
+def line_timing(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit=None, *,
+                max_duration: float = 600.0) -> SmoothTiming:
+    """The time-optimal jerk-limited rest-to-rest motion along the straight joint segment from
+    ``q_start`` to ``q_goal`` [rad]: the seven-phase profile of the path parameter s in [0, 1]
+    (Ruckig on one degree of freedom) under the tightest of the joints' limits on s
+    (v_j / |Δq_j|, a_j / |Δq_j|, J_j / |Δq_j|), which is Ruckig's phase-synchronised motion; no
+    linear program, no stretch, exact on the line (its pieces are cubic in t). T grows with the
+    distance. Limits as :func:`time_path`'s; an :class:`InfeasibleTimingError` where the motion
+    would last longer than ``max_duration`` [s] or the segment has no length."""
+    q_start, q_goal = np.asarray(q_start, dtype=float), np.asarray(q_goal, dtype=float)
+    step = q_goal - q_start
+    n = len(step)
+    velocity = positive_vector(velocity_limit, "velocity_limit", n)
+    acceleration = positive_vector(acceleration_limit, "acceleration_limit", n)
+    jerk = default_jerk_limit(acceleration) if jerk_limit is None else positive_vector(jerk_limit, "jerk_limit", n)
+    moving = np.abs(step) > 0
+    if not moving.any():
+        raise InfeasibleTimingError("path does not move: the goal equals the start", field=("path",))
+    limits = [float(np.min(limit[moving] / np.abs(step[moving]))) for limit in (velocity, acceleration, jerk)]
+    least = max(1 / limits[0], 2 * np.sqrt(1 / limits[1]), np.cbrt(32 / limits[2]))  # as _time_path's bounds
+    if not least <= max_duration:
+        raise InfeasibleTimingError(f"the limits are too small for the path: at least {least:.4g} s, longer than "
+                                    f"max_duration {max_duration:g} s", field=("path",))
+    generator = ruckig.Ruckig(1)
+    request = ruckig.InputParameter(1)
+    request.current_position, request.target_position = [0.0], [1.0]
+    request.current_velocity = request.current_acceleration = request.target_velocity = [0.0]
+    request.target_acceleration = [0.0]
+    request.max_velocity, request.max_acceleration, request.max_jerk = [limits[0]], [limits[1]], [limits[2]]
+    profile_trajectory = ruckig.Trajectory(1)
+    if generator.calculate(request, profile_trajectory) not in (ruckig.Result.Working, ruckig.Result.Finished):
+        raise InfeasibleTimingError("the straight segment cannot be timed (Ruckig found no profile)", field=("path",))
+    phases = np.cumsum(np.concatenate([[0.0], list(profile_trajectory.profiles[0][0].t)]))
+    knots = np.unique(np.append(phases[phases < profile_trajectory.duration], profile_trajectory.duration))
+    knots = knots[np.concatenate([[True], np.diff(knots) > 1e-12])]
+    knots[-1] = profile_trajectory.duration
+    states = np.array([[value[0] for value in profile_trajectory.at_time(t)[:3]] for t in knots])  # (K, s/ṡ/s̈)
+    states[0], states[-1] = (0.0, 0.0, 0.0), (1.0, 0.0, 0.0)
+    samples = np.stack([q_start + np.outer(states[:, 0], step), np.outer(states[:, 1], step),
+                        np.outer(states[:, 2], step)], axis=1)  # (K, q/q̇/q̈, n)
+    coefficients = quintic_hermite_coefficients(knots, samples, samples)  # the cubic pieces, exactly
+    ratio = exact_peaks(knots, coefficients) / np.stack([velocity, acceleration, jerk])
+    del generator, request, profile_trajectory  # no ruckig object outlives the call
+    path = PiecewisePolynomial.FirstOrderHold([0.0, 1.0], np.column_stack([q_start, q_goal]))
+    return SmoothTiming(HermiteLaw(knots, samples, samples), piecewise_trajectory(knots, coefficients),
+                        float(knots[-1]), path, 1.0, ratio, 0.0, 0)
 
 
 def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 250,
