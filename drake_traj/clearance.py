@@ -33,11 +33,16 @@ from pydrake.trajectories import Trajectory
 from drake_traj.cell import Cell, add_cell, refuse_free_bodies
 from drake_traj.errors import Cause, DrakeTrajError, Field, PlanningError, joint_label
 from drake_traj.robots import Robot
+from drake_traj.validation import MAX_RUN_DURATION
 
 __all__ = ["CellChecker", "CollisionError", "Contact", "JointRangeError", "MotionCheck", "geometry_owner", "joint_reach",
            "planner_target_word"]
 
 RANGE_GRID = 1e-3  # [s] joint ranges are checked at the log's period
+# The most samples the cell check takes of one motion (checked before it takes them): 1000 m of
+# the arm's travel bound at the default 10 mm clearance, about 8 s of distance queries (UR10e,
+# measured); the shipped scenarios take at most 3000.
+MAX_SAMPLES = 200_000
 
 
 class CollisionError(PlanningError):
@@ -218,8 +223,14 @@ def geometry_owner(plant, inspector, geometry, robot_instance) -> tuple[str, str
 
 
 def _grid(trajectory: Trajectory) -> np.ndarray:
-    """Times [s] spanning ``trajectory`` at :data:`RANGE_GRID` (at least its two ends)."""
+    """Times [s] spanning ``trajectory`` at :data:`RANGE_GRID` (at least its two ends); a
+    trajectory longer than :data:`~drake_traj.validation.MAX_RUN_DURATION` is refused (at
+    ``planner``) before its grid is allocated."""
     start, end = trajectory.start_time(), trajectory.end_time()
+    if not end - start <= MAX_RUN_DURATION:  # NaN too
+        raise DrakeTrajError(f"the planned motion lasts {end - start:.4g} s, longer than the {MAX_RUN_DURATION:g} s a run "
+                             "may last: raise the planner's limits or give fewer targets", field=("planner",),
+                             cause=Cause.INFEASIBLE)
     return np.linspace(start, end, max(2, int(np.ceil((end - start) / RANGE_GRID)) + 1))
 
 
@@ -343,11 +354,23 @@ class CellChecker:
         more than ``spacing`` [m] (default half the clearance, at least 1 mm) between two
         samples (module docstring). The speed bound is integrated on a 1 ms grid, each step's
         |Δq_j| standing for ∫|q̇_j| dt (exact where no joint turns back inside the millisecond;
-        a 10 % margin covers the rest). ``grid`` and ``q`` (the trajectory on it) when known."""
+        a 10 % margin covers the rest). ``grid`` and ``q`` (the trajectory on it) when known.
+
+        A motion that needs more than :data:`MAX_SAMPLES` samples (an arm of absurd reach, a
+        long motion at a small clearance) is refused before any is taken: DrakeTrajError at
+        ``cell.clearance`` (cause INFEASIBLE) naming the travel and the clearance."""
         spacing = self.default_spacing() if spacing is None else float(spacing)
         grid = _grid(trajectory) if grid is None else grid
         q = trajectory.vector_values(grid).T if q is None else q
         travel = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(q, axis=0)) @ self.reach)]) * 1.1
+        if not travel[-1] / spacing <= MAX_SAMPLES:  # NaN too
+            raise DrakeTrajError(
+                f"the motion is too long to check in the cell: its points travel up to {travel[-1]:.4g} m (the joints' "
+                f"turns times the arm's reach outboard of each, {float(np.max(self.reach)):.4g} m at most), which at "
+                f"cell.clearance = {self.clearance * 1e3:g} mm (samples {spacing * 1e3:g} mm of travel apart) takes "
+                f"{travel[-1] / spacing:.3g} samples, more than the {MAX_SAMPLES} the check takes: split the motion, "
+                "raise cell.clearance, or check the arm's lengths", field=("cell", "clearance"),
+                cause=Cause.INFEASIBLE)
         count = int(np.ceil(travel[-1] / spacing))
         times = np.interp(np.linspace(0.0, travel[-1], count + 1), travel, grid) if count else grid[:1]
         return np.unique(np.concatenate([times, grid[[0, -1]]]))

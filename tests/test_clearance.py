@@ -23,6 +23,8 @@ from drake_traj.planners import make_planner as planner_from_config
 from drake_traj.robots import UR10E
 from drake_traj.scenario import check_in_cell, preflight, shipped_scenarios
 
+from conftest import DIAGRAMS
+
 HOME = UR10E.home_configuration
 
 
@@ -294,3 +296,62 @@ def test_a_failure_from_a_planning_error_says_its_time_once():
     assert failure.message.count("t = 1.2500 s") == 1 and failure.message.startswith("PlanningError: the law stalled")
     other = Failure.from_exception(ValueError("singular"), 0.4)  # an error that gives no time: the run's
     assert other.message == "ValueError at t = 0.4000 s: singular"
+
+
+def test_a_motion_too_long_to_sample_is_refused_before_it_is_sampled():
+    """The samples are spaced by the arm's travel: 150 rad of joint 1 (about 1.5 m of reach) at a
+    zero clearance (1 mm apart) needs over 200 000 of them; refused naming the travel and the
+    clearance, at once."""
+    import time
+
+    from drake_traj.clearance import MAX_SAMPLES
+    from drake_traj.errors import DrakeTrajError
+
+    checker = CellChecker(UR10E, Cell(clearance=0.0))
+    end = HOME + np.array([150.0, 0, 0, 0, 0, 0])
+    motion = PiecewisePolynomial.FirstOrderHold([0.0, 100.0], np.column_stack([HOME, end]))
+    start = time.perf_counter()
+    with pytest.raises(DrakeTrajError, match=rf"the motion is too long to check in the cell: its points travel up to "
+                                             rf"[\d.]+ m .*cell.clearance = 0 mm .*more than the {MAX_SAMPLES} the check "
+                                             r"takes") as caught:
+        checker.sample_times(motion)
+    assert time.perf_counter() - start < 2.0
+    assert caught.value.field == ("cell", "clearance") and caught.value.cause is Cause.INFEASIBLE
+    short = PiecewisePolynomial.FirstOrderHold([0.0, 1.0], np.column_stack([HOME, HOME + 0.05]))
+    assert 2 < len(checker.sample_times(short)) < 1000
+
+
+def test_a_motion_longer_than_a_run_is_refused_before_its_grid_is_made():
+    from drake_traj.errors import DrakeTrajError
+
+    motion = PiecewisePolynomial.FirstOrderHold([0.0, 1e9], np.column_stack([HOME, HOME + 0.5]))
+    with pytest.raises(DrakeTrajError, match=r"the planned motion lasts 1e\+09 s, longer than the 600 s") as caught:
+        CellChecker(UR10E).check(motion)
+    assert caught.value.field == ("planner",)
+
+
+def test_an_arm_of_absurd_reach_is_refused_in_an_instant(tmp_path):
+    """A !DhArm with d1 = 1e6 m took 141 s in the cell check of a 0.05 rad move: refused at its
+    length, in the scenario and from Python (ChainArm.from_dh)."""
+    import time
+
+    from drake_traj.errors import DrakeTrajError
+    from drake_traj.robots.chain_arm import ChainArm
+
+    puma = load_scenario(DIAGRAMS / "puma560.yaml", "quintic")
+    table = [list(row) for row in puma.robot.dh]
+    table[0][0] = 1e6
+    with pytest.raises(ValueError, match=r"the links reach 1e\+06 m end to end .* above the 20 m a model may reach; the "
+                                         r"longest is table\[0\]\[0\] = 1e\+06 m \(d\)") as caught:
+        ChainArm.from_dh("huge", table, masses=puma.robot.masses, lower_limits=puma.robot.lower,
+                         upper_limits=puma.robot.upper, velocity_limits=1.0, acceleration_limits=2.0,
+                         effort_limits=100.0)
+    assert caught.value.field == ("table", 0, 0)
+    text = (DIAGRAMS / "puma560.yaml").read_text().replace("- [0.672, 0.0,", "- [1.0e6, 0.0,", 1)
+    (tmp_path / "huge.yaml").write_text(text)
+    start = time.perf_counter()
+    with pytest.raises(DrakeTrajError, match=r"robot.dh: the links reach 1e\+06 m") as caught:
+        load_scenario(tmp_path / "huge.yaml", "quintic")
+    assert time.perf_counter() - start < 2.0
+    assert caught.value.field == ("robot", "dh", 0, 0)
+    assert str(caught.value).startswith(f"{tmp_path / 'huge.yaml'}, line 13")

@@ -20,6 +20,11 @@ __all__ = ["ARM_JOINTS", "arm_name", "inertia_rows", "joint_vector", "link_radiu
            "payload", "ranges", "scenario_message", "unbounded_joints"]
 
 ARM_JOINTS = 6  # a custom arm has six revolute joints
+# [m] The most a DH arm's links may reach end to end (the sum over its rows of sqrt(d² + a²)):
+# the largest industrial arms reach under 5 m; lengths beyond this are a typo (mm for m) whose
+# model the cell check would sample without end.
+MAX_REACH = 20.0
+MAX_LINK_RADIUS = 1.0  # [m] a link capsule's radius
 _NAME_CHARACTERS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-")
 
 
@@ -107,7 +112,21 @@ def link_radius(value, name: str) -> float:
     radius = finite_array(value, name, "m", shape=())
     if radius <= 0:
         raise invalid(name, f"{name} must be positive [m], got {float(radius):g}")
+    if radius > MAX_LINK_RADIUS:
+        raise invalid(name, f"{name} = {float(radius):g} m is above the {MAX_LINK_RADIUS:g} m a link's capsule may have")
     return float(radius)
+
+
+def dh_reach(table: np.ndarray, name: str) -> None:
+    """Refuse a DH table (rows [d, a, alpha, offset]) whose links reach more than
+    :data:`MAX_REACH` end to end, at its largest length ``name[i][k]``."""
+    lengths = np.abs(table[:, :2])
+    reach = float(np.sum(np.hypot(lengths[:, 0], lengths[:, 1])))
+    if reach > MAX_REACH:
+        i, k = (int(v) for v in np.unravel_index(np.argmax(lengths), lengths.shape))
+        raise invalid(name, f"{name}: the links reach {reach:.4g} m end to end (the sum of sqrt(d^2 + a^2) over the rows), "
+                            f"above the {MAX_REACH:g} m a model may reach; the longest is {name}[{i}][{k}] = "
+                            f"{table[i, k]:g} m ({'d' if k == 0 else 'a'}): lengths are in metres", i, k)
 
 
 # a limit's unit, for the messages of missing_limit

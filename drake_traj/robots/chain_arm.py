@@ -222,6 +222,7 @@ class ChainArm(Robot):
                 disagree, and the errors of the other constructors.
         """
         chain = SerialChain.from_dh(table, convention)
+        arm_checks.dh_reach(np.asarray(table, dtype=float), "table")  # an absurd model before it is written
         if model_file is not None:
             path = path_argument(model_file, "model_file")
             return cls.from_plant(_parsed(path), base_frame=base_frame, tool_frame=tool_frame, name=name,

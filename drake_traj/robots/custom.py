@@ -154,6 +154,7 @@ class DhArm:
             raise invalid(f"{prefix}.convention", f"{prefix}.convention must be one of {CONVENTIONS}, "
                                                   f"got {self.convention!r:.40}")
         table = matrix(self.dh, f"{prefix}.dh", "m, m, rad, rad", 4, required=True)
+        arm_checks.dh_reach(table, f"{prefix}.dh")
         return dict(
             name=arm_name(self.name, f"{prefix}.name"), convention=self.convention, table=table,
             **_joint_data(self, prefix, required=True),
