@@ -24,6 +24,8 @@ from drake_traj.planners.quintic import (
     synchronized_duration,
 )
 
+from conftest import DIAGRAMS
+
 SQRT3 = math.sqrt(3.0)
 # Normalised times of the acceleration peaks: s = 1/2 -+ sqrt(3)/6.
 S_ACC_PEAKS = (0.5 - SQRT3 / 6.0, 0.5 + SQRT3 / 6.0)
@@ -528,3 +530,35 @@ def test_scalar_rates_match_the_vectorised_sample():
         rate, acceleration = plan.rates_at(float(t))
         np.testing.assert_allclose(rate, qd[row], rtol=1e-12, atol=1e-12)
         np.testing.assert_allclose(acceleration, qdd[row], rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("limit, field, pattern", [
+    (dict(velocity_limit=[1e-9, 1, 1, 1, 1, 1]), ("velocity_limit", 0),
+     r"^velocity_limit\[0\] = 1e-09 rad/s \(joint 1\) makes the move to goal 0 \(0\.5 rad on that joint\) last "
+     r"9\.375e\+08 s, ending at t = 9\.375e\+08 s, after the 600 s a run may last"),
+    (dict(acceleration_limit=[1, 1, 1e-9, 1, 1, 1]), ("acceleration_limit", 2),
+     r"^acceleration_limit\[2\] = 1e-09 rad/s\^2 \(joint 3\) makes the move to goal 1"),
+])
+def test_a_plan_longer_than_a_run_is_refused_at_the_limit_that_makes_it(limit, field, pattern):
+    """Was "MemoryError: Unable to allocate 698. GiB" where the duration set an array's length."""
+    from drake_traj.errors import Cause, DrakeTrajError
+
+    start = np.zeros(6)
+    goals = [[0.5, 0.0, 0.0, 0.0, 0.0, 0.0], [0.5, 0.0, 0.5, 0.0, 0.0, 0.0]]
+    limits = dict(velocity_limit=[1.0] * 6, acceleration_limit=[1.0] * 6) | limit
+    with pytest.raises(DrakeTrajError, match=pattern) as caught:
+        plan_synchronized_quintic(start, goals, **limits)
+    assert caught.value.field == field and caught.value.cause is Cause.INFEASIBLE
+    plan_synchronized_quintic(start, goals, velocity_limit=[5e-3] * 6, acceleration_limit=[1.0] * 6)  # 375 s: planned
+
+
+def test_a_scenarios_limit_too_small_for_a_run_is_refused_at_its_line(tmp_path):
+    from drake_traj import cli, load_scenario
+    from drake_traj.scenario import make_planner
+
+    text = (DIAGRAMS / "quintic_ptp.yaml").read_text()
+    path = tmp_path / "slow.yaml"
+    path.write_text(text.replace("velocity_limit: [1.05,", "velocity_limit: [1.0e-9,", 1))
+    with pytest.raises(ValueError, match=r"line 12, column \d+: planner.velocity_limit\[0\] = 1e-09 rad/s \(joint 1\)"):
+        make_planner(load_scenario(path))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out")]) == 2

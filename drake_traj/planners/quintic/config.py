@@ -2,6 +2,7 @@
 
 from dataclasses import dataclass, field
 
+from drake_traj.errors import DrakeTrajError
 from drake_traj.planners.quintic.law import plan_synchronized_quintic
 from drake_traj.planners.quintic.system import QuinticPtpPlanner
 from drake_traj.robots import Robot
@@ -33,6 +34,13 @@ def make(config: QuinticConfig, robot: Robot, q_initial) -> QuinticPtpPlanner:
     velocity = limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", robot.num_joints)
     acceleration = limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit",
                                     robot.num_joints)
-    plan = plan_synchronized_quintic(q_initial, config.goals, velocity, acceleration,
-                                     position_lower=robot.lower_limits, position_upper=robot.upper_limits)
+    try:
+        plan = plan_synchronized_quintic(q_initial, config.goals, velocity, acceleration,
+                                         position_lower=robot.lower_limits, position_upper=robot.upper_limits)
+    except DrakeTrajError as error:  # a limit not given is the robot's: say so
+        name = error.field[0] if error.field else None
+        if name in ("velocity_limit", "acceleration_limit") and not len(getattr(config, name)):
+            raise error.relocated(error.field, f"{error} (not given: the {robot.name} robot's joint-move limit; give "
+                                               f"{name})") from None
+        raise
     return QuinticPtpPlanner(plan, velocity, acceleration, robot=robot)

@@ -8,9 +8,10 @@ from typing import ClassVar
 
 import numpy as np
 
-from drake_traj.errors import field_text, joint_label
-from drake_traj.planners.quintic.profile import UNITS, quintic_profile, quintic_third_derivative, synchronized_duration
-from drake_traj.validation import invalid, joint_bound, joint_limit, real_array, require_finite
+from drake_traj.errors import Cause, DrakeTrajError, field_text, joint_label
+from drake_traj.planners.quintic.profile import (UNITS, joint_minimum_times, quintic_profile, quintic_third_derivative,
+                                                 synchronized_duration)
+from drake_traj.validation import MAX_RUN_DURATION, invalid, joint_bound, joint_limit, real_array, require_finite
 
 __all__ = ["QuinticLaw", "QuinticSegment", "plan_synchronized_quintic"]
 
@@ -233,6 +234,20 @@ class QuinticLaw:
         return jerk.reshape(shape + (self.num_joints,))
 
 
+def _too_long(k: int, d: np.ndarray, kv: np.ndarray, ka: np.ndarray, t: float, t_f: float) -> DrakeTrajError:
+    """The refusal of a plan whose move to goal ``k`` (displacement ``d``, ``t_f`` [s], from
+    ``t`` [s]) ends after :data:`MAX_RUN_DURATION`, at the limit of the joint that makes it so
+    long (cause INFEASIBLE)."""
+    times = np.asarray(joint_minimum_times(d, kv, ka))
+    j = int(np.argmax(times))
+    by_velocity = 15.0 / 8.0 * abs(d[j]) / kv[j] >= times[j]
+    name, value, unit = ("velocity_limit", kv[j], "rad/s") if by_velocity else ("acceleration_limit", ka[j], "rad/s^2")
+    return DrakeTrajError(
+        f"{name}[{j}] = {value:g} {unit} ({joint_label(j)}) makes the move to goal {k} ({abs(d[j]):.4g} rad on that "
+        f"joint) last {t_f:.4g} s, ending at t = {t + t_f:.4g} s, after the {MAX_RUN_DURATION:g} s a run may last: "
+        "raise it", field=(name, j), cause=Cause.INFEASIBLE)
+
+
 def plan_synchronized_quintic(
     q_start,
     goals,
@@ -267,7 +282,10 @@ def plan_synchronized_quintic(
     Raises:
         ValueError: wrong shapes, non-finite values, non-positive limits, position_lower above
             position_upper, or q_start / a goal outside the position bounds. The message names the
-            argument (and the goal index and joint where relevant).
+            argument (and the goal index and joint where relevant). A plan longer than
+            :data:`~drake_traj.validation.MAX_RUN_DURATION` (600 s) is refused at the
+            ``velocity_limit`` or ``acceleration_limit`` of the joint that makes it so long
+            (DrakeTrajError, cause INFEASIBLE).
     """
     q0 = real_array(q_start, "q_start", UNITS)
     if q0.ndim != 1 or q0.size == 0:
@@ -314,6 +332,8 @@ def plan_synchronized_quintic(
         if not np.any(d != 0.0):
             continue  # already there: no segment, no division by a zero duration
         t_f = synchronized_duration(d, kv, ka)  # eq. 9 per joint, second eq. 8 over joints
+        if t + t_f > MAX_RUN_DURATION:  # before anything sized by the duration is allocated
+            raise _too_long(len(segments), d, kv, ka, t, t_f)
         segments.append(QuinticSegment(current, goal, t, t_f))
         t = segments[-1].t_end
         current = goal
