@@ -111,6 +111,24 @@ def test_bad_task_names_the_field():
         P.PajakPlanner(P.paper_parameters(3), Q0[:5])
 
 
+def test_a_task_done_at_the_start_is_refused_at_its_waypoints(tmp_path):
+    """Was "RuntimeError: Segment number 0 out of range [0, 0)" (an empty plan) from the cell check."""
+    from drake_traj import cli
+    from drake_traj.robots import UR10E
+
+    start = UR10E.tcp_pose(Q0).tolist()
+    planner = P.PajakPlanner(P.PajakConfig(waypoints=[start]), Q0)
+    with pytest.raises(PlanningError, match=r"^the task has nothing to do: the start pose is already the only "
+                                            r"waypoint") as caught:
+        planner.plan()
+    assert caught.value.field == ("waypoints",) and caught.value.cause is Cause.INVALID
+    path = tmp_path / "start.yaml"
+    path.write_text(f"name: start\nrobot: ur10e\nplanner: !PajakConfig\n  waypoints:\n    - {start}\n")
+    with pytest.raises(PlanningError, match=rf"^{path}, line 5, column 5: planner.waypoints: the task has nothing to do"):
+        simulate(load_scenario(path))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
+
+
 class SpeedStep(LeafSystem):
     """1 until ``at`` [s], then ``value``: a speed override stepping down mid-motion."""
 

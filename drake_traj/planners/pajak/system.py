@@ -169,7 +169,8 @@ class PajakPlanner(TimeLawPlanner):
         periods).
 
         Raises the :class:`PlanningError` that the motion would end with: a waypoint out of
-        reach (before integrating), a stall, gimbal lock, non-finite values or no finish within
+        reach (before integrating), a task done at the start (at ``waypoints``, cause INVALID: no
+        motion to plan), a stall, gimbal lock, non-finite values or no finish within
         ``horizon`` (cause TIMEOUT), naming the time, the configuration and the cause (the stall
         message names the waypoint). A run that finishes has reached the whole pose (position
         within ε, orientation within ``orientation_accuracy``).
@@ -188,14 +189,21 @@ class PajakPlanner(TimeLawPlanner):
                                            f"{MAX_PREFLIGHT_STEPS:.0e}: raise update_period or lower max_duration")
         if self._run is None:
             try:
-                self._run = integrate(self.pajak_law, self.initial_positions(), dt=update_period, t_max=horizon,
-                                      settle_time=SETTLE_TIME)
+                run = integrate(self.pajak_law, self.initial_positions(), dt=update_period, t_max=horizon,
+                                settle_time=SETTLE_TIME)
             except PlanningError as error:
                 if error.cause is not Cause.TIMEOUT:
                     raise
                 raise PlanningError(f"the task did not finish within {horizon:g} s, the preflight's horizon (the run's "
                                     "max_duration)", time=error.time, configuration=error.configuration,
                                     cause=Cause.TIMEOUT, partial=error.partial) from None
+            if run["finish_index"] == 0:  # done at t = 0: no motion to plan, check or run
+                count = len(self.pajak_law.waypoints)
+                which = "the only waypoint" if count == 1 else f"every one of the {count} waypoints"
+                raise PlanningError(f"the task has nothing to do: the start pose is already {which} (within "
+                                    "accuracy and orientation_accuracy); give a waypoint the tool moves to",
+                                    field=("waypoints",), cause=Cause.INVALID)
+            self._run = run
         elif self._run["T"] > horizon:
             raise PlanningError(f"the task takes {self._run['T']:.3f} s, longer than {horizon:g} s, the preflight's "
                                 "horizon (the run's max_duration)", cause=Cause.TIMEOUT)
