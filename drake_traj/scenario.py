@@ -25,6 +25,7 @@ import re
 
 import numpy as np
 from pydrake.common.yaml import yaml_load_typed
+from pydrake.math import RollPitchYaw, RotationMatrix
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
@@ -38,7 +39,8 @@ from drake_traj.planners import PLANNER_CONFIGS, PlannerConfig, PlannerSystem, Q
 from drake_traj.planners import make_planner as make_planner_from_config
 from drake_traj.result import DEFAULT_TRACKING_TOLERANCE
 from drake_traj.robots import Robot
-from drake_traj.robots.custom import RobotChoice, resolve_robot, robot_label
+from drake_traj.robots.base import joint_actuators
+from drake_traj.robots.custom import CustomArm, DhArm, RobotChoice, resolve_robot, robot_label
 from drake_traj.validation import (MAX_RUN_DURATION, flag, instance_of, invalid, log_period_check, path_argument,
                                    real_array, realtime_rate, run_duration, settle_duration, step_size,
                                    tracking_tolerance_check)
@@ -47,7 +49,7 @@ from drake_traj.yaml_schema import ScenarioError, checked_document, locate
 __all__ = [
     "ControllerGains", "Scenario", "ScenarioError", "ScenarioSource", "ShippedScenario", "SpeedOverride",
     "default_plant_config", "default_scenario_path", "default_simulator_config", "find_scenario", "load_scenario",
-    "check_planned_duration", "locate_in_scenario", "make_planner", "preflight", "scenario_variants",
+    "check_cell_tcp", "check_planned_duration", "check_start_torques", "locate_in_scenario", "make_planner", "preflight", "scenario_variants",
     "shipped_scenarios",
 ]
 
@@ -265,7 +267,7 @@ class Scenario:
             raise invalid("plant", f"plant: {error}") from None
         self.controller.for_robot(robot)
         self.speed_override.validate()
-        self.cell.validate(robot)
+        self.checked_cell().validate(robot)
         tracking_tolerance_check(self.tracking_tolerance, self.cell.clearance)
         self.robot_with_tool()
 
@@ -279,13 +281,24 @@ class Scenario:
     def robot_with_tool(self) -> Robot:
         """The scenario's robot whose tool point is ``cell.tool``'s TCP (:meth:`Robot.with_tcp`):
         every task pose of the planner, the station's TCP and the result's are the TCP's. A
-        refusal (a point robot given an offset) names ``cell.tool.tcp_xyz``."""
-        tool = self.cell.tool
+        refusal (a point robot given an offset) names ``cell.tool.tcp_xyz``; the robot's own errors
+        name its field (``robot.dh``), a ``cell`` that is not a Cell names ``cell``."""
+        robot = self.base_robot()  # its errors at the robot's field, not the tool's
+        tool = self.checked_cell().tool
         try:
-            return self.base_robot().with_tcp(tool.tcp_xyz, tool.tcp_rpy)
+            return robot.with_tcp(tool.tcp_xyz, tool.tcp_rpy)
         except DrakeTrajError as error:
             field = ("cell", "tool", "tcp_" + str(error.field[0])) if error.field else ("cell", "tool", "tcp_xyz")
             raise error.relocated(field, f"{field_text(field)}: {error}") from None
+
+    def checked_cell(self) -> Cell:
+        """``cell``, or a TypeError naming ``cell`` and the expected type when it is not a Cell
+        (``scenario.cell = "table"``), located in the scenario's file when read from one."""
+        if not isinstance(self.cell, Cell):
+            raise TypeError(locate_in_scenario(self, ("cell",), f"cell must be a drake_traj.cell.Cell (a table, obstacles, "
+                                                                f"the tool: Cell(mounting=Table(), ...)), got "
+                                                                f"{type(self.cell).__name__}: {self.cell!r:.80}"))
+        return self.cell
 
     def directory(self) -> Path | None:
         """The folder of the scenario's file (relative model files of ``cell.directives`` are
@@ -523,12 +536,85 @@ def check_in_cell(scenario: Scenario, planner: PlannerSystem, checker: CellCheck
     :class:`~drake_traj.clearance.MotionCheck`."""
     checker = checker or scenario.cell_checker()
     try:
+        check_start_torques(checker, planner.initial_positions(), field=lambda j: _torque_field(scenario, j))
+    except DrakeTrajError as error:
+        raise error.relocated(error.field, locate_in_scenario(scenario, error.field, str(error))) from None
+    try:
         return checker.check_planner(planner, start_field=("q_initial",) if len(scenario.q_initial) else ("planner",))
     except DrakeTrajError as error:
         field = error.field or ("planner",)
         if field[0] in {item.name for item in fields(scenario.planner)}:  # a planner that plans in the cell: its goals
             field = ("planner", *field)
         raise error.relocated(field, locate_in_scenario(scenario, field, str(error))) from None
+
+
+def check_cell_tcp(robot: Robot, cell: Cell) -> None:
+    """A DrakeTrajError at ``cell.tool.tcp_xyz`` (or ``tcp_rpy``) when ``cell``'s tool has another
+    TCP than ``robot`` (:attr:`Robot.tcp_offset`, set by :meth:`Robot.with_tcp`): the planner
+    plans, and the station logs, the robot's TCP, so the cell's would be ignored without a word.
+    Both TCPs named, and how to make them one."""
+    tool = cell.tool
+    given = tool.tcp().GetAsMatrix4()
+    if np.allclose(given, robot.tcp_offset, rtol=0.0, atol=1e-12):
+        return
+    xyz = np.asarray(robot.tcp_offset)[:3, 3]
+    rpy = RollPitchYaw(RotationMatrix(np.asarray(robot.tcp_offset)[:3, :3])).vector()
+    field = ("cell", "tool", "tcp_xyz" if not np.allclose(given[:3, 3], xyz, rtol=0.0, atol=1e-12) else "tcp_rpy")
+
+    def numbers(values) -> str:
+        return "[" + ", ".join(f"{float(value) + 0.0:.6g}" for value in values) + "]"  # + 0.0: no -0
+
+    raise DrakeTrajError(
+        f"{field_text(field)}: the cell's tool has its TCP at tcp_xyz {numbers(tool.tcp_xyz)} m, tcp_rpy "
+        f"{numbers(tool.tcp_rpy)} rad, but the planner's robot {robot.name} has its TCP at xyz {numbers(xyz)} m, rpy "
+        f"{numbers(rpy)} rad (robot.tcp_offset) in the flange frame: the planner plans and the run logs the robot's "
+        "TCP. Make the planner for robot.with_tcp(cell.tool.tcp_xyz, cell.tool.tcp_rpy) (make_planner(config, "
+        "robot.with_tcp(...), q_initial); a scenario's: scenario.robot_with_tool()), or give the cell the robot's TCP",
+        field=field)
+
+
+def check_start_torques(checker: CellChecker, q, field=None) -> None:
+    """A DrakeTrajError (cause SATURATION) when a joint's drive cannot hold the start
+    configuration ``q`` against gravity: the gravity torque there (Drake's
+    ``CalcGravityGeneralizedForces`` in ``checker``'s plant: the robot, its tool and payload) above
+    the joint's effort limit, the first such joint named with both numbers. The drive would
+    saturate from t = 0 and the arm sag, a failure the run would report later as whatever the
+    falling arm hits. ``field(j)`` gives the error's field for joint ``j`` (default: the
+    payload's ``cell.tool.mass`` when there is one, else ``robot``)."""
+    plant, instance, robot = checker.plant, checker.instance, checker.robot
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, instance, np.asarray(q, dtype=float))
+    gravity = plant.CalcGravityGeneralizedForces(context)
+    actuators = joint_actuators(plant, instance)
+    mass = float(checker.cell.tool.mass)
+    for j, name in enumerate(robot.joint_names):
+        actuator = actuators.get(name)
+        if actuator is None:
+            continue
+        needed = -float(gravity[actuator.joint().velocity_start()])
+        limit = float(actuator.effort_limit())
+        if abs(needed) <= limit:
+            continue
+        unit = "N m" if robot.joint_unit(j) == "rad" else "N"
+        where = field(j) if field is not None else (("cell", "tool", "mass") if mass > 0 else ("robot",))
+        payload = f" with the tool's {mass:g} kg payload" if mass > 0 else ""
+        raise DrakeTrajError(
+            f"{field_text(where)}: {joint_label(j, robot.joint_names)} of the {robot.name} cannot hold the start "
+            f"configuration against gravity{payload}: it needs {needed:.4g} {unit} there, beyond its effort limit of "
+            f"±{limit:.4g} {unit}, so its drive saturates from t = 0 and the arm falls; raise the effort limit, lighten "
+            "the payload or bring its centre of mass closer to the flange, or start in another configuration",
+            field=where, cause=Cause.SATURATION)
+
+
+def _torque_field(scenario: Scenario, j: int) -> Field:
+    """The field a start that the drives cannot hold is refused at: the arm's own effort limit
+    where the scenario gives it, else the payload where there is one, else the start."""
+    arm = scenario.robot
+    if isinstance(arm, (DhArm, CustomArm)) and len(arm.effort_limits):
+        return ("robot", "effort_limits", j)
+    if scenario.cell.tool.mass > 0:
+        return ("cell", "tool", "mass")
+    return ("q_initial",) if len(scenario.q_initial) else ("robot",)
 
 
 def check_planned_duration(scenario: Scenario, planner: PlannerSystem) -> None:

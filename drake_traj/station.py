@@ -51,8 +51,8 @@ from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationRes
 from drake_traj.robots import UR10E, Robot
 from drake_traj.robots.base import joint_actuators
 from drake_traj.robots.custom import robot_label
-from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, check_planned_duration, default_plant_config,
-                                 default_simulator_config)
+from drake_traj.scenario import (ControllerGains, Scenario, SpeedOverride, check_cell_tcp, check_planned_duration,
+                                 check_start_torques, default_plant_config, default_simulator_config)
 from drake_traj.scenario import preflight as scenario_preflight
 from drake_traj.validation import (callable_or_none, flag, instance_of, invalid, log_period_check, positive_scalar,
                                    real_scalar, realtime_rate, run_duration, settle_duration, step_size,
@@ -510,6 +510,7 @@ def simulate(
     robot = station_robot(planner, robot)
     if cell is not None:
         instance_of(cell, Cell, "cell")
+        check_cell_tcp(robot, cell)  # the cell's TCP is the robot's, or it would be ignored
     # checked before the planner goes into a diagram (a planner is used in one diagram only)
     instance_of(name, str, "name")
     if simulator_config is not None:
@@ -532,7 +533,9 @@ def simulate(
         scenario_preflight(scenario, planner, max_duration)  # its errors located in the scenario file
     elif preflight:
         planner.preflight(max_duration)
-        CellChecker(robot, cell, cell_directory).check_planner(planner)
+        checker = CellChecker(robot, cell, cell_directory)
+        check_start_torques(checker, planner.initial_positions())  # drives that cannot hold the start
+        checker.check_planner(planner)
     if scenario is not None:
         check_planned_duration(scenario, planner)
     builder = DiagramBuilder()
