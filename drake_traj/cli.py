@@ -48,7 +48,8 @@ from drake_traj.refusal import refusal_figure
 from drake_traj.result import SimulationResult
 from drake_traj.robots import ROBOT_NAMES, get_robot
 from drake_traj.output import WriteError, locked, working_folder
-from drake_traj.rundir import MANIFEST, add_to_manifest, claim_run_folder, run_files, write_manifest
+from drake_traj.rundir import (MANIFEST, REFUSAL, add_to_manifest, claim_run_folder, earlier_run, run_files,
+                               write_manifest)
 from drake_traj.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
                                  load_scenario, preflight, scenario_variants, shipped_scenarios)
 from drake_traj.station import simulate
@@ -203,15 +204,23 @@ def with_refusal_picture(error: CollisionError, scenario, args) -> CollisionErro
         draw_refusal(meshcat, checker, error)
         print(f"drake-traj: the refused configuration is drawn at {meshcat.web_url()}", file=sys.stderr, flush=True)
         serve_recording(meshcat.web_url(), args.serve_after)
+    failure = Failure(error.cause, str(error), error.time, tuple(error.configuration.tolist())).to_dict()
     try:
-        with claim_run_folder(_run_folder(args, scenario), overwrite=args.overwrite, command=args.command_line) as claimed, \
-                claimed.replace() as staging:
-            picture = staging.write("refusal.png", lambda path: refusal_figure(checker, error).savefig(path, dpi=100))
-            write_manifest(staging, [picture.name], scenario=scenario.name, drake_traj=__version__,
-                           failure=Failure(error.cause, str(error), error.time, tuple(error.configuration.tolist())).to_dict())
+        with claim_run_folder(_run_folder(args, scenario), overwrite=args.overwrite, command=args.command_line) as claimed:
+            earlier = earlier_run(claimed.directory)  # kept: a refusal never replaces a run
+            with claimed.replace(keep_earlier=earlier is not None) as staging:
+                picture = staging.write(REFUSAL, lambda path: refusal_figure(checker, error).savefig(path, dpi=100))
+                if earlier is None:
+                    write_manifest(staging, [picture.name], scenario=scenario.name, drake_traj=__version__,
+                                   failure=failure)
+                else:  # the earlier run's manifest, listing the picture too (replacing the run removes it)
+                    details = {key: value for key, value in earlier.items() if key != "files"}
+                    details["refusal"] = {"scenario": scenario.name, "drake_traj": __version__, "failure": failure}
+                    write_manifest(staging, [*earlier["files"], picture.name], **details)
     except DrakeTrajError as reason:
         return error.relocated(error.field, f"{error}\n(no picture of the refused configuration: {reason})")
-    return error.relocated(error.field, f"{error}\n(picture of the refused configuration: {picture})")
+    kept = "" if earlier is None else f"; the earlier run in {claimed.directory} is kept, the picture beside it"
+    return error.relocated(error.field, f"{error}\n(picture of the refused configuration: {picture}{kept})")
 
 
 def serve_recording(url: str, seconds: float | None) -> None:
@@ -304,6 +313,8 @@ def export_run(args) -> int:
     into_run = out.parent.resolve() == run_dir.resolve()
     if into_run and out.name in {"result.npz", "metrics.json", MANIFEST} | set(run_files(run_dir)) - set(_exports()):
         raise ExportError(f"--out {out} is one of the run's own files; give another file name")
+    if out.is_dir():  # before the advice to overwrite: a folder is never replaced by a file
+        raise ExportError(f"--out {out} is a folder; give a file name, e.g. --out {out / f'reference{FORMATS[args.format]}'}")
     if out.exists() and not args.overwrite:
         raise ExportError(f"--out {out} exists; pass --overwrite to replace it")
     # into the run's own folder: locked, so that no run replaces the folder meanwhile

@@ -246,16 +246,20 @@ class Claim:
         self.release()
 
     @contextlib.contextmanager
-    def replace(self):
+    def replace(self, *, keep_earlier: bool = False):
         """Yields a :class:`Staging`: the new content is written there; when the block ends
         without an error it replaces the folder's earlier content (files listed by
-        ``earlier_files``), else it is removed and the earlier content stays. An OSError
-        while writing is a :class:`WriteError` naming the file."""
+        ``earlier_files``), else it is removed and the earlier content stays. With
+        ``keep_earlier``, the new files are added beside the earlier content instead, replacing
+        only the files of the same names (a refusal's picture and manifest beside an earlier run).
+        An OSError while writing is a :class:`WriteError` naming the file."""
         staging = Staging(self.directory, self.kind)
         try:
             yield staging
             earlier = []
-            if folder_kind(self.directory) == self.kind:
+            if keep_earlier:
+                earlier = list(staging.files)
+            elif folder_kind(self.directory) == self.kind:
                 earlier = list(dict.fromkeys([*self._earlier_files(self.directory), *FOLDER_KINDS[self.kind]]))
             staging.commit(earlier)
         finally:

@@ -12,10 +12,12 @@ other files, not a run (a bench, say), is never written into.
 import json
 from pathlib import Path
 
-from drake_traj.output import FOLDER_KINDS, OutputError, claim, write_file
+from drake_traj.output import FOLDER_KINDS, OutputError, claim, folder_kind, write_file
 
-__all__ = ["MANIFEST", "OutputError", "add_to_manifest", "claim_run_folder", "estimated_size", "manifest_text",
-           "run_files", "write_manifest"]
+__all__ = ["MANIFEST", "REFUSAL", "OutputError", "add_to_manifest", "claim_run_folder", "earlier_run", "estimated_size",
+           "manifest_text", "run_files", "write_manifest"]
+
+REFUSAL = "refusal.png"  # the picture of a refused motion, with a manifest naming the refusal
 
 # the manifest, and the files a run written before manifests is recognised by
 MANIFEST, *_RUN_FILES = FOLDER_KINDS["run"]
@@ -52,6 +54,22 @@ def run_files(directory: Path) -> list[str]:
                               "remove them by hand") from None
     return [path.name for path in directory.iterdir()
             if path.name in _RUN_FILES or path.suffix == ".png" or path.name == "meshcat.html"]
+
+
+def earlier_run(directory) -> dict | None:
+    """What ``run.json`` of the run in ``directory`` holds (``files``: :func:`run_files`, and the
+    rest of its manifest, if any) when the folder holds a run that is more than a refusal's
+    picture; else None. A refusal is written beside such a run and never replaces it. The caller
+    holds the folder's lock."""
+    directory = Path(directory)
+    if not directory.is_dir() or folder_kind(directory) != "run":
+        return None
+    files = run_files(directory)
+    if not set(files) - {REFUSAL} and not any((directory / name).exists() for name in _RUN_FILES):
+        return None  # an earlier refusal: a new one replaces it
+    manifest = directory / MANIFEST
+    details = json.loads(manifest.read_text()) if manifest.is_file() else {}
+    return details | {"files": files}
 
 
 def manifest_text(files, **details) -> str:
