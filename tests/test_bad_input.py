@@ -662,3 +662,101 @@ def test_debug_shows_the_traceback(tmp_path, capsys):
     assert cli.main(["--debug", "run", str(tmp_path / "nowhere.yaml")]) == cli.EXIT_BAD_INPUT
     err = capsys.readouterr().err
     assert "Traceback (most recent call last)" in err and "not found" in err
+
+
+# ---- the new surfaces: the cell's TCP, refusals beside a run, located errors ------------------
+
+def test_a_cells_tcp_other_than_the_planners_robot_is_refused_before_the_run():
+    from drake_traj.cell import Cell, Tool
+
+    bare = make_planner(QuinticConfig(goals=GOAL), get_robot("ur10e"), UR10E_HOME)
+    with pytest.raises(ValueError, match=r"^cell.tool.tcp_xyz: the cell's tool has its TCP at tcp_xyz \[0, 0, 0.3\] m, "
+                                         r"tcp_rpy \[0, 0, 0\] rad, but the planner's robot ur10e has its TCP at xyz "
+                                         r"\[0, 0, 0\] m, rpy \[0, 0, 0\] rad .*robot.with_tcp") as caught:
+        simulate(bare, cell=Cell(tool=Tool(tcp_xyz=[0, 0, 0.3])))
+    assert caught.value.field == ("cell", "tool", "tcp_xyz")
+    scenario = load_scenario("quintic_ptp")  # its robot's TCP is its own cell's (the flange)
+    with pytest.raises(ValueError, match=r"^cell.tool.tcp_rpy: .*tcp_rpy \[0, 0, 0.5\] rad"):
+        simulate(scenario, cell=Cell(tool=Tool(tcp_rpy=[0, 0, 0.5])))
+    # the same TCP in both runs
+    tool = Tool(tcp_xyz=[0, 0, 0.15])
+    planner = make_planner(QuinticConfig(goals=[UR10E_HOME + 0.01]), get_robot("ur10e").with_tcp([0, 0, 0.15], [0, 0, 0]),
+                           UR10E_HOME)
+    assert simulate(planner, cell=Cell(tool=tool), settle_time=0.01).succeeded
+
+
+def test_a_robots_own_error_is_named_at_its_field_not_the_tools():
+    from drake_traj.robots.custom import DhArm
+
+    for call in (lambda scenario: scenario.validate(), simulate):
+        with pytest.raises(ValueError, match=r"^robot.dh is missing") as caught:
+            call(Scenario(robot=DhArm(name="bare")))
+        assert caught.value.field == ("robot", "dh")
+
+
+def test_a_cell_that_is_not_a_cell_is_named():
+    for call in (lambda scenario: scenario.validate(), simulate, make_station):
+        scenario = Scenario(name="s")
+        scenario.cell = "table"
+        with pytest.raises(TypeError, match=r"scenario 's': cell must be a drake_traj.cell.Cell .*got str: 'table'"):
+            call(scenario)
+
+
+def test_exporting_into_the_runs_folder_itself_asks_for_a_file_name(saved_run, capsys):
+    before = folder_state(saved_run)
+    code = cli.main(["export", str(saved_run), "--format", "csv", "--out", str(saved_run)])
+    err = capsys.readouterr().err
+    assert code == cli.EXIT_BAD_INPUT and f"--out {saved_run} is a folder; give a file name" in err, err
+    assert "--overwrite" not in err and folder_state(saved_run) == before
+
+
+def test_drives_that_cannot_hold_the_start_are_named_before_the_run(tmp_path, capsys):
+    # torque limits of 1e-3 N m: the shoulder cannot hold the arm (before: "collision ... and table")
+    scenario = load_scenario(DIAGRAMS / "example_arm.yaml", "quintic")
+    scenario.robot.effort_limits = [1e-3] * 6
+    with pytest.raises(ValueError, match=r"robot.effort_limits\[1\]: joint 2 \(shoulder_lift_joint\) of the example_arm "
+                                         r"cannot hold the start configuration against gravity: it needs .* N m there, "
+                                         r"beyond its effort limit of ±0.001 N m") as caught:
+        simulate(scenario)
+    assert caught.value.cause == "saturation" and caught.value.field == ("robot", "effort_limits", 1)
+    # 12.5 kg at the end of a 10 m TCP, from the command line: at the payload's line, nothing run
+    path = tmp_path / "heavy.yaml"
+    path.write_text(QUINTIC + "cell:\n  tool:\n    tcp_xyz: [10, 0, 0]\n    mass: 12.5\n    center_of_mass: [10, 0, 0]\n")
+    line = path.read_text().splitlines().index("    mass: 12.5") + 1
+    assert_clean_exit(cli.main(["run", str(path), "--out", str(tmp_path / "out")]), capsys,
+                      rf"line {line}, column \d+: cell.tool.mass: joint 2 \(shoulder_lift_joint\) of the ur10e cannot hold "
+                      r"the start configuration against gravity with the tool's 12.5 kg payload: it needs -771.8 N m there, "
+                      r"beyond its effort limit of ±330 N m")
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_refusal_never_removes_an_earlier_run(tmp_path, capsys):
+    # C19: the start configuration inside a box; --overwrite on a good run's folder
+    folder = tmp_path / "run"
+    folder.mkdir()
+    for name, content in (("result.npz", b"the earlier run"), ("metrics.json", b"{}"), ("joints.png", b"png")):
+        (folder / name).write_bytes(content)
+    (folder / "run.json").write_text(json.dumps({"files": ["joints.png", "metrics.json", "result.npz"],
+                                                 "scenario": "earlier", "failure": None}))
+    earlier = folder_state(folder)
+    centre = get_robot("ur10e").tool_position(UR10E_HOME)
+    path = tmp_path / "c19.yaml"
+    path.write_text(QUINTIC + "cell:\n  obstacles:\n  - !Box {name: crate, size: [0.2, 0.2, 0.2], "
+                              f"xyz: [{centre[0]:.4f}, {centre[1]:.4f}, {centre[2]:.4f}]}}\n")
+    code = cli.main(["run", str(path), "--out", str(folder), "--overwrite"])
+    err = capsys.readouterr().err
+    assert code == cli.EXIT_BAD_INPUT and "crate" in err, err
+    assert f"the earlier run in {folder} is kept" in err, err
+    after = folder_state(folder)
+    assert {name: after[name] for name in earlier if name != "run.json"} == {
+        name: content for name, content in earlier.items() if name != "run.json"}  # the earlier run intact
+    assert set(after) == set(earlier) | {"refusal.png"}
+    manifest = json.loads(after["run.json"])
+    assert manifest["files"] == ["joints.png", "metrics.json", "refusal.png", "result.npz"]  # a new run replaces all
+    assert manifest["scenario"] == "earlier" and manifest["failure"] is None
+    assert manifest["refusal"]["failure"]["cause"] == "collision" and "crate" in manifest["refusal"]["failure"]["message"]
+    # a refusal where there was only a refusal replaces it
+    code = cli.main(["run", str(path), "--out", str(tmp_path / "refused")])
+    code = cli.main(["run", str(path), "--out", str(tmp_path / "refused"), "--overwrite"])
+    capsys.readouterr()
+    assert code == cli.EXIT_BAD_INPUT and sorted(folder_state(tmp_path / "refused")) == ["refusal.png", "run.json"]
