@@ -264,3 +264,14 @@ def test_hundreds_of_dense_goals_along_a_smooth_path_are_timed():
     assert 0.03 < np.median(spacing) < 0.1  # about 0.05 rad apart
     planner = make_planner(SmoothWaypointsConfig(goals=goals.tolist()), UR10E, q0)
     assert planner.timing.peaks.max() <= 1 + 1e-9 and planner.timing.deviation < 1e-4
+
+
+@pytest.mark.parametrize("apart", [1e-10, 1e-8, 1e-7, 1e-6])
+def test_goals_a_rounding_apart_are_one_goal_not_a_cusp(apart):
+    """Two goals 1e-8 rad apart were a cusp while duplicates merged only within 1e-9: goals closer
+    than 1e-5 of the longest chord are one."""
+    q0 = UR10E.home_configuration
+    first = q0 + np.array([0.4, -0.3, 0.5, 0.2, -0.4, 0.3])
+    goals = [first.tolist(), (first + apart).tolist(), (q0 + 0.8).tolist()]
+    planner = make_planner(SmoothWaypointsConfig(goals=goals), UR10E, q0)
+    assert planner.timing.peaks.max() <= 1 + 1e-9

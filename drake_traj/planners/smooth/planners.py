@@ -57,9 +57,13 @@ def waypoint_path(q_waypoints) -> PiecewisePolynomial:
     """The C2 path through joint waypoints (m + 1, n) [rad]: the not-a-knot cubic spline with the
     centripetal parameter (s grows by the square root of each chord's length [rad], which bulges
     less past a waypoint where joints reverse than the chord length: 2 % shorter motions on
-    seeded tasks); the straight segment for one move. Repeated waypoints are dropped."""
+    seeded tasks); the straight segment for one move. Repeated waypoints (closer than 1e-5 of the
+    longest chord) are dropped."""
     q = np.asarray(q_waypoints, dtype=float)
-    keep = np.concatenate([[True], np.linalg.norm(np.diff(q, axis=0), axis=1) > 1e-9])
+    step = np.linalg.norm(np.diff(q, axis=0), axis=1)
+    # goals closer than 1e-5 of the longest chord are one (closer than about 1e-6 of it, the spline
+    # stops and turns there: a cusp); no drive resolves them apart
+    keep = np.concatenate([[True], step > 1e-5 * max(1.0, float(step.max(initial=0.0)))])
     q = q[keep]
     if len(q) < 2:
         raise DrakeTrajError("goals: every goal equals the start: there is no path to time", field=("goals",))
