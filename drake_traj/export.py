@@ -10,6 +10,7 @@ Every writer checks its options and the reference first and writes nothing when 
 wrong (:class:`ExportError`, naming the option or the joint, time and value).
 """
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +19,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_traj.version import __version__
 from drake_traj.errors import DrakeTrajError
-from drake_traj.output import write_file
+from drake_traj.output import OutputError, WriteError, check_writable, write_file
 from drake_traj.robots import UR_ARMS, Robot, get_robot
 
 __all__ = ["FORMATS", "ExportError", "export", "reference_trajectory", "resample"]
@@ -175,8 +176,10 @@ def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_tim
 
     Returns the path written. Raises :class:`ExportError`, writing nothing, when an option is out
     of range or the reference is not fit for the format; :class:`~drake_traj.output.OutputError`
-    when ``path`` is a symbolic link or in another run's or bench's folder, or does not fit on the
-    disk (:func:`drake_traj.output.write_file`: the file is written whole or not at all).
+    when ``path`` is a symbolic link or in another run's or bench's folder, its folder cannot be
+    written (a read-only file system, no permission: checked first, naming the folder), or it
+    does not fit on the disk (:func:`drake_traj.output.write_file`: the file is written whole or
+    not at all).
     """
     if format not in FORMATS:
         raise ExportError(f"--format must be one of {sorted(FORMATS)}, got {format!r}")
@@ -191,6 +194,12 @@ def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_tim
                 raise ExportError(f"{name} must be in UR's range [{low:g}, {high:g}], got {value}")
         if not 0 < approach_speed <= 1.0:
             raise ExportError(f"--approach-speed must be in (0, 1] rad/s, got {approach_speed}")
+    folder = Path(os.path.abspath(path)).parent
+    if folder.is_dir():  # a missing folder is named by write_file
+        try:
+            check_writable(folder)  # e.g. a read-only file system: before the work
+        except OutputError as error:
+            raise error.relocated(error.field, f"--out {path}: {error}; nothing was written") from None
     t, q, qd, qdd = resample(result, period)
     if format == "csv":
         text = _csv(result, t, q, qd, qdd, period)
@@ -201,4 +210,10 @@ def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_tim
         text = _ros2(result, t, q, qd, qdd, result.joint_names or [f"joint_{j + 1}" for j in range(q.shape[1])])
     if result.failure is not None:  # allowed: the first line says so (a comment in all three formats)
         text = f"# FAILED RUN: {' '.join(str(result.failure).split())}\n" + text
-    return write_file(path, text, own_folder=run_folder)
+    try:
+        return write_file(path, text, own_folder=run_folder)
+    except OutputError:
+        raise
+    except OSError as error:  # the folder changed since it was checked
+        raise WriteError(f"--out {path}: the folder {folder} cannot be written: {error.strerror or error}; nothing was "
+                         "written") from None

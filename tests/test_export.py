@@ -221,3 +221,75 @@ def test_urscript_refuses_a_run_whose_logged_limits_are_not_the_named_arms(resul
                                           r"are not the UR10e's \[330.0, 330.0, 150.0, 56.0, 56.0, 56.0\] N m"):
         SimulationResult(**{**vars(result), "effort_limit": puma}).export(tmp_path / "x.script", "urscript")
     assert not (tmp_path / "x.script").exists()
+
+
+def _read_only(monkeypatch, folder: Path) -> None:
+    """Make ``folder`` behave as on a read-only file system (EROFS), root or not: access(2)
+    says so, statvfs flags it, and creating or removing a file there fails."""
+    import errno
+    import os
+
+    def erofs(path):
+        return OSError(errno.EROFS, "Read-only file system", str(path))
+
+    inside = lambda path: Path(os.path.abspath(path)).parent == folder  # noqa: E731
+    access, statvfs, open_, unlink = os.access, os.statvfs, os.open, os.unlink
+
+    class Flags:
+        def __init__(self, real):
+            self.real = real
+
+        def __getattr__(self, name):
+            return self.real.f_flag | os.ST_RDONLY if name == "f_flag" else getattr(self.real, name)
+
+    monkeypatch.setattr(os, "access", lambda path, mode, **kw: False if Path(path) == folder and mode & os.W_OK
+                        else access(path, mode, **kw))
+    monkeypatch.setattr(os, "statvfs", lambda path: Flags(statvfs(path)) if Path(path) == folder else statvfs(path))
+
+    def open_or_fail(path, flags, *args, **kw):
+        if inside(path) and flags & (os.O_WRONLY | os.O_CREAT):
+            raise erofs(path)
+        return open_(path, flags, *args, **kw)
+
+    def unlink_or_fail(path, *args, **kw):
+        if inside(path):
+            raise erofs(path)
+        return unlink(path, *args, **kw)
+
+    monkeypatch.setattr(os, "open", open_or_fail)
+    monkeypatch.setattr(os, "unlink", unlink_or_fail)
+
+
+@pytest.mark.parametrize("how", ["python", "cli"])
+def test_an_export_into_a_read_only_folder_names_the_folder(result, quintic_run_dir, tmp_path, monkeypatch, capsys, how):
+    """Was "internal error: OSError: [Errno 30] Read-only file system" (removing the temporary
+    file that could not be made)."""
+    folder = tmp_path / "readonly"
+    folder.mkdir()
+    _read_only(monkeypatch, folder)
+    message = (f"--out {folder / 'ref.csv'}: output folder {folder} cannot be written: {folder} is on a read-only "
+               "file system; nothing was written")
+    if how == "cli":
+        assert cli.main(["export", str(quintic_run_dir), "--format", "csv", "--out", str(folder / "ref.csv")]) == 2
+        assert message in capsys.readouterr().err
+    else:
+        from drake_traj.output import OutputError
+
+        with pytest.raises(OutputError) as caught:
+            result.export(folder / "ref.csv", "csv")
+        assert str(caught.value) == message
+    monkeypatch.undo()
+    assert list(folder.iterdir()) == []
+
+
+def test_an_export_whose_folder_fails_while_writing_is_a_write_error(result, tmp_path, monkeypatch):
+    """Writable when checked, read-only when written (remounted meanwhile): still an OutputError."""
+    import drake_traj.export as export_module
+    from drake_traj.output import OutputError
+
+    folder = tmp_path / "remounted"
+    folder.mkdir()
+    _read_only(monkeypatch, folder)
+    monkeypatch.setattr(export_module, "check_writable", lambda directory: None)
+    with pytest.raises(OutputError, match=rf"--out {folder / 'ref.csv'}"):
+        result.export(folder / "ref.csv", "csv")
