@@ -382,7 +382,7 @@ def write_file(path, text: str | bytes, *, own_folder=None, what: str = "--out")
                 handle.flush()
                 os.fsync(handle.fileno())
             os.replace(temporary, absolute)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
+    finally:  # the temporary file, where it was made (on a read-only folder unlinking fails too: the
+        with contextlib.suppress(OSError):  # write's own error is the one to report)
             temporary.unlink()
     return path
