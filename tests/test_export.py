@@ -291,5 +291,5 @@ def test_an_export_whose_folder_fails_while_writing_is_a_write_error(result, tmp
     folder.mkdir()
     _read_only(monkeypatch, folder)
     monkeypatch.setattr(export_module, "check_writable", lambda directory: None)
-    with pytest.raises(OutputError, match=rf"--out {folder / 'ref.csv'}"):
+    with pytest.raises(OutputError, match=rf"read-only file system while writing {folder / 'ref.csv'}; nothing was written"):
         result.export(folder / "ref.csv", "csv")
