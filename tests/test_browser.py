@@ -18,7 +18,7 @@ from drake_traj.meshcat import export_html
 
 CHROMIUM = browser.find_chromium()
 pytestmark = pytest.mark.skipif(
-    CHROMIUM is None and not os.environ.get("CI"), reason="chromium is not installed: install it first (Debian: sudo apt-get install chromium; .ci/run does)"
+    CHROMIUM is None and not os.environ.get("CI"), reason="chromium is not installed: install it first (Debian, as root or with sudo: apt-get update && apt-get install -y chromium; .ci/run does)"
 )
 
 
