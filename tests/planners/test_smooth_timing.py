@@ -214,7 +214,7 @@ def test_the_infeasible_causes():
 
 
 # --- every input (issue: smooth timing on every input) ---------------------------------------------
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=25, deadline=None, derandomize=True)
 @given(spacing=st.floats(1e-3, 0.4), count=st.integers(2, 8), decimals=st.integers(3, 12))
 def test_collinear_evenly_spaced_goals_never_end_the_process(spacing, count, decimals):
     """Goals Q0 + k spacing (1, ..., 1), rounded: the spline's breaks fall a rounding away from the

@@ -73,6 +73,19 @@ def waypoint_path(q_waypoints) -> PiecewisePolynomial:
     return PiecewisePolynomial.CubicWithContinuousSecondDerivatives(chord, q.T, periodic_end_condition=False)
 
 
+def _on_one_line(q: np.ndarray) -> bool:
+    """True where the waypoints (m + 1, n) [rad] lie on the segment from the first to the last, in
+    order along it (within 1e-9 of its length or 1e-7 rad, rounding): the path through them is that segment, and a
+    C2 spline through evenly spaced collinear goals is slow to time."""
+    step = q[-1] - q[0]
+    length = float(np.linalg.norm(step))
+    if length == 0.0:
+        return False
+    along = (q - q[0]) @ step / length**2  # (m + 1,) the position along the segment, 0 to 1
+    off = np.linalg.norm(q - q[0] - np.outer(along, step), axis=1).max()
+    return bool(off <= max(1e-9 * length, 1e-7) and np.all(np.diff(along) >= -1e-12))
+
+
 def _check_joint_range(path, robot: Robot, name: str) -> None:
     """A JOINT_RANGE error naming the joint where the path leaves the robot's position range."""
     s = np.linspace(path.start_time(), path.end_time(), 1001)
@@ -116,9 +129,9 @@ class SmoothWaypointsConfig:
 
 
 def make_smooth_waypoints(config: SmoothWaypointsConfig, robot: Robot, q_initial) -> SmoothPlanner:
-    """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]: one move is the
-    time-optimal jerk-limited profile along its straight line (:func:`line_timing`), several the
-    smooth timing of the spline through them (:func:`time_path`)."""
+    """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]: one move (or goals in order
+    along one line) is the time-optimal jerk-limited profile along its straight line
+    (:func:`line_timing`), several the smooth timing of the spline through them (:func:`time_path`)."""
     q = start_and_goals(q_initial, config.goals, robot.num_joints)
     if len(q) - 1 > MAX_GOALS:
         raise DrakeTrajError(f"goals: {len(q) - 1} goals, at most {MAX_GOALS} (each is a knot of the path and a node of "
@@ -128,8 +141,8 @@ def make_smooth_waypoints(config: SmoothWaypointsConfig, robot: Robot, q_initial
     path = waypoint_path(q)
     _check_joint_range(path, robot, "goals")
     grid_points = whole_number(config.grid_points, "grid_points", minimum=20, maximum=MAX_GRID_POINTS)
-    if path.get_number_of_segments() == 1 and path.get_segment_times()[-1] > 0:  # one straight move: its optimum
-        ends = path.vector_values([path.start_time(), path.end_time()]).T
+    if _on_one_line(q):  # one straight move, or goals along one line in order: the line's optimum
+        ends = q[[0, -1]]
         try:
             timing = line_timing(ends[0], ends[1], velocity, acceleration, jerk)
         except DrakeTrajError as error:

@@ -541,10 +541,12 @@ def line_timing(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit=
     if not moving.any():
         raise InfeasibleTimingError("path does not move: the goal equals the start", field=("path",))
     limits = [float(np.min(limit[moving] / np.abs(step[moving]))) for limit in (velocity, acceleration, jerk)]
-    least = max(1 / limits[0], 2 * np.sqrt(1 / limits[1]), np.cbrt(32 / limits[2]))  # as _time_path's bounds
+    bounds = (1 / limits[0], 2 * np.sqrt(1 / limits[1]), np.cbrt(32 / limits[2]))  # as _time_path's bounds
+    least = max(bounds)
     if not least <= max_duration:
-        raise InfeasibleTimingError(f"the limits are too small for the path: at least {least:.4g} s, longer than "
-                                    f"max_duration {max_duration:g} s", field=("path",))
+        name = ("velocity_limit", "acceleration_limit", "jerk_limit")[int(np.argmax(bounds))]
+        raise InfeasibleTimingError(f"the limits are too small for the path: the straight move takes ({name}): at "
+                                    f"least {least:.4g} s, longer than max_duration {max_duration:g} s", field=("path",))
     generator = ruckig.Ruckig(1)
     request = ruckig.InputParameter(1)
     request.current_position, request.target_position = [0.0], [1.0]
