@@ -10,14 +10,23 @@ Planner configs (``PajakConfig``, ``QuinticConfig``, ...) build planners with
 :func:`drake_traj.planners.make_planner`; robots come from :func:`get_robot`.
 """
 
-from drake_traj.station import add_station, build_station, make_station, run_station, simulate
-from drake_traj.errors import Cause, DrakeTrajError, Failure, PlanningError, SingularConfigurationError
-from drake_traj.planners import (BorygaConfig, FreeMotionConfig, LiConfig, MovejConfig, PajakConfig, QuinticConfig,
-                                 RetimedPajakConfig, RuckigConfig, SmoothWaypointsConfig, ToppraConfig)
-from drake_traj.result import Metrics, SimulationResult
-from drake_traj.robots import Robot, get_robot
-from drake_traj.scenario import ControllerGains, Scenario, SpeedOverride, load_scenario, make_planner, preflight
+import importlib
+
 from drake_traj.version import __version__
+
+# each public name -> the module it comes from, imported on first use (PEP 562): ``import
+# drake_traj`` (and ``drake-traj --version``, whose module is in this package) does not import Drake
+_SOURCES = {
+    **dict.fromkeys(("add_station", "build_station", "make_station", "run_station", "simulate"), "drake_traj.station"),
+    **dict.fromkeys(("Cause", "DrakeTrajError", "Failure", "PlanningError", "SingularConfigurationError"),
+                    "drake_traj.errors"),
+    **dict.fromkeys(("BorygaConfig", "FreeMotionConfig", "LiConfig", "MovejConfig", "PajakConfig", "QuinticConfig",
+                     "RetimedPajakConfig", "RuckigConfig", "SmoothWaypointsConfig", "ToppraConfig"), "drake_traj.planners"),
+    **dict.fromkeys(("Metrics", "SimulationResult"), "drake_traj.result"),
+    **dict.fromkeys(("Robot", "get_robot"), "drake_traj.robots"),
+    **dict.fromkeys(("ControllerGains", "Scenario", "SpeedOverride", "load_scenario", "make_planner", "preflight"),
+                    "drake_traj.scenario"),
+}
 
 
 __all__ = [
@@ -28,3 +37,16 @@ __all__ = [
     "run_station", "Scenario", "simulate", "SimulationResult", "SingularConfigurationError", "SmoothWaypointsConfig",
     "SpeedOverride", "ToppraConfig",
 ]
+
+
+def __getattr__(name: str):
+    """A public name of :data:`__all__`, imported from its module on first use."""
+    if name not in _SOURCES:
+        raise AttributeError(f"module 'drake_traj' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_SOURCES[name]), name)
+    globals()[name] = value  # the next use does not come here
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_SOURCES))

@@ -31,6 +31,7 @@ from drake_traj import (
     SimulationResult,
     ToppraConfig,
     cli,
+    commands,
     get_robot,
     load_scenario,
     make_station,
@@ -631,7 +632,7 @@ def test_a_log_whose_time_runs_backwards_is_refused(saved_run, tmp_path):
 
 
 def test_signals_while_writing_wait_until_the_files_are_written():
-    with cli._interrupts_deferred() as received:
+    with commands._interrupts_deferred() as received:
         os.kill(os.getpid(), signal.SIGINT)
         os.kill(os.getpid(), signal.SIGTERM)
         time.sleep(0.05)  # the handlers run here, and record instead of raising
@@ -644,7 +645,7 @@ def test_sigterm_stops_a_run_like_ctrl_c_with_its_own_exit_code(tmp_path, monkey
         time.sleep(1.0)  # the SIGTERM handler raises KeyboardInterrupt here
         raise AssertionError("SIGTERM did not stop the run")
 
-    monkeypatch.setattr(cli, "simulate", terminated)
+    monkeypatch.setattr(commands, "simulate", terminated)
     assert cli.main(["run", "quintic_ptp", "--out", str(tmp_path / "x")]) == cli.EXIT_TERMINATED == 143
     assert "terminated (SIGTERM)" in capsys.readouterr().err
     assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # restored

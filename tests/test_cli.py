@@ -1,6 +1,7 @@
 """The command line a newcomer meets first: the shipped scenarios with their files, a scenario to
 copy, a rerun into the default folder, and the live view's recording without a terminal."""
 
+import importlib.metadata
 import io
 import subprocess
 import sys
@@ -11,9 +12,29 @@ import numpy as np
 import pytest
 
 import browser
-from drake_traj import cli
+from drake_traj import cli, commands
 from drake_traj.robots import ROBOT_NAMES, get_robot
 from drake_traj.scenario import load_scenario, shipped_scenarios
+
+
+@pytest.mark.parametrize("argv", [["--version"], ["--help"], ["no-such-command"]])
+def test_version_and_help_do_not_import_drake(argv):
+    # the console script imports drake_traj.cli: it, and the package, must answer these alone
+    code = ("import sys\nfrom drake_traj import cli\ncode = cli.main(sys.argv[1:])\n"
+            "heavy = sorted(m for m in sys.modules if m.split('.')[0] in ('pydrake', 'numpy', 'matplotlib', 'distributed'))\n"
+            "print('imported:', heavy, 'exit', code)")
+    done = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=60)
+    assert done.stdout.splitlines()[-1] == f"imported: [] exit {2 if argv[0] == 'no-such-command' else 0}", done
+
+
+def test_the_version_is_the_installed_packages(capsys):
+    assert cli.main(["--version"]) == cli.EXIT_OK
+    assert capsys.readouterr().out == f"drake-traj {importlib.metadata.version('drake_traj')}\n"
+
+
+def test_a_commands_help_lists_its_options(capsys):
+    assert cli.main(["export", "--help"]) == cli.EXIT_OK
+    assert "--format {csv,ros2,urscript}" in capsys.readouterr().out
 
 
 def test_list_gives_each_shipped_files_path_above_its_scenarios(capsys):
@@ -66,15 +87,15 @@ class Stdin(io.StringIO):
         return self._terminal
 
 
-@pytest.mark.parametrize("terminal, serve_after, slept", [(False, None, cli.DEFAULT_SERVE_AFTER), (False, 2.5, 2.5),
+@pytest.mark.parametrize("terminal, serve_after, slept", [(False, None, commands.DEFAULT_SERVE_AFTER), (False, 2.5, 2.5),
                                                           (True, 2.5, 2.5), (False, 0.0, None)])
 def test_the_recording_is_served_for_serve_after_seconds(terminal, serve_after, slept, monkeypatch, capsys):
     # without a terminal (a script, CI, an IDE) there is no Ctrl-C prompt: the recording stays
     # served for --serve-after seconds (default 60); on a terminal too when it is given
     sleeps = []
     monkeypatch.setattr(sys, "stdin", Stdin(terminal))
-    monkeypatch.setattr(cli, "sleep", sleeps.append)
-    cli.serve_recording("http://localhost:7000", serve_after)
+    monkeypatch.setattr(commands, "sleep", sleeps.append)
+    commands.serve_recording("http://localhost:7000", serve_after)
     assert sleeps == ([] if slept is None else [slept])
     err = capsys.readouterr().err
     assert (f"serving the recording at http://localhost:7000 for {slept:g} s" in err) if slept else not err

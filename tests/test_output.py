@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from drake_traj import SimulationResult, bench, cli, output
+from drake_traj import SimulationResult, bench, cli, commands, output
 
 SIGNS = ("result.npz", "metrics.json", "run.json")
 
@@ -43,7 +43,7 @@ def nothing_runs(monkeypatch):
     """A run or bench that starts its work fails the test: the refusal must come before it."""
     def started(*args, **kwargs):
         raise AssertionError("the work started")
-    monkeypatch.setattr(cli, "simulate", started)
+    monkeypatch.setattr(commands, "simulate", started)
     monkeypatch.setattr(bench, "tasks", started)
 
 
@@ -53,7 +53,7 @@ def simulated(monkeypatch, quintic_run_dir):
     instead): the writing alone."""
     loaded = SimulationResult.load(quintic_run_dir)
     result = SimulationResult(**{**vars(loaded), "wall_time": loaded.wall_time + 1.0})  # files unlike the earlier run's
-    monkeypatch.setattr(cli, "simulate", lambda *args, **kwargs: result)
+    monkeypatch.setattr(commands, "simulate", lambda *args, **kwargs: result)
 
 
 def mount_tmpfs(folder: Path, options: str) -> bool:
