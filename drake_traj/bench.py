@@ -432,23 +432,58 @@ def _run_on(client, work, builders, toppra, bar) -> dict:
 
 
 class _Progress:
-    """Runs done, failed and the time left (tqdm), on a terminal only."""
+    """Runs done, failed and the time left: a tqdm bar on a terminal; on another stream (a log
+    file, CI) a line at most every :data:`LOG_INTERVAL`; nothing when the stream is None. A first
+    line says how many runs there are and where they run."""
 
-    def __init__(self, total, stream):
-        quiet = stream is None or not getattr(stream, "isatty", lambda: False)()
-        self._bar = tqdm(total=total, unit="run", desc="bench", file=stream or sys.stderr, disable=quiet,
+    def __init__(self, total: int, stream, where: str):
+        self._stream = stream
+        terminal = stream is not None and getattr(stream, "isatty", lambda: False)()
+        self._lines = stream is not None and not terminal
+        if stream is not None:
+            print(f"bench: {total} runs {where}", file=stream, flush=True)
+        self._bar = tqdm(total=total, unit="run", desc="bench", file=stream or sys.stderr, disable=not terminal,
                          dynamic_ncols=True)
-        self.failed = 0
+        self.total, self.count, self.failed = total, 0, 0
+        self._start = self._said = time.monotonic()
 
     def done(self, row) -> dict:
         """Count ``row``'s run; returns the row."""
+        self.count += 1
         self.failed += not row["succeeded"]
         self._bar.set_postfix(failed=self.failed, refresh=False)
         self._bar.update()
+        if self._lines and time.monotonic() - self._said >= LOG_INTERVAL and self.count < self.total:
+            self._say(self.line())
         return row
+
+    def line(self) -> str:
+        """The progress as one line: runs done of all, failed, elapsed and estimated time left
+        (the mean time per run so far times the runs left)."""
+        elapsed = time.monotonic() - self._start
+        left = elapsed / self.count * (self.total - self.count) if self.count else float("nan")
+        eta = f"about {tqdm.format_interval(left)} left" if self.count else "time left not known yet"
+        return (f"bench: {self.count}/{self.total} runs ({100 * self.count / self.total:.0f} %), {self.failed} failed, "
+                f"{tqdm.format_interval(elapsed)} elapsed, {eta}")
+
+    def _say(self, text: str) -> None:
+        print(text, file=self._stream, flush=True)
+        self._said = time.monotonic()
 
     def close(self):
         self._bar.close()
+        if self._lines:
+            self._say(f"bench: {self.count}/{self.total} runs in {tqdm.format_interval(time.monotonic() - self._start)}, "
+                      f"{self.failed} failed")
+
+
+def _where(workers: int | None, scheduler: str | None) -> str:
+    """Where the runs go, for the progress's first line."""
+    if scheduler is not None:
+        return f"on the Dask cluster at {scheduler}"
+    if workers == 1:
+        return "in this process, one after another"
+    return f"on a local Dask cluster of {workers} processes"
 
 
 def _default_workers() -> int:
@@ -523,8 +558,11 @@ def _engine(workers, scheduler):
         with _connect(scheduler) as client:
             yield client
         return
+    # no dashboard; the scheduler's HTTP server (health, metrics) on a free local port: on Dask's
+    # default 8787 a second cluster (another bench, a notebook) warned "Port 8787 is already in use"
     with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}, silence_logs=logging.ERROR) as cluster, \
+            Client(cluster) as client:
         yield client
 
 
@@ -534,6 +572,7 @@ def _engine(workers, scheduler):
 
 
 MAX_COUNT = 10_000  # seeded tasks per bench: each costs about 10 s of one core here (all planners)
+LOG_INTERVAL = 30.0  # [s] at most between progress lines where the progress is not a terminal
 SCHEDULER_TIMEOUT = 10.0  # [s] a --scheduler address answers as a Dask scheduler within this, or is refused
 
 
@@ -565,6 +604,7 @@ def _check_arguments(count, seed, repeats, workers, scheduler, planners, extra_p
                 f"extra_planners[{name!r}] must be a new planner name with a config builder, got {build!r}")
 
 
+BENCH_FILES = ("bench.csv", "bench.md", "bench.png")  # what a bench writes into its folder
 BENCH_SIZE = 4 * 2**20  # [bytes] about what bench.csv, bench.md and bench.png take, rounded up
 
 
@@ -604,7 +644,11 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers:
             returning a planner config (poses (m, 6) [m, rad], joint waypoints (m + 1, 6)
             [rad]). On Dask, ``build`` must be a top-level function of a module the workers
             can import. A build or planner that raises gives failed rows.
-        progress: stream of the progress bar (shown only if it is a terminal), or None.
+        progress: stream of the progress (stderr by default; None: none): a first line with the
+            number of runs and where they run, then on a terminal a bar with the runs done, failed
+            and the time left, elsewhere (a log, CI) a line of the same at most every
+            :data:`LOG_INTERVAL` (30 s) and at the end. ``print``s bench.md's tables and a last
+            line naming the files written.
         overwrite: replace an earlier bench in ``out_dir``.
         command: names this process to another writer of ``out_dir`` (default its command line).
 
@@ -627,6 +671,7 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers:
         table, text = _bench(claimed, count, seed, repeats, workers, scheduler, (*planners, *extra_planners), builders,
                              toppra, progress)
     print(text)
+    print(f"wrote {out_dir}: {', '.join(BENCH_FILES)}")
     return table
 
 
@@ -634,9 +679,9 @@ def _bench(claimed, count, seed, repeats, workers, scheduler, names, builders, t
     """The bench of :func:`bench` into its ``claimed`` folder (rows of the planners ``names`` in
     order); returns the table and bench.md's text."""
     with _engine(workers, scheduler) as client:
-        work = tasks(count, seed, repeats)
-        bar = _Progress(len(work) * (len(builders) + toppra), progress)
+        bar = _Progress((count + 1) * (len(builders) + toppra), progress, _where(workers, scheduler))
         try:
+            work = tasks(count, seed, repeats)
             if client is None:
                 by_run = _run_serial(work, builders, toppra, bar)
             else:
@@ -653,9 +698,10 @@ def _bench(claimed, count, seed, repeats, workers, scheduler, names, builders, t
     if count:
         text += f"\n## Medians over {count} seeded tasks\n\n" + _markdown(table[len(rows):])
     with claimed.replace() as staging:
-        staging.write("bench.csv", functools.partial(_write_csv, table))
-        staging.write("bench.md", lambda path: path.write_text(text))
-        staging.write("bench.png", lambda path: bench_figure(rows).savefig(path, dpi=110))
+        csv_file, markdown, figure = BENCH_FILES
+        staging.write(csv_file, functools.partial(_write_csv, table))
+        staging.write(markdown, lambda path: path.write_text(text))
+        staging.write(figure, lambda path: bench_figure(rows).savefig(path, dpi=110))
     return table, text
 
 

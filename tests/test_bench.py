@@ -1,9 +1,14 @@
 """The benchmark on a tiny set: its table is consistent, the same serially and on a Dask cluster,
 a failing run is a row, and bad arguments stop it before any run (not a timing test)."""
 
+import contextlib
 import csv
+import io
 import logging
 import math
+import re
+import socket
+import warnings
 
 import numpy as np
 import pytest
@@ -145,6 +150,54 @@ def test_the_plot_has_the_task_count_in_its_title_and_a_legend_on_each_panel(row
     # a box over fewer runs than tasks (a failed run has no value) says how many
     labels = [label.get_text() for label in bench.bench_figure(cluster_rows).axes[0].get_xticklabels()]
     assert labels == ["pajak_blend", "quintic_stop", "toppra", "broken\n(0 of 2)"]
+
+
+class Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_progress_without_a_terminal_is_a_line_at_a_time(monkeypatch):
+    # a log or CI: no bar redrawn in place; a first line, then the runs done, failed and time left
+    monkeypatch.setattr(bench, "LOG_INTERVAL", 0.0)  # a line after every run (30 s apart as shipped)
+    stream = io.StringIO()
+    progress = bench._Progress(4, stream, "in this process, one after another")
+    progress.done({"succeeded": True})
+    progress.done({"succeeded": False})
+    progress.close()
+    first, *lines, last = stream.getvalue().splitlines()
+    assert first == "bench: 4 runs in this process, one after another"
+    assert re.fullmatch(r"bench: 1/4 runs \(25 %\), 0 failed, 00:00 elapsed, about 00:00 left", lines[0]), lines
+    assert re.fullmatch(r"bench: 2/4 runs \(50 %\), 1 failed, 00:00 elapsed, about 00:00 left", lines[1]), lines
+    assert re.fullmatch(r"bench: 2/4 runs in 00:00, 1 failed", last)
+
+
+def test_progress_on_a_terminal_is_a_bar_with_the_time_left():
+    stream = Terminal()
+    progress = bench._Progress(4, stream, "on a local Dask cluster of 2 processes")
+    progress.done({"succeeded": False})
+    progress.close()
+    text = stream.getvalue()
+    assert text.startswith("bench: 4 runs on a local Dask cluster of 2 processes\n")
+    assert re.search(r"bench:  25%.*\| 1/4 \[00:00<00:00, .*failed=1\]", text), text  # [elapsed<left]
+
+
+def test_a_bench_names_what_it_wrote(tmp_path, capsys):
+    out = tmp_path / "out"
+    bench.bench(out, count=0, repeats=1, workers=1, planners=("quintic_stop",), progress=None)
+    assert capsys.readouterr().out.splitlines()[-1] == f"wrote {out}: bench.csv, bench.md, bench.png"
+
+
+def test_the_local_cluster_serves_http_on_a_free_port_without_a_warning():
+    # Dask's default HTTP port 8787 taken (another cluster, a notebook): no "Port 8787 is already in use"
+    with socket.socket() as taken, warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with contextlib.suppress(OSError):  # already taken is as good
+            taken.bind(("127.0.0.1", 8787))
+            taken.listen()
+        with bench._engine(2, None) as client:
+            assert client.submit(sum, [1, 2]).result() == 3
+            assert client.scheduler_info()["services"].get("dashboard") != 8787  # a free port, not Dask's default
 
 
 def independent_optimal_time(path, velocity: float, acceleration: float, points: int = 3000) -> float:
