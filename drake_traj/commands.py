@@ -30,7 +30,8 @@ from drake_traj.output import WriteError, locked, working_folder
 from drake_traj.rundir import (MANIFEST, REFUSAL, add_to_manifest, claim_run_folder, earlier_run, run_files,
                                write_manifest)
 from drake_traj.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
-                                 load_scenario, preflight, scenario_variants, shipped_scenarios)
+                                 load_scenario, preflight, scenario_variants, shipped_copy, shipped_directory,
+                                 shipped_scenarios)
 from drake_traj.station import simulate
 from drake_traj.validation import REALTIME_RATES
 
@@ -221,9 +222,10 @@ def serve_recording(url: str, seconds: float | None) -> None:
 
 
 def list_scenarios(args) -> int:
-    """``drake-traj list``: the shipped scenarios, a line each (name, robot, description), under
-    the path of their file."""
+    """``drake-traj list``: which copy of the shipped files runs (:func:`shipped_copy`), then the
+    shipped scenarios, a line each (name, robot, description), under the path of their file."""
     entries = shipped_scenarios()
+    print(f"shipped scenarios, from {shipped_copy()}")
     width = max(len(entry.name) for entry in entries)
     robot_width = max(len(entry.robot) for entry in entries)
     for path in dict.fromkeys(entry.path for entry in entries):
@@ -279,7 +281,8 @@ def show_scenario(args) -> int:
         load_scenario(path, variant)  # refuses it, naming the file's variants as ``run`` does
     print(path.read_text(), end="")
     option = f" --variant {variant or '|'.join(variants)}" if variants else ""
-    print(f"drake-traj: that is {path}; run a copy with: drake-traj run my_copy.yaml{option}", file=sys.stderr)
+    shipped = f", from {shipped_copy()}" if path.parent == shipped_directory() else ""
+    print(f"drake-traj: that is {path}{shipped}; run a copy with: drake-traj run my_copy.yaml{option}", file=sys.stderr)
     return EXIT_OK
 
 

@@ -50,7 +50,7 @@ __all__ = [
     "ControllerGains", "Scenario", "ScenarioError", "ScenarioSource", "ShippedScenario", "SpeedOverride",
     "default_plant_config", "default_scenario_path", "default_simulator_config", "find_scenario", "load_scenario",
     "check_cell_tcp", "check_planned_duration", "check_start_torques", "locate_in_scenario", "make_planner", "preflight", "scenario_variants",
-    "shipped_scenarios",
+    "shipped_copy", "shipped_scenarios",
 ]
 
 DEFAULT_SCENARIO = ("pajak.yaml", "sim3")  # what ``drake-traj run`` runs when given no scenario
@@ -404,7 +404,8 @@ def _find_scenario(path: Path, reference: str, variant: str | None) -> tuple[Pat
     if path.is_dir() and not (bare_name and _is_shipped_name(reference)):
         raise ScenarioError(f"scenario file {path} is a folder, not a scenario file")
     if not bare_name:
-        raise ScenarioError(f"scenario file {path} not found")
+        where = "" if path.is_absolute() else _in_working_folder()
+        raise ScenarioError(f"scenario file {path} not found{where}{_shipped_alternative(path, variant)}")
     shipped = shipped_scenarios()
     for entry in shipped:
         if entry.name == reference:  # with a variant: that variant of the scenario's file
@@ -415,6 +416,41 @@ def _find_scenario(path: Path, reference: str, variant: str | None) -> tuple[Pat
     names = ", ".join(entry.name for entry in shipped)
     raise ScenarioError(f"no scenario file {reference!r} and no shipped scenario of that name; "
                      f"shipped: {names} (drake-traj list)")
+
+
+def _in_working_folder() -> str:
+    """`` in <the working folder>``, where a relative path was looked for ("" if it is gone)."""
+    try:
+        return f" in {Path.cwd()}"
+    except OSError:  # the working folder was deleted
+        return ""
+
+
+def _shipped_alternative(path: Path, variant: str | None) -> str:
+    """For a scenario ``path`` that is not there (``diagrams/pajak.yaml`` outside the checkout): how
+    to run the shipped file of that name (by its file name, ``.yaml`` or not), or ""."""
+    file = shipped_directory() / (path.name if path.suffix in (".yaml", ".yml") else f"{path.name}.yaml")
+    entries = [entry for entry in shipped_scenarios() if entry.path.name == file.name]
+    if not entries:
+        return ""
+    chosen = [entry for entry in entries if variant is None or entry.variant == variant]
+    if len(chosen) == 1:
+        name = chosen[0].name
+        return f"; the shipped scenario of that name runs as `drake-traj run {name}` (Python: load_scenario({name!r}))"
+    name = next((entry.name for entry in entries if (file.name, entry.variant) == DEFAULT_SCENARIO), entries[0].name)
+    return (f"; the shipped file of that name holds {', '.join(entry.name for entry in entries)}: run one by its "
+            f"name, e.g. `drake-traj run {name}` (Python: load_scenario({name!r}))")
+
+
+def shipped_copy() -> str:
+    """Which copy of the shipped scenario files runs, said by ``drake-traj list`` and ``show``: a
+    source tree's ``diagrams/`` (a checkout, an editable install), where an edit changes what
+    runs, or the installed package's, which a checkout's ``diagrams/`` does not change."""
+    directory = shipped_directory()
+    if (directory.parent / "pyproject.toml").is_file():
+        return f"this source tree's diagrams/ ({directory}; an edit there changes what runs)"
+    return (f"the installed package ({directory}; a checkout's diagrams/ is not read: copy a scenario with "
+            "drake-traj show NAME > my_task.yaml, edit the copy and run it by its path)")
 
 
 def _is_shipped_name(reference: str) -> bool:

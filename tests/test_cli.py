@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import browser
-from drake_traj import cli, commands
+from drake_traj import cli, commands, scenario
 from drake_traj.robots import ROBOT_NAMES, get_robot
 from drake_traj.scenario import load_scenario, shipped_scenarios
 
@@ -39,13 +39,34 @@ def test_a_commands_help_lists_its_options(capsys):
 
 def test_list_gives_each_shipped_files_path_above_its_scenarios(capsys):
     assert cli.main(["list"]) == cli.EXIT_OK
-    lines = capsys.readouterr().out.splitlines()
+    lines = capsys.readouterr().out.splitlines()[1:]  # below which copy runs
     for entry in shipped_scenarios():
         header = lines.index(str(entry.path))
         below = lines[header + 1:]
         below = below[:next((k for k, line in enumerate(below) if not line.startswith("  ")), len(below))]
         assert any(line.split()[0] == entry.name for line in below), (entry.name, lines)
 
+
+
+def test_list_and_show_say_which_copy_of_the_shipped_files_runs(capsys):
+    directory = shipped_scenarios()[0].path.parent
+    here = f"from this source tree's diagrams/ ({directory}; an edit there changes what runs)"  # the tests run in a checkout
+    assert cli.main(["list"]) == cli.EXIT_OK
+    assert capsys.readouterr().out.splitlines()[0] == f"shipped scenarios, {here}"
+    assert cli.main(["show", "quintic_ptp"]) == cli.EXIT_OK
+    assert f"that is {directory / 'quintic_ptp.yaml'}, {here}; run a copy with" in capsys.readouterr().err
+
+
+def test_an_installed_copy_says_a_checkouts_diagrams_are_not_read(tmp_path, monkeypatch, capsys):
+    installed = tmp_path / "site-packages" / "drake_traj" / "diagrams"  # no pyproject.toml beside it
+    installed.mkdir(parents=True)
+    (installed / "quintic_ptp.yaml").write_text((shipped_scenarios()[0].path.parent / "quintic_ptp.yaml").read_text())
+    monkeypatch.setattr(scenario, "shipped_directory", lambda: installed)
+    assert cli.main(["list"]) == cli.EXIT_OK
+    assert capsys.readouterr().out.splitlines()[:2] == [
+        f"shipped scenarios, from the installed package ({installed}; a checkout's diagrams/ is not read: copy a "
+        "scenario with drake-traj show NAME > my_task.yaml, edit the copy and run it by its path)",
+        str(installed / "quintic_ptp.yaml")]
 
 @pytest.mark.parametrize("argv, variant", [(["show", "quintic_ptp"], None), (["show", "pajak_sim3"], "sim3"),
                                            (["show", "pajak", "--variant", "sim2"], "sim2")])

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from drake_traj import QuinticConfig, cli
-from drake_traj.scenario import (Scenario, default_scenario_path, find_scenario, load_scenario, make_planner,
-                                 scenario_variants)
+from drake_traj.scenario import (Scenario, ScenarioError, default_scenario_path, find_scenario, load_scenario,
+                                 make_planner, scenario_variants)
 
 from conftest import DIAGRAMS
 
@@ -67,6 +67,34 @@ def test_missing_scenario_file_is_named(tmp_path):
     with pytest.raises(ValueError, match="scenario file .*nowhere.yaml not found"):
         load_scenario(tmp_path / "nowhere.yaml")
 
+
+@pytest.mark.parametrize("reference, variant, shipped", [
+    ("diagrams/boryga_loop.yaml", "scara", "boryga_loop_scara"), ("diagrams/pajak.yaml", "sim3", "pajak_sim3"),
+    ("diagrams/quintic_ptp.yaml", None, "quintic_ptp"), ("../elsewhere/quintic_ptp", None, "quintic_ptp")])
+def test_a_path_to_a_shipped_file_not_found_here_suggests_the_shipped_name(reference, variant, shipped, tmp_path,
+                                                                           monkeypatch):
+    # the README's diagrams/... paths, run outside the checkout
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ScenarioError) as error:
+        load_scenario(reference, variant)
+    assert str(error.value) == (f"scenario file {reference} not found in {tmp_path}; the shipped scenario of that name "
+                                f"runs as `drake-traj run {shipped}` (Python: load_scenario('{shipped}'))")
+    assert load_scenario(shipped).name == shipped
+
+
+def test_a_path_to_a_shipped_file_of_variants_names_them(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["run", "diagrams/pajak.yaml"]) == cli.EXIT_BAD_INPUT
+    names = ", ".join(f"pajak_{variant}" for variant in scenario_variants(DIAGRAMS / "pajak.yaml"))
+    assert capsys.readouterr().err == (f"drake-traj: error: scenario file diagrams/pajak.yaml not found in {tmp_path}; "
+                                       f"the shipped file of that name holds {names}: run one by its name, e.g. "
+                                       "`drake-traj run pajak_sim3` (Python: load_scenario('pajak_sim3'))\n")
+
+
+def test_a_path_of_no_shipped_name_is_only_not_found(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ScenarioError, match=rf"^scenario file diagrams/mine.yaml not found in {tmp_path}$"):
+        load_scenario("diagrams/mine.yaml")
 
 def test_a_shipped_name_is_found_beside_a_folder_of_that_name(tmp_path, monkeypatch):
     # an earlier run written with --out quintic_ptp must not hide the shipped scenario
