@@ -9,13 +9,16 @@ updated every step), so no Drake system is involved here.
 from __future__ import annotations
 
 import dataclasses
+import inspect
 
 import numpy as np
 import pytest
+from numba.core.registry import CPUDispatcher
 
 from drake_traj.robots import task_space
 from drake_traj.robots import ur10e as robot
 from drake_traj.planners import pajak as P
+from drake_traj.planners.pajak import kernel
 from drake_traj.planners.pajak.kernel import PENALTY_SPAN, PENALTY_STIFFNESS, VIABILITY_MARGIN, Parameter, viability_bound
 
 Q0 = P.paper_initial_configuration()
@@ -466,7 +469,7 @@ def test_acceleration_is_continuous(sim):
 def test_jerk_budget_rates():
     # improvement 1: the rate limits that keep c (and σ, the approach rate) from changing q̈ faster
     # than the budget: budget / max |∂q̈_i/∂x|
-    from drake_traj.planners.pajak.kernel import budgeted_rate
+    from drake_traj.planners.pajak.terms import budgeted_rate
     from drake_traj.planners.pajak.limits import scaling_slew
 
     b = np.array([1.0, -200.0, 0.5, 0.0, 0.0, 0.0])
@@ -625,3 +628,14 @@ def test_overshoot_of_the_final_goal(task):
         assert overshoot[False] > 7e-4 and overshoot[True] < 2e-4
     else:
         assert overshoot[False] > 0.05 and overshoot[True] < 1.5e-3
+
+
+def test_the_cached_law_follows_an_edit_of_every_module_it_calls():
+    # numba checks a cached function against its own file only: the law's compiled functions that
+    # call compiled code of another module close over the digest of those modules' sources
+    # (kernel.DEPENDENCY_SOURCES), so that an edit of any of them (terms.py, limits.py, ...)
+    # recompiles the law in the next process
+    hashed = {str(path) for path in kernel.DEPENDENCY_SOURCES}
+    called = {inspect.getsourcefile(value.py_func) for value in vars(kernel).values()
+              if isinstance(value, CPUDispatcher)} - {kernel.__file__}
+    assert called and called <= hashed

@@ -1,6 +1,8 @@
 """The Pająk 2024 law, compiled: every equation of the planner and its fixed-step integrator.
 
-This module is the one implementation of the law. :mod:`.law` wraps it for Python callers (the
+This module is the one implementation of the law, with its task-space terms (:mod:`.terms`: J⁻¹,
+a and b of eq. 17, the approach damping, σ of eq. 19) and its limit keeping (:mod:`.limits`: the
+choice of c, the braking). :mod:`.law` wraps it for Python callers (the
 Drake system, tests) and :mod:`.integration` for whole runs; the functions here take flat float
 vectors whose layouts are the enums below, so that a call from Python costs no conversion:
 
@@ -29,16 +31,16 @@ from drake_traj import compiled as compiled_module
 from drake_traj.compiled import compiled, sources_digest
 from drake_traj.planners.laws import scaling
 from drake_traj.planners.laws.scaling import relaxed_scaling
-from drake_traj.planners.pajak import limits
+from drake_traj.planners.pajak import limits, terms
 from drake_traj.planners.pajak.limits import (BRAKE_LAG, BRAKE_SLEW, brake, brake_weight, choose_scaling,
                                               holding_joint, keep_limits, scaling_interval, scaling_slew)
+from drake_traj.planners.pajak.terms import (ORIENTATION_LENGTH, acceleration_terms, approach_damping, approach_rate,
+                                             blend_progress, budgeted_rate, damping_factor)
 from drake_traj.robots import UR10E, compiled_kinematics
 
 __all__ = [
-    "Discrete", "Evaluation", "Log", "Parameter", "Status", "acceleration_box", "acceleration_terms",
-    "approach_damping", "approach_rate", "blend_progress", "blended_target", "budgeted_rate", "damping_factor",
-    "KINEMATICS", "evaluate_kernel", "finished_kernel", "integrate_kernel", "update_kernel", "velocity_penalty",
-    "viability_bound",
+    "Discrete", "Evaluation", "Log", "Parameter", "Status", "acceleration_box", "blended_target", "KINEMATICS",
+    "evaluate_kernel", "finished_kernel", "integrate_kernel", "update_kernel", "velocity_penalty", "viability_bound",
 ]
 
 
@@ -133,7 +135,6 @@ class Status(IntEnum):
     TIMEOUT = -4
 
 
-ORIENTATION_LENGTH = 0.1  # [m/rad], weight of orientation in the progress measure and the approach rate
 MIN_COS_PITCH = 1e-6  # Euler gimbal lock (as the UR10e's analytic_jacobian_and_bias): the paper's method
 # "ours" (improvement 6 on): stop at the Euler angles' gimbal lock once φ_Y is within 1e-3 rad
 # (0.057°) of ±90° (the margin PajakConfig.validate keeps waypoints from it). Closer, B(φ)⁻¹ and
@@ -171,7 +172,8 @@ kinematics_into, orientation_error, wrapped = KINEMATICS.kinematics_into, KINEMA
 
 
 # --------------------------------------------------------------------------------------------
-# The law's pieces (compiled functions of floats and small arrays, tested one by one)
+# The law's joint-space pieces (compiled functions of floats and small arrays, tested one by one;
+# its task-space terms are in :mod:`.terms`)
 # --------------------------------------------------------------------------------------------
 
 
@@ -213,143 +215,6 @@ def velocity_penalty(qd: float, qd_max: float, rho: float, vartheta: float, smoo
 
 
 @compiled
-def approach_rate(error, error_rate, delta: float) -> float:
-    """r = -ė·e / (|e|² + δ²) [1/s]: the rate at which the TCP closes on p_w, from the error e to
-    it and ė = J q̇ (6 each), orientation rows weighted by 0.1 m/rad (improvement 4). The distance
-    decays as exp(-r t) while r holds; δ only keeps r finite at e = 0. One rate for the whole pose,
-    not one per component: a component that passes 0 while the TCP sweeps by the goal would give
-    a rate that spikes to ±∞ and back within milliseconds."""
-    closing = 0.0
-    size = delta * delta
-    for k in range(6):
-        weight = 1.0 if k < 3 else ORIENTATION_LENGTH * ORIENTATION_LENGTH
-        closing += weight * error[k] * error_rate[k]
-        size += weight * error[k] * error[k]
-    return -closing / size
-
-
-@compiled
-def approach_damping(rate: float, stiffness: float, damping: float) -> float:
-    """Damping D [1/s] that keeps the TCP from overshooting p_w when it closes at ``rate`` r
-    against ``stiffness`` K, given the law's ``damping`` (improvement 4).
-
-    For ë = -D ė - K e, r = -ė/e obeys dr/dt = r² - D r + K. With D = r + K/r it is constant:
-    ė = -r e is invariant and e decays as exp(-r t) without crossing 0. Returned: the given
-    ``damping`` for r <= sqrt(K) (the literal law), ramped (smoothstep in r) up to λ + K/λ at
-    r = λ = 2 sqrt(K), and r + K/r above λ; never below ``damping``. Continuous in r.
-    """
-    root = math.sqrt(stiffness)
-    held = max(rate, 2.0 * root)
-    hold = held + stiffness / held
-    x = min(max(rate / root - 1.0, 0.0), 1.0)
-    return max(damping, damping + (hold - damping) * (x * x * (3.0 - 2.0 * x)))
-
-
-@compiled
-def damping_factor(measure: float, threshold: float, max_damping: float) -> float:
-    """λ² of the damped least-squares inverse (improvement 3): 0 for measure >= threshold,
-    rising to max_damping² at a singular J: λ² = λ_max² (1 - measure/threshold)², which starts
-    with zero slope, so q̈ does not bend sharply where the damping sets in."""
-    gap = max(1.0 - measure / threshold, 0.0)
-    return max_damping * max_damping * gap * gap
-
-
-@compiled
-def _factor(jac, lam2, use_damped, matrix, pivots):
-    """LU factors (partial pivoting) of J, or of JᵀJ + λ²I for the damped inverse, into
-    ``matrix`` (6, 6) and ``pivots`` (6,)."""
-    for i in range(6):
-        for j in range(6):
-            if use_damped:
-                total = 0.0
-                for k in range(6):
-                    total += jac[k, i] * jac[k, j]
-                matrix[i, j] = total + (lam2 if i == j else 0.0)
-            else:
-                matrix[i, j] = jac[i, j]
-    for k in range(6):
-        pivot = k
-        for i in range(k + 1, 6):
-            if abs(matrix[i, k]) > abs(matrix[pivot, k]):
-                pivot = i
-        pivots[k] = pivot
-        if pivot != k:
-            for j in range(6):
-                matrix[k, j], matrix[pivot, j] = matrix[pivot, j], matrix[k, j]
-        for i in range(k + 1, 6):
-            factor = matrix[i, k] / matrix[k, k]
-            matrix[i, k] = factor
-            for j in range(k + 1, 6):
-                matrix[i, j] -= factor * matrix[k, j]
-
-
-@compiled
-def _solve(jac, use_damped, matrix, pivots, rhs, out):
-    """J⁻¹ rhs (eq. 13), or (JᵀJ + λ²I)⁻¹ Jᵀ rhs (damped least squares), into ``out`` (6,),
-    from the factors of :func:`_factor`."""
-    for i in range(6):
-        if use_damped:
-            total = 0.0
-            for k in range(6):
-                total += jac[k, i] * rhs[k]
-            out[i] = total
-        else:
-            out[i] = rhs[i]
-    for k in range(6):
-        pivot = pivots[k]
-        if pivot != k:
-            out[k], out[pivot] = out[pivot], out[k]
-    for i in range(6):
-        for k in range(i):
-            out[i] -= matrix[i, k] * out[k]
-    for i in range(5, -1, -1):
-        for k in range(i + 1, 6):
-            out[i] -= matrix[i, k] * out[k]
-        out[i] /= matrix[i, i]
-
-
-@compiled
-def acceleration_terms(jac, bias, error, error_rate, kp, damping, penalty, lam2, use_damped, a, b):
-    """a and b of eq. 17 into ``a``, ``b`` (6,):
-
-    a = -J⁻¹ J̇q̇, b = -J⁻¹ (D ė + Λ_P e) + Δq̈, with ė = J q̇ (``error_rate``), e of eq. 6 or
-    eq. 19 and the damping D = Λ_V (eq. 13) or more (improvement 4). q̈ = a + c b is eq. 17;
-    with c = 1 it is eq. 16 (eq. 13 without Δq̈). With ``use_damped`` J⁻¹ is the damped
-    least-squares inverse with λ² = ``lam2`` (:func:`damping_factor`).
-    """
-    matrix = np.empty((6, 6))
-    pivots = np.empty(6, dtype=np.int64)
-    _factor(jac, lam2, use_damped, matrix, pivots)
-    rhs = np.empty(6)
-    _solve(jac, use_damped, matrix, pivots, bias, a)
-    for i in range(6):
-        a[i] = -a[i]
-        rhs[i] = damping[i] * error_rate[i] + kp[i] * error[i]
-    _solve(jac, use_damped, matrix, pivots, rhs, b)
-    for i in range(6):
-        b[i] = penalty[i] - b[i]
-
-
-@compiled
-def budgeted_rate(jac, lam2, use_damped, direction, scale: float, budget: float) -> float:
-    """Largest rate [1/s] at which a quantity that moves q̈ = a + c b (eq. 17) by
-    ∂q̈/∂x = -c J⁻¹ ``direction`` (``direction`` (6,) in task space, J⁻¹ damped as in
-    :func:`acceleration_terms`) may change without changing any q̈_i faster than ``budget``
-    [rad/s³] (improvement 1): budget / (c max |J⁻¹ direction|), with c = ``scale``, the largest
-    c until the next update. Very large (not infinite) where x does not move q̈, so that the
-    rate times 0 s is 0."""
-    matrix = np.empty((6, 6))
-    pivots = np.empty(6, dtype=np.int64)
-    _factor(jac, lam2, use_damped, matrix, pivots)
-    sensitivity = np.empty(6)
-    _solve(jac, use_damped, matrix, pivots, direction, sensitivity)
-    largest = 1e-300
-    for k in range(6):
-        largest = max(largest, scale * abs(sensitivity[k]))
-    return budget / largest
-
-
-@compiled
 def acceleration_box(qd, p, lower, upper):
     """The box [lower, upper] (6 each) that q̈ must stay in: ±q̈_max (eq. 5), narrowed near the
     velocity limits (improvement 2) so that q̇ stays viable: q̈_i <= viability_bound(q̇_max - q̇_i)
@@ -381,36 +246,22 @@ def viability_bound(gap: float, gain: float, jerk: float) -> float:
     return math.sqrt(2.0 * jerk * gap + offset * offset) - offset
 
 
-@compiled
-def blend_progress(position, reference, travel: float, length: float):
-    """(σ of eq. 19 before the monotone max, step): σ = the TCP path length through the ball /
-    ``length``, clipped to [0, 1].
-
-    σ = (ℓ + |x - x_ref|) / length, where ℓ is the path length accumulated at the updates since
-    the TCP entered the ball and x_ref the TCP position at the last update (step = |x - x_ref|).
-    It is 0 on entry, continuous in x and grows whenever the TCP moves, so the target always
-    leads (a projection on p_i -> p_{i+1} does not grow while the TCP is still heading for p_i,
-    and 1 - δ/ϵ is not monotone: both stall, docs/papers.md). ``length`` = ``blend_length`` · ϵ.
-    """
-    step = math.sqrt((position[0] - reference[0]) ** 2 + (position[1] - reference[1]) ** 2
-                     + (position[2] - reference[2]) ** 2)
-    return min(max((travel + step) / length, 0.0), 1.0), step
-
-
 # --------------------------------------------------------------------------------------------
 # The law
 # --------------------------------------------------------------------------------------------
 #
 # numba caches a compiled function under its own source file only (numba issue #1833): after an
-# edit of the robot's kinematics, of eq. 18 or of the limit keeping in their modules, the cached
-# law would go on using the old code. Numba does hash a function's closure into its cache key, so each function below that
-# reaches compiled code of another module is made in a closure over the digest of those modules'
-# sources (``dependencies``, unused otherwise); they call each other through the module's globals.
+# edit of the robot's kinematics, of eq. 18, of the limit keeping (limits.py) or of the task-space
+# terms (terms.py) in their modules, the cached law would go on using the old code. Numba does hash
+# a function's closure into its cache key, so each function below that reaches compiled code of
+# another module is made in a closure over the digest of those modules' sources
+# (``dependencies``, unused otherwise); they call each other through the module's globals.
 
 
-_DEPENDENCIES = sources_digest(
+DEPENDENCY_SOURCES = (
     *(inspect.getsourcefile(function.py_func) for function in (kinematics_into, orientation_error, wrapped)),
-    *compiled_kinematics.SOURCES, scaling.__file__, limits.__file__, compiled_module.__file__)
+    *compiled_kinematics.SOURCES, scaling.__file__, limits.__file__, terms.__file__, compiled_module.__file__)
+_DEPENDENCIES = sources_digest(*DEPENDENCY_SOURCES)
 
 
 @compiled

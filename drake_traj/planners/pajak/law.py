@@ -16,7 +16,8 @@ into :class:`PlanningError`. A LeafSystem (continuous state [q; q̇], the discre
 
 Corrections, readings and our improvements (each a flag of :class:`~.parameters.PajakConfig`,
 default on; all off gives the paper's method as printed, with the corrections) are listed in
-docs/papers.md (Pająk 2024) and at the functions of :mod:`.kernel` that implement them.
+docs/papers.md (Pająk 2024) and at the functions of :mod:`.kernel` (and :mod:`.terms`,
+:mod:`.limits`) that implement them.
 """
 
 from __future__ import annotations
@@ -30,7 +31,6 @@ from drake_traj.planners.pajak.kernel import (
     KINEMATICS,
     GIMBAL_MARGIN,
     MIN_COS_PITCH,
-    ORIENTATION_LENGTH,
     VIABILITY_MARGIN,
     Discrete,
     Evaluation,
@@ -41,6 +41,7 @@ from drake_traj.planners.pajak.kernel import (
     update_kernel,
 )
 from drake_traj.planners.pajak.parameters import TASK_JOINTS, PajakConfig
+from drake_traj.planners.pajak.terms import ORIENTATION_LENGTH
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import limit_or_default
 
