@@ -41,7 +41,7 @@ def check_cost(repeats: int) -> None:
           "check / closed-loop run |")
     print("|---|---|---|---|---|---|---|")
     for name in UR10E_SCENARIOS:
-        scenario = load_scenario(name if name != "fixture_cell" else "diagrams/fixture_cell.yaml")
+        scenario = load_scenario(name)
         checker = scenario.cell_checker()
         checks, plans, ratios = [], [], []
         for _ in range(repeats):

@@ -5,7 +5,7 @@
 Tasks: :func:`drake_traj.bench.pajak_walk_tasks` (the set of tests/planners/test_pajak_random.py
 at 0.7 rad, seed 9): 1-4 waypoints, each the flange pose of a configuration up to ``step`` rad per
 joint from the previous one, random limits. The law runs alone under its own RK4 integrator at
-1 ms, 0.5 s past its finish. Per scale it prints:
+1 ms, 0.5 s past its finish. Its progress (tasks done, time left) goes to stderr; per scale it prints:
 
 - finished tasks, and the failures by cause with the stall's reason;
 - the q̈-continuity share of the finished tasks, two ways: strictly, no change of q̈ between 1 ms
@@ -24,8 +24,10 @@ A benchmark: run it to measure; no assertion here (the tests assert a small seed
 import argparse
 import json
 import math
+import sys
 
 import numpy as np
+from tqdm import tqdm
 
 from drake_traj.bench import optimal_duration, pajak_walk_tasks
 from drake_traj.planners import pajak as P
@@ -110,7 +112,9 @@ def main() -> None:
     args = parser.parse_args()
     everything = {}
     for step in args.steps:
-        figures = [measure(task) for task in pajak_walk_tasks(args.count, args.seed, step)]
+        tasks = tqdm(pajak_walk_tasks(args.count, args.seed, step), desc=f"moves of up to {step} rad", unit="task",
+                     file=sys.stderr)
+        figures = [measure(task) for task in tasks]
         everything[str(step)] = figures
         print(summary(step, figures), flush=True)
     if args.json:

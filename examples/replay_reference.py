@@ -1,7 +1,10 @@
 """Replay a run's reference in another Drake diagram: the reference as a PiecewisePolynomial
 (``SimulationResult.reference_trajectory()``) driving a ``TrajectorySource``.
 
-    python examples/replay_reference.py RUN_DIR
+    python examples/replay_reference.py [RUN_DIR]
+
+RUN_DIR defaults to the main job's folder: ``out`` (the README's ``drake-traj run --out out``) or
+``out/pajak_sim3`` (``drake-traj run``'s own default), the first that holds a run.
 
 The diagram here is a bare UR10e plant with its PD actuators and gravity compensation (no
 feed-forward of the acceleration), so its tracking error is larger than the station's; any diagram
@@ -9,6 +12,7 @@ that takes a desired state [q; q̇] can take the same source.
 """
 
 import sys
+from pathlib import Path
 
 import numpy as np
 from pydrake.multibody.plant import AddMultibodyPlant
@@ -19,7 +23,11 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
 
 from drake_traj import SimulationResult, get_robot
+from drake_traj.result import ResultFileError
 from drake_traj.scenario import default_plant_config
+
+# the main job's folders: the README's `drake-traj run --out out`, and `drake-traj run` without --out
+MAIN_JOB_FOLDERS = ("out", "out/pajak_sim3")
 
 
 def replay(run_dir) -> float:
@@ -49,5 +57,25 @@ def replay(run_dir) -> float:
     return error
 
 
+def main(argv: list[str]) -> int:
+    """Replays the run of ``argv[0]`` or of the main job's folder; returns the exit code (2: no run
+    there, said in one line)."""
+    if argv:
+        run_dir = argv[0]
+    else:
+        run_dir = next((folder for folder in MAIN_JOB_FOLDERS if (Path(folder) / "result.npz").is_file()), None)
+        if run_dir is None:
+            print(f"replay_reference.py: no run in {' or '.join(MAIN_JOB_FOLDERS)} (in {Path.cwd()}): "
+                  "`drake-traj run --out out` writes one; or give a run's folder: "
+                  "python examples/replay_reference.py RUN_DIR", file=sys.stderr)
+            return 2
+    try:
+        replay(run_dir)
+    except ResultFileError as error:
+        print(f"replay_reference.py: {error} (`drake-traj run --out {run_dir}` writes a run there)", file=sys.stderr)
+        return 2
+    return 0
+
+
 if __name__ == "__main__":
-    replay(sys.argv[1] if len(sys.argv) > 1 else "out/pajak_sim3")
+    sys.exit(main(sys.argv[1:]))
