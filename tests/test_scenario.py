@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drake_traj import QuinticConfig, cli
+from drake_traj import QuinticConfig, cli, get_robot, planners
 from drake_traj.scenario import (Scenario, ScenarioError, default_scenario_path, find_scenario, load_scenario,
                                  make_planner, scenario_variants)
 
@@ -140,3 +140,16 @@ def test_example_runs_and_writes_its_outputs(tmp_path, monkeypatch, capsys):
     runpy.run_path(str(EXAMPLES / "quintic_ptp.py"), run_name="__main__")
     assert "T = " in capsys.readouterr().out
     assert (tmp_path / "result.npz").is_file() and (tmp_path / "joints.png").is_file()
+
+
+def test_the_config_level_make_planner_says_what_to_pass():
+    # drake_traj.planners.make_planner takes a config, a robot and a start; a scenario goes to drake_traj.make_planner
+    with pytest.raises(TypeError, match=r"got Scenario: .*; a scenario's planner is drake_traj\.make_planner\(scenario\)"):
+        planners.make_planner(load_scenario("quintic_ptp"))
+    with pytest.raises(TypeError, match=r"^make_planner\(QuinticConfig\(\.\.\.\), robot, q_initial\) needs robot and "
+                                        r"q_initial: .* make_planner\(config, robot, robot.home_configuration\)$"):
+        planners.make_planner(QuinticConfig(goals=[[0.0] * 6]))
+    robot = get_robot("ur10e")
+    with pytest.raises(TypeError, match=r"needs q_initial: "):
+        planners.make_planner(QuinticConfig(goals=[[0.0] * 6]), robot)
+    assert planners.make_planner(QuinticConfig(goals=[[0.0] * 6]), robot, robot.home_configuration).robot.name == "ur10e"

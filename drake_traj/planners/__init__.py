@@ -47,15 +47,23 @@ PlannerConfig = Union[QuinticConfig, PajakConfig, BorygaConfig, LiConfig, MovejC
                       SmoothWaypointsConfig, RetimedPajakConfig, FreeMotionConfig]
 
 
-def make_planner(config: PlannerConfig, robot: Robot, q_initial) -> PlannerSystem:
-    """The planner system ``config`` describes, on ``robot``, starting at rest at ``q_initial``;
-    its :attr:`~drake_traj.planners.base.PlannerSystem.robot` is ``robot`` (a station runs it
-    there and refuses another robot)."""
+def make_planner(config: PlannerConfig, robot: Robot | None = None, q_initial=None) -> PlannerSystem:
+    """The planner system ``config`` describes, on ``robot``, starting at rest at ``q_initial``
+    [rad, or m for a prismatic joint], (num_joints,); both are needed (left out, a TypeError says
+    what to pass). Its :attr:`~drake_traj.planners.base.PlannerSystem.robot` is ``robot`` (a
+    station runs it there and refuses another robot). A scenario's planner is
+    ``drake_traj.make_planner(scenario)``."""
     try:
         maker = _MAKERS[type(config)]
     except KeyError:
-        raise TypeError(f"config must be one of {[c.__name__ for c in PLANNER_CONFIGS]}, got {type(config).__name__} "
-                        "(a scenario's planner is drake_traj.make_planner(scenario))") from None
+        raise TypeError(f"config must be one of {[c.__name__ for c in PLANNER_CONFIGS]}, got {type(config).__name__}: "
+                        f"{config!r:.80}; a scenario's planner is drake_traj.make_planner(scenario), a config's "
+                        "drake_traj.planners.make_planner(config, robot, q_initial)") from None
+    missing = [name for name, value in (("robot", robot), ("q_initial", q_initial)) if value is None]
+    if missing:
+        raise TypeError(f"make_planner({type(config).__name__}(...), robot, q_initial) needs {' and '.join(missing)}: "
+                        "the robot it runs on and its start configuration [rad], e.g. robot = drake_traj.get_robot('ur10e'); "
+                        "make_planner(config, robot, robot.home_configuration)")
     instance_of(robot, Robot, "robot")
     planner = maker(config, robot, finite_array(q_initial, "q_initial", "rad or m", shape=(robot.num_joints,)))
     planner.robot = planner_robot(robot, planner.num_joints)
