@@ -266,13 +266,17 @@ class SimulationResult:
                                              f"{self.effort_limit[j]:g} at t = {self.t[first]:.3f} s and stayed there "
                                              f"{saturated[:, j].sum() * self.log_period:.3f} s in all: the arm could "
                                              "not follow the reference", float(self.t[first]), tuple(self.q_meas[first]))
-        error = np.linalg.norm(self.tcp_ref[:, :3] - self.tcp[:, :3], axis=1)
+        error = self.tcp_position_error()
         if len(error) and not error.max() <= tracking_tolerance:  # NaN is not within the tolerance
             first = int(np.argmax(~(error <= tracking_tolerance)))
             return Failure(Cause.TRACKING, f"the TCP was {1e3 * error.max():.3f} mm from the reference (tolerance "
                                        f"{1e3 * tracking_tolerance:g} mm), first over it at t = {self.t[first]:.3f} s",
                            float(self.t[first]), tuple(self.q_meas[first]))
         return None
+
+    def tcp_position_error(self) -> np.ndarray:
+        """Distance [m] between the reference and the measured TCP position at each sample, (N,)."""
+        return np.linalg.norm(self.tcp_ref[:, :3] - self.tcp[:, :3], axis=1)
 
     def jerk(self) -> np.ndarray:
         """Reference jerk [rad/s^3] by finite differences of qdd_ref, shape (N-1, 6)."""
@@ -282,7 +286,7 @@ class SimulationResult:
         """Scalar and per-joint figures of merit (NaN where the log holds NaN: a NaN is never
         skipped; such a run has not succeeded)."""
         failure = self.failure or self.non_finite_failure()
-        tcp_error = np.linalg.norm(self.tcp_ref[:, :3] - self.tcp[:, :3], axis=1)
+        tcp_error = self.tcp_position_error()
         simulated = float(self.t[-1]) if len(self.t) else 0.0
         jerk = self.jerk()
         peak_torque = _over_samples(np.max, np.abs(self.tau))
@@ -488,10 +492,27 @@ class SimulationResult:
         figure.suptitle(f"{self.name}: joint reference")
         return figure
 
+    def _tcp_error_panel(self, ax) -> None:
+        """The TCP position error [mm] (:meth:`tcp_position_error`) against time on ``ax``, its
+        largest value in the legend, with the finish line."""
+        error = 1e3 * self.tcp_position_error()
+        worst = int(np.nanargmax(error)) if len(error) and np.isfinite(error).any() else None
+        label = "|p_ref - p_meas|" if worst is None else \
+            f"|p_ref - p_meas|, max {error[worst]:.3g} mm at t = {self.t[worst]:.3f} s"
+        ax.plot(self.t, error, color="tab:red", label=label)
+        self._finish_line([ax])
+        ax.set_ylabel("TCP position error [mm]")
+        if worst is not None and error[worst] > 0:
+            ax.set_ylim(0.0, 1.3 * error[worst])  # room above the curve for the legend
+        else:
+            ax.set_ylim(bottom=0.0)
+        ax.grid(True, alpha=0.3)
+
     def tracking_figure(self) -> Figure:
-        """Joint tracking error q_ref - q_meas and torque over the effort limit."""
-        figure = Figure(figsize=(11, 6), layout="constrained")
-        error_ax, torque_ax = figure.subplots(2, 1, sharex=True)
+        """Joint tracking error q_ref - q_meas, the TCP position error [mm] and the torque over the
+        effort limit, against time."""
+        figure = Figure(figsize=(11, 8.5), layout="constrained")
+        error_ax, tcp_ax, torque_ax = figure.subplots(3, 1, sharex=True)
         for j in range(self.q_ref.shape[1]):
             scale, unit = (1e3, "mm") if self.joint_unit(j) == "m" else (1e3, "mrad")
             error_ax.plot(self.t, scale * (self.q_ref[:, j] - self.q_meas[:, j]), label=f"joint {j + 1} [{unit}]",
@@ -499,21 +520,27 @@ class SimulationResult:
             torque_ax.plot(self.t, self.tau[:, j] / self.effort_limit[j], label=f"joint {j + 1}", **joint_style(j))
         error_ax.set_ylabel("q_ref - q_meas [mrad or mm]" if self.joint_types and "prismatic" in self.joint_types
                             else "q_ref - q_meas [mrad]")
+        self._tcp_error_panel(tcp_ax)
         torque_ax.set_ylabel("effort / effort limit")
         torque_ax.set_xlabel("t [s]")
         self._finish_line([error_ax, torque_ax])
-        for ax in (error_ax, torque_ax):
+        for ax in (error_ax, tcp_ax, torque_ax):
             ax.grid(True, alpha=0.3)
             _legend(ax)
         figure.suptitle(f"{self.name}: tracking")
         return figure
 
     def scaling_figure(self) -> Figure:
-        """The scaling coefficient c(t)."""
+        """The scaling coefficient c(t); for a planner that does not scale its trajectory (c the
+        same throughout), a note saying so on the panel."""
         figure = Figure(figsize=(8, 3), layout="constrained")
         ax = figure.subplots()
         ax.plot(self.t, self.scaling, label="c")
         self._finish_line([ax])
+        if len(self.scaling) and np.all(self.scaling == self.scaling[0]):
+            ax.text(0.5, 0.5, f"no trajectory scaling: constant {self.scaling[0]:g}", transform=ax.transAxes,
+                    ha="center", va="center", fontsize="large", color="dimgrey",
+                    bbox={"facecolor": "white", "edgecolor": "lightgrey"})
         ax.set_xlabel("t [s]")
         ax.set_ylabel("c")
         ax.set_ylim(-0.05, 1.05)
@@ -523,11 +550,13 @@ class SimulationResult:
         return figure
 
     def tcp_path_figure(self) -> Figure:
-        """The measured and reference TCP paths in 3-D (base frame) with the waypoints and, for a
-        planner that turns to the next waypoint inside a neighbourhood of each (the Pająk
-        planner's ϵ), those neighbourhoods as spheres."""
-        figure = Figure(figsize=(7, 6), layout="constrained")
-        ax = figure.add_subplot(projection="3d")
+        """Left, the measured and reference TCP paths in 3-D (base frame) with the waypoints and,
+        for a planner that turns to the next waypoint inside a neighbourhood of each (the Pająk
+        planner's ϵ), those neighbourhoods as spheres; right, the distance between the two paths
+        [mm] against time, which the 3-D view's scale cannot show."""
+        figure = Figure(figsize=(13, 6), layout="constrained")
+        grid = figure.add_gridspec(1, 2, width_ratios=(3, 2))
+        ax = figure.add_subplot(grid[0], projection="3d")
         ax.plot(*self.tcp_ref[:, :3].T, label="reference", linewidth=2)
         ax.plot(*self.tcp[:, :3].T, "--", label="measured", linewidth=1)
         if len(self.waypoints):
@@ -545,8 +574,15 @@ class SimulationResult:
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
         ax.set_zlabel("z [m]")
-        figure.legend(loc="outside right upper", fontsize="small")  # the one panel's, clear of the 3-D box
-        ax.set_title(f"{self.name}: TCP path")
+        # the 3-D panel's legend below it, clear of the box
+        figure.legend(*ax.get_legend_handles_labels(), loc="outside lower left", ncols=3, fontsize="small")
+        ax.set_title("TCP path (base frame)")
+        error_ax = figure.add_subplot(grid[1])
+        self._tcp_error_panel(error_ax)
+        error_ax.set_xlabel("t [s]")
+        error_ax.legend(loc="upper left", fontsize="small")
+        error_ax.set_title("the measured TCP off the reference")
+        figure.suptitle(f"{self.name}: TCP path")
         return figure
 
     def _draw_neighbourhoods(self, ax) -> None:
