@@ -6,6 +6,7 @@ a command is given.
 
 import contextlib
 import json
+import os
 import signal
 import sys
 import threading
@@ -444,6 +445,9 @@ def execute(args) -> int:
         kind = "the task cannot be done" if isinstance(error, PlanningError) else "error"
         print(f"drake-traj: {kind}: {error}", file=sys.stderr)
         failure, code = error, EXIT_BAD_INPUT
+    except BrokenPipeError:  # stdout's reader stopped early (drake-traj list | head): nothing more to say
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # Python's last flush of stdout goes nowhere
+        return EXIT_OK
     except Exception as error:  # a bug, or the machine (disk full, ...): still no traceback unless asked
         print(f"drake-traj: internal error: {type(error).__name__}: {error} (--debug shows where)", file=sys.stderr)
         failure, code = error, EXIT_RUN_FAILED

@@ -27,6 +27,13 @@ def test_version_and_help_do_not_import_drake(argv):
     assert done.stdout.splitlines()[-1] == f"imported: [] exit {2 if argv[0] == 'no-such-command' else 0}", done
 
 
+
+def test_a_reader_that_stops_early_is_no_error():
+    # drake-traj list | head -1: the pipe closes while the list is printed
+    done = subprocess.run(f"{sys.executable} -m drake_traj.cli list | head -1", shell=True, capture_output=True,
+                          text=True, timeout=120)
+    assert done.stdout.startswith("shipped scenarios, from ") and not done.stderr, done
+
 def test_the_version_is_the_installed_packages(capsys):
     assert cli.main(["--version"]) == cli.EXIT_OK
     assert capsys.readouterr().out == f"drake-traj {importlib.metadata.version('drake_traj')}\n"
