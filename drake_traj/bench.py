@@ -458,13 +458,12 @@ class _Progress:
         return row
 
     def line(self) -> str:
-        """The progress as one line: runs done of all, failed, elapsed and estimated time left
-        (the mean time per run so far times the runs left)."""
+        """The progress after a run as one line: runs done of all, failed, elapsed and the time
+        left estimated as the mean time per run so far times the runs left."""
         elapsed = time.monotonic() - self._start
-        left = elapsed / self.count * (self.total - self.count) if self.count else float("nan")
-        eta = f"about {tqdm.format_interval(left)} left" if self.count else "time left not known yet"
+        left = elapsed / self.count * (self.total - self.count)
         return (f"bench: {self.count}/{self.total} runs ({100 * self.count / self.total:.0f} %), {self.failed} failed, "
-                f"{tqdm.format_interval(elapsed)} elapsed, {eta}")
+                f"{tqdm.format_interval(elapsed)} elapsed, about {tqdm.format_interval(left)} left")
 
     def _say(self, text: str) -> None:
         print(text, file=self._stream, flush=True)
