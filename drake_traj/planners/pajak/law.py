@@ -128,6 +128,7 @@ class PajakLaw:
             (Parameter.ORIENTATION_ACCURACY, p.orientation_accuracy), (Parameter.NEIGHBOURHOOD, p.neighbourhood),
             (Parameter.BLEND_DISTANCE, p.blend_length * p.neighbourhood), (Parameter.SCALING_RATE, p.scaling_rate),
             (Parameter.SCALING_SLEW, p.scaling_slew), (Parameter.JERK_BUDGET, p.jerk_budget),
+            (Parameter.JERK_LIMIT, p.jerk_limit),
             (Parameter.SINGULARITY_THRESHOLD, p.singularity_threshold),
             (Parameter.MAX_DAMPING, p.max_damping),
             (Parameter.APPROACH_DELTA, 1e-4 * p.accuracy),  # improvement 4: keeps the approach rate finite at p_w

@@ -8,7 +8,7 @@ import numpy as np
 from drake_traj.compiled import compiled
 
 __all__ = ["BRAKE_LAG", "BRAKE_ONSET", "BRAKE_SLEW", "BRAKE_TIME", "brake", "brake_weight", "choose_scaling",
-           "holding_joint", "keep_limits", "scaling_interval", "scaling_slew"]
+           "holding_joint", "keep_limits", "limit_jerk", "scaling_interval", "scaling_slew"]
 
 BRAKE_TIME = 0.05  # [s], time constant of the fallback braking at low speed (improvement 2)
 BRAKE_ONSET = 0.5  # violation (relative to q̈_max) at which the fallback is pure braking
@@ -123,6 +123,16 @@ def keep_limits(a, b, c_relaxed: float, lower, upper, qdd_max, c_low: float, c_h
     for k in range(6):
         qdd[k] = min(max(a[k] + c * b[k], lower[k]), upper[k])  # eq. 17, clipped to the box
     return c, violation
+
+
+@compiled
+def limit_jerk(last, reach: float, lower, upper, qdd):
+    """Improvement 1's jerk limit: q̈ (in ``qdd``) at most ``reach`` [rad/s²] from ``last``, its
+    value after the last update (``reach``: the jerk limit times the time since), then clipped to the box
+    [lower, upper]: the joint limits win where the box moved further (its edges move at no more
+    than the jerk budget where q̈ rides them, :func:`~.kernel.viability_bound`)."""
+    for k in range(qdd.shape[0]):
+        qdd[k] = min(max(min(max(qdd[k], last[k] - reach), last[k] + reach), lower[k]), upper[k])
 
 
 @compiled

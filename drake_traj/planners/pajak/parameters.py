@@ -68,7 +68,12 @@ class PajakConfig:
         jerk_budget: improvement 1 (with ``limit_acceleration`` and ``bounded_scaling``): the
             largest rate [rad/s³] at which each of these may change any q̈_i: c (its rate limit
             is lowered below ``scaling_slew``), the blend's σ moving the target (eq. 19) and the
-            approach rate of improvement 4 falling (the feedback itself is not limited).
+            approach rate of improvement 4 falling.
+        jerk_limit: improvement 1 (with ``limit_acceleration`` and ``bounded_scaling``): q̈_i
+            changes by at most this [rad/s³] (0.08 rad/s² in 1 ms), the joint limits
+            (eq. 4-5) excepted; where the law's own q̈ changes faster (near a singular J, where
+            a = -J⁻¹J̇q̇ of eq. 17 grows faster than the scaling can follow), q̈ follows it at
+            this rate.
         singularity_threshold: damped least squares below this :func:`drake_traj.robot.singularity_measure`.
         max_damping: damping λ of the damped least squares at a singular J.
         stop_speed: stop mode: TCP speed [m/s] below which a waypoint counts as reached.
@@ -104,6 +109,7 @@ class PajakConfig:
     scaling_rate: float = 1.0
     scaling_slew: float = 3.0
     jerk_budget: float = 40.0
+    jerk_limit: float = 80.0
     singularity_threshold: float = 0.1
     max_damping: float = 0.2
     stop_speed: float = 0.01
@@ -140,7 +146,7 @@ class PajakConfig:
             values[name] = None if is_default_limit else positive_vector(value, name, n)
         for name in (
             "rho", "accuracy", "orientation_accuracy", "neighbourhood", "scaling_rate", "scaling_slew", "jerk_budget",
-            "singularity_threshold", "max_damping",
+            "jerk_limit", "singularity_threshold", "max_damping",
             "stop_speed", "stall_time", "blend_length", "update_period",
         ):
             value = getattr(self, name)
