@@ -16,13 +16,32 @@ from drake_traj.planners.pajak.parameters import PajakConfig
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import finite_array, invalid, run_duration
 
-__all__ = ["MAX_PREFLIGHT_STEPS", "PajakPlanLaw", "PajakPlanner", "make"]
+__all__ = ["MAX_PREFLIGHT_STEPS", "PajakPlanLaw", "PajakPlanner", "coming_to_rest", "make"]
 
-# The preflight's integration steps at most: its log holds Log.SIZE values a step (54: 432 MB at
+# The preflight's integration steps at most: its log holds Log.SIZE values a step (60: 480 MB at
 # this bound; 600 s, the longest run, at the default 1 ms update period is 6e5 steps)
 MAX_PREFLIGHT_STEPS = 1_000_000
 SETTLE_TIME = 4.0  # [s] the law integrated on after the finish, while it settles (sim 3: 1e-6 rad/s after 2.6 s)
 REST_SPEED = 1e-6  # [rad/s] the planned motion ends where every joint is slower: at rest
+
+
+def coming_to_rest(qd: np.ndarray, qdd: np.ndarray, jerk: float, qdd_max: np.ndarray) -> tuple[float, np.ndarray]:
+    """(T [s], displacement [rad]): the stop from q̇, q̈ [rad/s, rad/s²] (n,) to rest (q̇ = q̈ = 0)
+    in T, the quartic of least ∫ jerk² with its end position free (a quintic's natural condition
+    there is a zero fifth derivative). With x = s/T and |q̈| <= ``qdd_max`` at the start:
+
+        q̈ = q̈(0) (1 - x)(1 - 3x) - (6 q̇(0)/T) x (1 - x),  jerk -(4 q̈(0) T + 6 q̇(0))/T² at the
+        start, (2 q̈(0) T + 6 q̇(0))/T² at the end (linear in s),
+
+    so T is the shortest with (4 |q̈(0)| T + 6 |q̇(0)|)/T² <= ``jerk`` [rad/s³] (q̈ goes on
+    continuously from the law's) and T >= 4 |q̇(0)|/q̈_max on every joint, which keeps |q̈| <= q̈_max
+    (|(1 - x)(1 - 3x)| + 1.5 x (1 - x) <= 1 on [0, 1]); |q̇| stays below |q̇(0)| + (4/27) |q̈(0)| T."""
+    speed, acceleration = np.abs(qd), np.abs(qdd)
+    duration = float(max(np.max((4.0 * acceleration + np.sqrt(16.0 * acceleration ** 2 + 24.0 * jerk * speed))
+                                / (2.0 * jerk)), np.max(4.0 * speed / qdd_max)))
+    c4 = (qd + 0.5 * qdd * duration) / (2.0 * duration ** 3)
+    c3 = -(qdd + 12.0 * c4 * duration ** 2) / (6.0 * duration)
+    return duration, duration * (qd + duration * (0.5 * qdd + duration * (c3 + duration * c4)))
 
 
 class PajakPlanLaw:
@@ -131,8 +150,7 @@ class PajakPlanner(TimeLawPlanner):
                 except PlanningError as error:
                     failure = error
         if failure is None:
-            end = self._rest_index() + 1
-            run = {name: self._run[name][:end] for name in ("t", "q", "qd", "qdd", "c")}
+            times, samples, scaling = self._planned_samples()
         else:
             run = getattr(failure, "partial", None) or {}
             if len(run.get("t", ())) < 2:  # failed at the first step: stand still for one period
@@ -140,10 +158,32 @@ class PajakPlanner(TimeLawPlanner):
                 zeros = np.zeros((2, len(start)))
                 run = {"t": np.array([0.0, period]), "q": np.stack([start, start]), "qd": zeros, "qdd": zeros,
                        "c": np.zeros(2)}
-        samples = np.stack([run["q"], run["qd"], run["qdd"]], axis=1)
-        law = HermiteLaw(run["t"], samples, samples)
+            times, scaling = np.asarray(run["t"]), np.asarray(run["c"])
+            samples = np.stack([run["q"], run["qd"], run["qdd"]], axis=1)
+        law = HermiteLaw(times, samples, samples)
         finish = law.duration if failure is not None else float(self._run["T"])
-        return law, np.asarray(run["t"]), np.asarray(run["c"]), failure, finish
+        return law, times, scaling, failure, finish
+
+    def _planned_samples(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(times [s] (K,), (q, q̇, q̈) (K, 3, n), c (K,)) of the planned motion: the preflight's
+        samples up to rest after the finish (:meth:`_rest_index`). Where the law has not come to
+        rest SETTLE_TIME after its finish (it may wander on at a goal near a singular J, where
+        the damped least squares leave a direction of the joints undamped: 2 of 250 tasks of
+        moves of 1 rad per joint), the motion ends with a stop from its last sample
+        (:func:`coming_to_rest`, within the jerk and acceleration limits), one more sample: cut
+        there, q̇ and q̈ jumped to 0 (q̈ by up to 0.2 rad/s² on those tasks)."""
+        end = self._rest_index() + 1
+        times = self._run["t"][:end]
+        samples = np.stack([self._run[name][:end] for name in ("q", "qd", "qdd")], axis=1)
+        scaling = self._run["c"][:end]
+        q, qd, qdd = samples[-1]
+        if np.abs(qd).max() > REST_SPEED:
+            duration, displacement = coming_to_rest(qd, qdd, self.pajak_law.parameters.jerk_limit,
+                                                    self.pajak_law.qdd_max)
+            times = np.append(times, times[-1] + duration)
+            samples = np.concatenate([samples, [[q + displacement, np.zeros_like(q), np.zeros_like(q)]]])
+            scaling = np.append(scaling, scaling[-1])
+        return times, samples, scaling
 
     def _rest_index(self) -> int:
         """The preflight's last sample of the motion: the first after the finish where every
@@ -158,7 +198,8 @@ class PajakPlanner(TimeLawPlanner):
 
     def limit_conflicts(self) -> int:
         """Update periods of the planned motion at which the limits overruled the law (q̈
-        clipped to the box, or the fallback braking; improvement 2); the preflight's."""
+        clipped to the box, or the fallback braking, improvement 2; or held to the jerk limit,
+        improvement 1); the preflight's."""
         if self._run is None:
             self.preflight()
         return int(np.count_nonzero(self._run["saturated"][: self._run["finish_index"] + 1]))
@@ -222,9 +263,7 @@ class PajakPlanner(TimeLawPlanner):
         with the default horizon."""
         if self._run is None:
             self.preflight()
-        end = self._rest_index() + 1
-        times = self._run["t"][:end]
-        samples = np.stack([self._run[name][:end] for name in ("q", "qd", "qdd")], axis=1)
+        times, samples, _ = self._planned_samples()
         return times, quintic_hermite_coefficients(times, samples, samples)
 
     def goal_pose(self) -> np.ndarray:

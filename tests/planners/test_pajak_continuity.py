@@ -1,0 +1,113 @@
+"""The Pająk planner's q̈ is continuous on moves of 1 rad per joint (issue 32, item 4): the planned
+motion (:class:`~drake_traj.planners.pajak.PajakPlanner`'s plan: the preflight's RK4 samples at
+1 ms joined by quintic Hermite pieces, up to rest after the finish) sampled densely.
+
+Tasks of :func:`drake_traj.bench.pajak_walk_tasks` at 1.0 rad, the sets of
+examples/pajak_continuity.py (60 tasks per seed, seeds 1-5); here the tasks that were steepest
+before the jerk limit and the two whose law had not come to rest 4 s after its finish.
+"""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from drake_traj.bench import pajak_walk_tasks
+from drake_traj.planners import pajak as P
+from drake_traj.planners.pajak.system import coming_to_rest
+
+Q0 = P.paper_initial_configuration()
+DENSE = 1e-4  # [s] between samples of the plan
+WINDOW = 10  # samples: 1 ms
+
+
+def planned(task: P.PajakConfig) -> tuple[P.PajakPlanner, np.ndarray, np.ndarray, np.ndarray]:
+    """(planner, q̇, q̈ of its plan every DENSE seconds (K, 6), the plan's end time repeated once)."""
+    planner = P.PajakPlanner(task, Q0)
+    planner.preflight()
+    plan = planner.plan()
+    times = np.append(np.arange(0.0, plan.end_time(), DENSE), plan.end_time())
+    return planner, plan.derivative(1).vector_values(times).T, plan.derivative(2).vector_values(times).T, times
+
+
+def within_limits(planner: P.PajakPlanner, qd: np.ndarray, qdd: np.ndarray) -> None:
+    """The joint limits at the plan's 1 ms samples (the law's own); between them the quintic
+    pieces pass q̈_max by up to 0.006 rad/s² where q̈ leaves a limit (0.016 without the jerk limit)."""
+    law = planner.pajak_law
+    assert np.all(np.abs(qd) <= law.qd_max + 1e-9)
+    assert np.all(np.abs(qdd[::WINDOW]) <= law.qdd_max + 1e-9)
+    assert np.all(np.abs(qdd) <= law.qdd_max + 0.01)
+
+
+def largest_change(qdd: np.ndarray) -> float:
+    """The largest change of q̈ within 1 ms, over every 1 ms window on the dense grid [rad/s²]."""
+    return float(np.abs(qdd[WINDOW:] - qdd[:-WINDOW]).max())
+
+
+# (seed, task): the largest 1 ms change of q̈ before the jerk limit [rad/s²] (examples/pajak_continuity.py):
+# near a singular J, where a = -J⁻¹J̇q̇ of eq. 17 grows faster than c can follow and leaves the box
+STEEP = {(3, 54): 0.508, (2, 1): 0.373, (4, 37): 0.316, (2, 51): 0.287}
+
+
+@pytest.mark.parametrize("seed, index", STEEP)
+def test_qdd_changes_within_the_jerk_limit_near_a_singular_configuration(seed, index):
+    task = pajak_walk_tasks(60, seed, 1.0)[index]
+    planner, qd, qdd, _ = planned(task)
+    # measured: 0.0800 between the 1 ms samples (the limit's 80 rad/s³), 0.084-0.085 in a 1 ms
+    # window across two of them (the quintic pieces bend where the limit sets in)
+    assert 0.08 <= largest_change(qdd) <= 0.087
+    within_limits(planner, qd, qdd)
+    if (seed, index) == (3, 54):  # the law without the limit, as it was
+        free = P.integrate(P.PajakLaw(dataclasses.replace(task, jerk_limit=1e9)), Q0)
+        assert np.abs(np.diff(free["qdd"], axis=0)).max() == pytest.approx(STEEP[seed, index], abs=1e-3)
+        assert planner.planned_duration() == pytest.approx(free["T"], rel=0.01)
+
+
+@pytest.mark.parametrize("index", [10, 24])
+def test_a_motion_whose_law_wanders_after_its_finish_ends_at_rest(index):
+    # seed 5, tasks 10 and 24 end near a singular J (measure 0.03-0.04): the law keeps moving
+    # (0.05-0.25 rad/s) more than 4 s after its finish; the plan then stops from its last sample
+    # (coming_to_rest), where it was cut before (q̈ jumped by 0.20 and 0.19 rad/s² to 0)
+    planner, qd, qdd, times = planned(pajak_walk_tasks(60, 5, 1.0)[index])
+    run = planner._run
+    cut = run["finish_index"] + round(4.0 / 1e-3)
+    assert np.abs(run["qd"][cut]).max() > 1e-3  # not at rest where the preflight ends
+    assert times[-1] > run["t"][cut]
+    assert np.allclose(qd[-1], 0.0, atol=1e-12) and np.allclose(qdd[-1], 0.0, atol=1e-12)
+    assert largest_change(qdd) <= 0.087
+    within_limits(planner, qd, qdd)
+
+
+def test_coming_to_rest_keeps_the_jerk_and_acceleration_limits():
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        qd, qdd, qdd_max = rng.uniform(-0.5, 0.5, 6), rng.uniform(-1.4, 1.4, 6), np.full(6, 1.4)
+        duration, displacement = coming_to_rest(qd, qdd, 80.0, qdd_max)
+        s = np.linspace(0.0, duration, 2001)[:, None]
+        # the quartic of the docstring, its coefficients from the end conditions q̇(T) = q̈(T) = 0
+        c4 = (qd + 0.5 * qdd * duration) / (2.0 * duration ** 3)
+        c3 = -(qdd + 12.0 * c4 * duration ** 2) / (6.0 * duration)
+        velocity = qd + qdd * s + 3.0 * c3 * s ** 2 + 4.0 * c4 * s ** 3
+        acceleration = qdd + 6.0 * c3 * s + 12.0 * c4 * s ** 2
+        jerk = 6.0 * c3 + 24.0 * c4 * s
+        assert np.allclose(velocity[-1], 0.0, atol=1e-12) and np.allclose(acceleration[-1], 0.0, atol=1e-12)
+        assert np.allclose(displacement, qd * duration + qdd * duration ** 2 / 2 + c3 * duration ** 3
+                           + c4 * duration ** 4, atol=1e-12)
+        assert np.abs(jerk).max() <= 80.0 + 1e-9 and np.all(np.abs(acceleration) <= qdd_max + 1e-9)
+
+
+def test_a_seeded_set_of_moves_of_1_rad():
+    # the first 12 tasks of seed 1's set (examples/pajak_continuity.py): 11 finish, and on each the
+    # largest change of q̈ within any 1 ms is at most 0.0861 rad/s² (median 0.057); before the jerk
+    # limit task 7 changed it by 0.308 rad/s² within 1 ms after its finish, near a singular J
+    changes, refused = [], 0
+    for task in pajak_walk_tasks(60, 1, 1.0)[:12]:
+        try:
+            planner, qd, qdd, _ = planned(task)
+        except P.PlanningError:
+            refused += 1
+            continue
+        within_limits(planner, qd, qdd)
+        changes.append(largest_change(qdd))
+    assert refused == 1
+    assert max(changes) <= 0.087 and np.median(changes) == pytest.approx(0.057, abs=0.005)
