@@ -199,6 +199,12 @@ def run_block(block: Block, folder: Path) -> None:
             f"{block.name}: printed:\n{process.stdout}\nthe page ({block.output.name}) says:\n{block.output.text}")
 
 
+def cost(page: Path) -> int:
+    """A rough estimate of a page's run time, to start the longest pages first."""
+    text = "".join(block.text for block in steps(page))
+    return 10 * text.count("drake-traj bench") + 3 * text.count("drake-traj run") + len(steps(page))
+
+
 class PageRuns:
     """One folder per page, outside the checkout. The blocks of a page run in order, once, in a
     thread of their own; pages run side by side (``WORKERS`` at a time: the commands are separate
@@ -214,11 +220,11 @@ class PageRuns:
         self.lock = threading.Lock()
 
     def start(self, pages) -> None:
-        """Run ``pages`` (the most blocks first), each block's outcome a future."""
+        """Run ``pages`` (the longest first), each block's outcome a future."""
         with self.lock:
             new = [page for page in pages if page not in self.started]
             self.started.update(new)
-            for page in sorted(new, key=lambda page: -len(steps(page))):
+            for page in sorted(new, key=lambda page: -cost(page)):
                 for block in steps(page):
                     self.outcome[block.name] = Future()
                 self.pool.submit(self._run_page, page)
