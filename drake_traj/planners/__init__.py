@@ -19,8 +19,8 @@ from drake_traj.planners.baselines.toppra import ToppraConfig
 from drake_traj.planners.li import LiConfig
 from drake_traj.planners.pajak import PajakConfig
 from drake_traj.planners.quintic import QuinticConfig
-from drake_traj.planners.smooth import planners as smooth
-from drake_traj.planners.smooth.planners import RetimedPajakConfig, SmoothWaypointsConfig
+from drake_traj.planners.smooth.planners import (RetimedPajakConfig, SmoothWaypointsConfig, make_retimed_pajak,
+                                                make_smooth_waypoints)
 from drake_traj.robots.base import Robot
 from drake_traj.validation import finite_array, instance_of
 
@@ -38,8 +38,8 @@ _MAKERS = {
     MovejConfig: movej.make,
     RuckigConfig: ruckig.make,
     ToppraConfig: toppra.make,
-    SmoothWaypointsConfig: smooth.make_smooth_waypoints,
-    RetimedPajakConfig: smooth.make_retimed_pajak,
+    SmoothWaypointsConfig: make_smooth_waypoints,
+    RetimedPajakConfig: make_retimed_pajak,
     FreeMotionConfig: free.make,
 }
 PLANNER_CONFIGS = tuple(_MAKERS)
