@@ -238,21 +238,45 @@ def test_limits_too_small_for_any_array_are_refused_first():
         make_planner(SmoothWaypointsConfig(goals=[(q0 + 0.3).tolist(), (q0 + 0.5).tolist()], grid_points=1_000_000), UR10E, q0)
 
 
-def test_a_single_move_is_as_fast_as_ruckig_and_its_time_grows_with_the_distance():
-    """One straight move: the time-optimal jerk-limited profile along the line (Ruckig's phase
-    synchronisation). Every joint moving d: Ruckig's own time (its time-synchronised joints keep the
-    line then); from 1e-4 to 2 rad, T grows with d. Measured: ratio 1.0000 at every d (before:
-    1.95 at 0.001 rad, 2.13 at 0.05 rad, and the 0.1 rad move faster than the 0.05 one)."""
+@pytest.mark.parametrize("direction", ["every joint", "seeded"])
+def test_a_single_move_is_as_fast_as_ruckig_and_its_time_grows_with_the_distance(direction):
+    """One move: Ruckig's time-synchronised rest-to-rest optimum (the straight line is slower where
+    the joints' limit ratios differ: 1.2-8 % on seeded tasks before). From 1e-4 to 2 rad, T is
+    Ruckig's (ratio 1.000000 measured; at most 1.0000015 where Ruckig's own profile exceeds the
+    jerk limit by its rounding and ours is stretched to hold it) and grows with d, every limit
+    held at the exact peaks.
+    Before: 1.95 x Ruckig at 0.001 rad, 2.13 x at 0.05 rad, and the 0.1 rad move faster than 0.05."""
     q0 = UR10E.home_configuration
+    rng = np.random.default_rng(11)
+    unit = np.ones(6) if direction == "every joint" else rng.uniform(-1, 1, 6)
+    unit = unit / np.abs(unit).max()
+    velocity, acceleration = 0.5 + rng.uniform(size=(2, 6)) * UR10E.joint_move_limits  # per joint, uneven
     times = []
     for d in (1e-4, 1e-3, 1e-2, 0.05, 0.1, 0.3, 1.0, 2.0):
-        goals = [(q0 + d).tolist()]
-        smooth = make_planner(SmoothWaypointsConfig(goals=goals), UR10E, q0)
-        ruckig = make_planner(RuckigConfig(goals=goals), UR10E, q0)
-        assert smooth.planned_duration() <= ruckig.planned_duration() * (1 + 1e-9), d
-        assert smooth.timing.peaks.max() <= 1 + 1e-9  # every limit held at the exact peaks
+        config = dict(goals=[(q0 + d * unit).tolist()], velocity_limit=velocity.tolist(),
+                      acceleration_limit=acceleration.tolist())
+        smooth = make_planner(SmoothWaypointsConfig(**config), UR10E, q0)
+        ruckig = make_planner(RuckigConfig(**config), UR10E, q0)
+        assert smooth.planned_duration() <= ruckig.planned_duration() * (1 + 1e-5), d
+        assert smooth.timing.peaks.max() <= 1  # every limit held at the exact peaks
+        q = smooth.timing.trajectory.vector_values(np.linspace(0, smooth.planned_duration(), 2001))
+        assert np.abs(q[:, -1] - (q0 + d * unit)).max() < 1e-12 and np.abs(q[:, 0] - q0).max() < 1e-12
         times.append(smooth.planned_duration())
     assert np.all(np.diff(times) > 0)
+
+
+def test_line_timing_keeps_to_the_line_and_is_never_faster_than_the_synchronised_move():
+    """Goals in order along one line: the line's optimum passes every goal; a single move's
+    time-synchronised optimum is never slower than it."""
+    q0 = UR10E.home_configuration
+    step = np.array([0.3, -0.2, 0.4, 0.1, -0.3, 0.2])
+    goals = [(q0 + k * step / 3).tolist() for k in (1, 2, 3)]
+    along = make_planner(SmoothWaypointsConfig(goals=goals), UR10E, q0)
+    q = along.timing.trajectory.vector_values(np.linspace(0, along.planned_duration(), 4001)).T
+    off_line = q - q0 - np.outer((q - q0) @ step / (step @ step), step)
+    assert np.abs(off_line).max() < 1e-12
+    single = make_planner(SmoothWaypointsConfig(goals=goals[-1:]), UR10E, q0)
+    assert single.planned_duration() <= along.planned_duration() * (1 + 1e-8)
 
 
 def test_hundreds_of_dense_goals_along_a_smooth_path_are_timed():
@@ -275,3 +299,72 @@ def test_goals_a_rounding_apart_are_one_goal_not_a_cusp(apart):
     goals = [first.tolist(), (first + apart).tolist(), (q0 + 0.8).tolist()]
     planner = make_planner(SmoothWaypointsConfig(goals=goals), UR10E, q0)
     assert planner.timing.peaks.max() <= 1 + 1e-9
+
+
+def _waypoint_tasks(seed: int, count: int):
+    """Seeded waypoint tasks: 2-4 goals up to 0.8 rad per joint apart from the home configuration,
+    limits 0.5-1.5 x the UR10e's joint-move limits per joint."""
+    rng = np.random.default_rng(seed)
+    velocity, acceleration = UR10E.joint_move_limits
+    for _ in range(count):
+        q = [UR10E.home_configuration]
+        for _ in range(rng.integers(2, 5)):
+            q.append(q[-1] + rng.uniform(-0.8, 0.8, 6))
+        yield np.array(q), velocity * rng.uniform(0.5, 1.5, 6), acceleration * rng.uniform(0.5, 1.5, 6)
+
+
+def test_more_grid_points_are_never_refused_nor_longer():
+    """grid_points 1000 was refused ("the timing's linear program failed: Unknown") on every straight
+    move tried and gave up to 6 % longer motions than 250. Now a finer grid starts from the 100-node
+    solution: seeded tasks, grids 100 to 1000. Measured: never refused, never longer than 100 nodes,
+    at most 0.03 % longer than a coarser grid (8 tasks, 50-4000 nodes)."""
+    for q, velocity, acceleration in _waypoint_tasks(7, 3):
+        path = waypoint_path(q)
+        durations = [time_path(path, velocity, acceleration, grid_points=points).duration for points in (100, 250, 1000)]
+        assert durations[1] <= durations[0] and durations[2] <= durations[0]
+        assert durations[2] <= durations[1] * (1 + 1e-3)
+
+
+def test_a_failing_linear_program_names_its_rows_and_what_to_change(monkeypatch):
+    from drake_traj.planners.smooth import timing
+
+    q, velocity, acceleration = next(_waypoint_tasks(3, 1))
+    path = waypoint_path(q)
+    reference = time_path(path, velocity, acceleration, grid_points=100)
+    run = timing._Program._run
+    calls = []
+
+    def fail_after(count):
+        def patched(self, lower, upper):
+            calls.append(1)
+            if len(calls) > count:
+                self.status = "Unknown"
+                return None
+            return run(self, lower, upper)
+        return patched
+
+    monkeypatch.setattr(timing._Program, "_run", fail_after(0))
+    with pytest.raises(InfeasibleTimingError, match=r"linear program on \d+ nodes \(velocity_limit and acceleration_limit\) "
+                                                    r"failed: HiGHS reports 'Unknown'.*give fewer grid_points"):
+        time_path(path, velocity, acceleration, grid_points=100)
+    calls.clear()
+    monkeypatch.setattr(timing._Program, "_run", fail_after(1))  # the first jerk program fails, and its retries
+    with pytest.raises(InfeasibleTimingError, match=r"velocity_limit, acceleration_limit and jerk_limit \(the jerk "
+                                                    r"linearised at the last iterate\)"):
+        time_path(path, velocity, acceleration, grid_points=100)
+    calls.clear()
+    monkeypatch.setattr(timing._Program, "_run", fail_after(4))  # a later program fails: the best so far is kept
+    kept = time_path(path, velocity, acceleration, grid_points=100)
+    assert kept.peaks.max() <= 1 and reference.duration <= kept.duration < 1.1 * reference.duration
+
+
+def test_the_timing_prints_nothing_and_its_module_imports_beside_the_planners(capfd):
+    """HiGHS writes a banner when its Python object is made unless its log is off first; and the
+    planners' package once hid the smooth subpackage behind a module of the same name."""
+    q, velocity, acceleration = next(_waypoint_tasks(5, 1))
+    time_path(waypoint_path(q), velocity, acceleration, grid_points=100)
+    assert capfd.readouterr().out == ""
+    import drake_traj.planners  # noqa: F401
+    import drake_traj.planners.smooth.timing as timing_module
+
+    assert timing_module.time_path is time_path

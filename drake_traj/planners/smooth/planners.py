@@ -13,7 +13,7 @@ from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.planners.baselines.ruckig import jerk_limited_limits
 from drake_traj.planners.pajak import PajakConfig, PajakPlanner
-from drake_traj.planners.smooth.timing import MAX_GRID_POINTS, SmoothTiming, line_timing, time_path
+from drake_traj.planners.smooth.timing import MAX_GRID_POINTS, SmoothTiming, line_timing, move_timing, time_path
 from drake_traj.robots import Robot
 from drake_traj.validation import instance_of, positive_vector, whole_number
 
@@ -129,9 +129,10 @@ class SmoothWaypointsConfig:
 
 
 def make_smooth_waypoints(config: SmoothWaypointsConfig, robot: Robot, q_initial) -> SmoothPlanner:
-    """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]: one move (or goals in order
-    along one line) is the time-optimal jerk-limited profile along its straight line
-    (:func:`line_timing`), several the smooth timing of the spline through them (:func:`time_path`)."""
+    """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]: one move is the time-optimal
+    jerk-limited rest-to-rest move (:func:`move_timing`, Ruckig's), goals in order along one line
+    the time-optimal profile along that line (:func:`line_timing`), other goals the smooth timing
+    of the spline through them (:func:`time_path`)."""
     q = start_and_goals(q_initial, config.goals, robot.num_joints)
     if len(q) - 1 > MAX_GOALS:
         raise DrakeTrajError(f"goals: {len(q) - 1} goals, at most {MAX_GOALS} (each is a knot of the path and a node of "
@@ -141,10 +142,12 @@ def make_smooth_waypoints(config: SmoothWaypointsConfig, robot: Robot, q_initial
     path = waypoint_path(q)
     _check_joint_range(path, robot, "goals")
     grid_points = whole_number(config.grid_points, "grid_points", minimum=20, maximum=MAX_GRID_POINTS)
-    if _on_one_line(q):  # one straight move, or goals along one line in order: the line's optimum
+    if len(path.get_segment_times()) == 2 or _on_one_line(q):
+        # one move: Ruckig's time-synchronised optimum; goals along one line in order: the line's
+        timing_of_move = move_timing if len(path.get_segment_times()) == 2 else line_timing
         ends = q[[0, -1]]
         try:
-            timing = line_timing(ends[0], ends[1], velocity, acceleration, jerk)
+            timing = timing_of_move(ends[0], ends[1], velocity, acceleration, jerk)
         except DrakeTrajError as error:
             raise error.relocated(("goals",), f"goals: {error}") from None
     else:

@@ -24,22 +24,22 @@ distance to the end), q̈ = 0 at the end and the end interval lasts 3 h / √x.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
-import ruckig
 import scipy.sparse
-from scipy.optimize._highspy import _core as highs  # HiGHS's own bindings, as scipy ships them
+import highspy
 from pydrake.trajectories import PiecewisePolynomial, Trajectory
 
 from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import piecewise_trajectory
-from drake_traj.planners.baselines.ruckig import default_jerk_limit
+from drake_traj.planners.baselines.ruckig import RuckigStopLaw, default_jerk_limit
 from drake_traj.planners.baselines.toppra import time_optimal_along_path
 from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coefficients, sigma_derivatives
 from drake_traj.planners.laws.polynomials import rate_peaks
 from drake_traj.validation import positive_scalar, positive_vector, real_array, require_finite, whole_number
 
-__all__ = ["InfeasibleTimingError", "SmoothTiming", "check_path", "exact_peaks", "time_path"]
+__all__ = ["InfeasibleTimingError", "SmoothTiming", "check_path", "exact_peaks", "line_timing", "move_timing", "time_path"]
 
 PATH_TOLERANCE = 1e-4
 """The largest joint-space deviation [rad] of the timed motion from the given path."""
@@ -51,6 +51,12 @@ TRUST_REGION = 1.3
 """x may grow by at most this factor from one linear program to the next (where √x is frozen)."""
 _REVERSAL_COSINE = -0.5  # consecutive sample steps turning by more than 120°: a reversal
 
+
+COARSE_GRID_POINTS = 100
+"""Nodes of the first grid: a finer grid asked for is solved from its solution (evenly spaced in
+its time, x interpolated), and the finer motion kept where it is no longer (from the bang-bang
+start, x near the ends grew only by the trust region's factor per program: a fine grid solved
+alone ended up to 3 times longer than a coarse one)."""
 
 MAX_GRID_POINTS = 4000
 """Nodes of the timing's linear programs at most (a program of N nodes has 2N variables and about
@@ -259,9 +265,30 @@ def _grid(path, velocity, acceleration, jerk, points: int) -> np.ndarray:
         x, p = _Program(path, even, velocity, acceleration, jerk).solve(None, np.inf)
         times = _node_times(even, x, p)
         s = np.interp(np.linspace(0.0, times[-1], points), times, even)
+    return _with_breaks(path, s)
+
+
+def _refined(path, coarse: np.ndarray, x: np.ndarray, p: np.ndarray, points: int):
+    """(nodes s, x, p) of a finer grid of about ``points`` nodes evenly spaced in the time of the
+    coarse grid's solution (x, p) at its nodes ``coarse`` (plus the path's breaks), with x and p
+    interpolated there: the start of the finer grid's programs. On the end intervals x follows
+    the end law, x ∝ distance^(4/3)."""
+    breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
+    times = _node_times(coarse, x, p)
+    s = _with_breaks(path, np.interp(np.linspace(0.0, times[-1], max(points - len(breaks), points // 2)), times, coarse))
+    x_fine, p_fine = np.interp(s, coarse, x), np.interp(s, coarse, p)
+    first, last = s < coarse[1], s > coarse[-2]
+    x_fine[first] = x[1] * ((s[first] - coarse[0]) / (coarse[1] - coarse[0])) ** (4 / 3)
+    x_fine[last] = x[-2] * ((coarse[-1] - s[last]) / (coarse[-1] - coarse[-2])) ** (4 / 3)
+    return s, x_fine, p_fine
+
+
+def _with_breaks(path, s: np.ndarray) -> np.ndarray:
+    """Grid nodes ``s`` in order within the path, with the path's own breaks as nodes (q⃛ may
+    jump there) and the nodes too close to one dropped."""
+    breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
     s = np.maximum.accumulate(np.clip(s, path.start_time(), path.end_time()))
     s[0], s[-1] = path.start_time(), path.end_time()
-    # the path's own breaks are nodes (q''' may jump there); grid nodes too close to one are dropped
     if len(breaks):
         spacing = np.interp(breaks, s[1:], np.diff(s))
         near = (np.abs(s[:, None] - breaks[None, :]) < 0.3 * spacing[None, :]).any(axis=1)
@@ -310,6 +337,16 @@ def _node_times(s: np.ndarray, x: np.ndarray, p: np.ndarray) -> np.ndarray:
     dt[0] = 3 * h[0] / np.sqrt(x[1])
     dt[-1] = 3 * h[-1] / np.sqrt(x[-2])
     return np.concatenate([[0.0], np.cumsum(dt)])
+
+
+class _QuietHighs(highspy.Highs):
+    """highspy's HiGHS with its log off from the start: ``Highs.__init__`` registers its callbacks
+    (``enableCallbacks``), which writes HiGHS's banner to stdout unless ``output_flag`` is already
+    false by then."""
+
+    def enableCallbacks(self):
+        self.setOptionValue("output_flag", False)
+        super().enableCallbacks()
 
 
 class _Program:
@@ -364,6 +401,7 @@ class _Program:
         margin = np.full(N - 2, LIMIT_MARGIN)
         margin[:3] = margin[-3:] = END_JERK_MARGIN
         self.jerk_bound = np.concatenate([np.tile(margin, 2) * jerk[j] for j in range(n)])
+        self.jerk_limits = np.repeat(jerk, 2 * (N - 2))
         with np.errstate(divide="ignore"):
             bound = np.min(velocity**2 / np.maximum(d1**2, 1e-300), axis=1)
             mid_bound = np.min(velocity**2 / np.maximum(m1**2, 1e-300), axis=1)
@@ -391,7 +429,12 @@ class _Program:
 
     def solve(self, previous, growth: float) -> tuple[np.ndarray, np.ndarray]:
         """(x, p) of the LP; without ``previous`` (x, p) the jerk is left out (a bang-bang profile
-        with continuous s̈); with it, x grows by at most the factor ``growth`` (the trust region)."""
+        with continuous s̈); with it, x grows by at most the factor ``growth`` (the trust region).
+
+        HiGHS now and then stops short of the optimum on a program it has warm-started (status
+        "Unknown": numerical trouble, never infeasibility: x = 0 meets every row); the program is
+        then solved again from a fresh start, and only a second failure is an error (naming the
+        rows in the program and what to change)."""
         N = self.num_nodes
         upper = self.velocity_bound.copy()
         if previous is not None:
@@ -405,37 +448,55 @@ class _Program:
             if not self.jerk_programs:
                 # columns scaled to the first program's solution (x spans 1e-6 near the ends to 1
                 # mid-path, beyond HiGHS's absolute tolerances)
-                self._start(self._scale(*previous))
+                self._start(self._scale(*previous), None if self.solver is None else self.solver.getBasis())
             self.jerk_programs += 1
             ends = [1, 2, N - 3, N - 2]  # the nodes next to the ends weigh nothing in the sum but their time,
             lower[ends] = np.minimum(previous[0][ends] / growth, high[ends])  # 3 h / √x, is long: they fall by the trust region's factor at most
-            with np.errstate(divide="ignore"):
-                bound = self.jerk_bound / np.tile(np.sqrt(np.maximum(previous[0][1:-1], 0.0)), 2 * self.num_joints)
-            rows = range(self.num_fixed_rows, self.matrix.shape[0])  # (scipy's HiGHS has no changeRowsBounds)
-            list(map(self.solver.changeRowBounds, rows, (-bound).tolist(), bound.tolist()))
+            self._set_jerk_rows(previous[0] * growth)
         z = self._run(lower, high)
+        if z is None and previous is not None:  # from a fresh start, scaled to the last iterate
+            self._start(self._scale(*previous))
+            self.jerk_programs = 1
+            self._set_jerk_rows(previous[0] * growth)
+            z = self._run(lower, high)
         if z is None and previous is not None and lower[1] > 0:  # without the floor at the ends
             lower[[1, 2, N - 3, N - 2]] = 0.0
             z = self._run(lower, high)
         if z is None:
-            raise InfeasibleTimingError(f"the timing's linear program failed: {self.status}", field=("path",))
+            rows = ("velocity_limit and acceleration_limit" if previous is None else
+                    "velocity_limit, acceleration_limit and jerk_limit (the jerk linearised at the last iterate)")
+            raise InfeasibleTimingError(
+                f"the timing's linear program on {N} nodes ({rows}) failed: HiGHS reports {self.status!r} (numerical "
+                f"trouble: x = 0 meets every row); give fewer grid_points (e.g. {max(20, N // 2)}), or limits closer "
+                "to each other in size across the joints", field=("path",))
         z = z * self.scale
         return np.maximum(z[:N], 0.0), z[N:]
 
-    def _start(self, scale: np.ndarray) -> None:
-        """A HiGHS model of the programs with columns scaled by ``scale``, from the last basis."""
-        basis = None if self.solver is None else self.solver.getBasis()
+    def _set_jerk_rows(self, x_previous: np.ndarray) -> None:
+        """The jerk rows' bounds: the jerk limit over √x frozen at the last iterate."""
+        with np.errstate(divide="ignore"):
+            bound = self.jerk_bound / np.tile(np.sqrt(np.maximum(x_previous[1:-1], 0.0)), 2 * self.num_joints)
+        rows = np.arange(self.num_fixed_rows, self.matrix.shape[0], dtype=np.int32)
+        self.solver.changeRowsBounds(len(rows), rows, -bound, bound)
+
+    def jerk_ratio(self, x: np.ndarray, p: np.ndarray) -> float:
+        """The largest |q⃛| over its limit at the nodes of the iterate (x, p), with its own √x."""
+        rates = np.tile(np.sqrt(np.maximum(x[1:-1], 0.0)), 2 * self.num_joints)
+        return float(np.max(np.abs(self.jerk @ np.concatenate([x, p])) * rates / self.jerk_limits))
+
+    def _start(self, scale: np.ndarray, basis=None) -> None:
+        """A HiGHS model of the programs with columns scaled by ``scale``, from ``basis`` (None:
+        HiGHS's own start)."""
         matrix = self.matrix @ scipy.sparse.diags(scale)
         cost = np.concatenate([-self.weights, np.zeros(self.num_nodes)]) * scale
-        lp = highs.HighsLp()
+        lp = highspy.HighsLp()
         lp.num_col_, lp.num_row_ = len(cost), matrix.shape[0]
         lp.col_cost_, lp.col_lower_, lp.col_upper_ = cost, np.zeros(len(cost)), np.zeros(len(cost))
         lp.row_lower_, lp.row_upper_ = self.row_low, self.row_high
-        lp.a_matrix_.format_ = highs.MatrixFormat.kRowwise
+        lp.a_matrix_.format_ = highspy.MatrixFormat.kRowwise
         lp.a_matrix_.num_col_, lp.a_matrix_.num_row_ = matrix.shape[1], matrix.shape[0]
         lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = matrix.indptr, matrix.indices, matrix.data
-        self.solver = highs._Highs()
-        self.solver.setOptionValue("output_flag", False)
+        self.solver = _QuietHighs()
         self.solver.passModel(lp)
         if basis is not None:
             self.solver.setBasis(basis)
@@ -448,7 +509,7 @@ class _Program:
         self.solver.changeColsBounds(len(columns), columns, lower / self.scale, upper / self.scale)
         self.solver.run()
         status = self.solver.getModelStatus()
-        if status != highs.HighsModelStatus.kOptimal:
+        if status != highspy.HighsModelStatus.kOptimal:
             self.status = self.solver.modelStatusToString(status)
             return None
         return np.asarray(self.solver.getSolution().col_value)
@@ -531,45 +592,168 @@ def line_timing(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit=
     linear program, no stretch, exact on the line (its pieces are cubic in t). T grows with the
     distance. Limits as :func:`time_path`'s; an :class:`InfeasibleTimingError` where the motion
     would last longer than ``max_duration`` [s] or the segment has no length."""
-    q_start, q_goal = np.asarray(q_start, dtype=float), np.asarray(q_goal, dtype=float)
+    q_start, q_goal, limits = _move_inputs(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit,
+                                           max_duration)
     step = q_goal - q_start
+    moving = step != 0
+    line_limits = [[float(np.min(limit[moving] / np.abs(step[moving])))] for limit in limits]
+    knots, s = _ruckig_states(RuckigStopLaw([[0.0], [1.0]], *line_limits), max_duration)  # s: (K, s/ṡ/s̈, 1)
+    samples = s * step[None, None, :]
+    samples[:, 0] += q_start
+    path = PiecewisePolynomial.FirstOrderHold([0.0, 1.0], np.column_stack([q_start, q_goal]))
+    return _exact_timing(knots, samples, limits, path)
+
+
+def move_timing(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit=None, *,
+                max_duration: float = 600.0) -> SmoothTiming:
+    """The time-optimal jerk-limited rest-to-rest move from ``q_start`` to ``q_goal`` [rad]:
+    Ruckig's time-synchronised motion (every joint starts and stops together, the limiting joint
+    on its own time-optimal profile, the others on profiles of the same duration), the fastest a
+    rest-to-rest move can be under per-joint limits and never slower than the straight line
+    (:func:`line_timing`). The joints do not keep to the straight segment between the two: the
+    timing's ``path`` is the motion itself (s = t). Exact (cubic pieces in t), no stretch; T
+    grows with the distance. Limits and errors as :func:`line_timing`'s."""
+    q_start, q_goal, limits = _move_inputs(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit,
+                                           max_duration)
+    knots, samples = _ruckig_states(RuckigStopLaw([q_start, q_goal], *limits), max_duration)
+    return _exact_timing(knots, samples, limits, None)
+
+
+def _move_inputs(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit, max_duration):
+    """(q_start, q_goal, (velocity, acceleration, jerk)) of a rest-to-rest move, checked: the goal
+    differs from the start, and no limit alone makes the move last longer than ``max_duration``
+    [s] (checked before Ruckig sees limits of 1e-300)."""
+    q_start, q_goal = np.asarray(q_start, dtype=float), np.asarray(q_goal, dtype=float)
+    step = np.abs(q_goal - q_start)
     n = len(step)
     velocity = positive_vector(velocity_limit, "velocity_limit", n)
     acceleration = positive_vector(acceleration_limit, "acceleration_limit", n)
     jerk = default_jerk_limit(acceleration) if jerk_limit is None else positive_vector(jerk_limit, "jerk_limit", n)
-    moving = np.abs(step) > 0
-    if not moving.any():
+    if not np.any(step > 0):
         raise InfeasibleTimingError("path does not move: the goal equals the start", field=("path",))
-    limits = [float(np.min(limit[moving] / np.abs(step[moving]))) for limit in (velocity, acceleration, jerk)]
-    bounds = (1 / limits[0], 2 * np.sqrt(1 / limits[1]), np.cbrt(32 / limits[2]))  # as _time_path's bounds
-    least = max(bounds)
-    if not least <= max_duration:
-        name = ("velocity_limit", "acceleration_limit", "jerk_limit")[int(np.argmax(bounds))]
-        raise InfeasibleTimingError(f"the limits are too small for the path: the straight move takes ({name}): at "
-                                    f"least {least:.4g} s, longer than max_duration {max_duration:g} s", field=("path",))
-    generator = ruckig.Ruckig(1)
-    request = ruckig.InputParameter(1)
-    request.current_position, request.target_position = [0.0], [1.0]
-    request.current_velocity = request.current_acceleration = request.target_velocity = [0.0]
-    request.target_acceleration = [0.0]
-    request.max_velocity, request.max_acceleration, request.max_jerk = [limits[0]], [limits[1]], [limits[2]]
-    profile_trajectory = ruckig.Trajectory(1)
-    if generator.calculate(request, profile_trajectory) not in (ruckig.Result.Working, ruckig.Result.Finished):
-        raise InfeasibleTimingError("the straight segment cannot be timed (Ruckig found no profile)", field=("path",))
-    phases = np.cumsum(np.concatenate([[0.0], list(profile_trajectory.profiles[0][0].t)]))
-    knots = np.unique(np.append(phases[phases < profile_trajectory.duration], profile_trajectory.duration))
+    max_duration = positive_scalar(max_duration, "max_duration", "s")
+    # each joint's rest-to-rest move lasts at least d / v, 2 sqrt(d / a) and (32 d / J)^(1/3)
+    bounds = {"velocity_limit": (step / velocity, velocity, "rad/s"),
+              "acceleration_limit": (2 * np.sqrt(step / acceleration), acceleration, "rad/s²"),
+              "jerk_limit": (np.cbrt(32 * step / jerk), jerk, "rad/s³")}
+    for name, (least, limit, unit) in bounds.items():
+        if not np.max(least) <= max_duration:
+            j = int(np.argmax(least))
+            raise InfeasibleTimingError(
+                f"the limits are too small for the path: {joint_label(j)} moves {step[j]:.4g} rad with at most "
+                f"{limit[j]:.4g} {unit} ({name}): at least {least[j]:.4g} s, longer than max_duration "
+                f"{max_duration:g} s", field=("path",))
+    return q_start, q_goal, (velocity, acceleration, jerk)
+
+
+def _ruckig_states(law: RuckigStopLaw, max_duration: float) -> tuple[np.ndarray, np.ndarray]:
+    """(knots (K,) [s], states (K, position/rate/acceleration, n)) of a one-move Ruckig law at its
+    knots (every joint is one cubic between them), at rest at both ends; an
+    :class:`InfeasibleTimingError` naming the limit where it lasts longer than ``max_duration``."""
+    if not law.duration <= max_duration:
+        raise InfeasibleTimingError(f"the limits are too small for the path: the move takes {law.duration:.4g} s, longer "
+                                    f"than max_duration {max_duration:g} s (velocity_limit, acceleration_limit or "
+                                    "jerk_limit)", field=("path",))
+    knots = np.asarray(law.polynomial_breaks, dtype=float)
     knots = knots[np.concatenate([[True], np.diff(knots) > 1e-12])]
-    knots[-1] = profile_trajectory.duration
-    states = np.array([[value[0] for value in profile_trajectory.at_time(t)[:3]] for t in knots])  # (K, s/ṡ/s̈)
-    states[0], states[-1] = (0.0, 0.0, 0.0), (1.0, 0.0, 0.0)
-    samples = np.stack([q_start + np.outer(states[:, 0], step), np.outer(states[:, 1], step),
-                        np.outer(states[:, 2], step)], axis=1)  # (K, q/q̇/q̈, n)
+    knots[-1] = law.duration
+    states = np.stack(law.sample(knots), axis=1)
+    states[0, 1:] = states[-1, 1:] = 0.0
+    states[-1, 0] = law.q_waypoints[-1]
+    return knots, states
+
+
+def _exact_timing(knots, samples, limits, path) -> SmoothTiming:
+    """The SmoothTiming of cubic pieces given exactly by their states at ``knots`` along ``path``
+    (None: the motion itself), stretched in time where Ruckig's profile exceeds a limit by its
+    rounding (the jerk by up to 5e-6 of the limit)."""
     coefficients = quintic_hermite_coefficients(knots, samples, samples)  # the cubic pieces, exactly
-    ratio = exact_peaks(knots, coefficients) / np.stack([velocity, acceleration, jerk])
-    del generator, request, profile_trajectory  # no ruckig object outlives the call
-    path = PiecewisePolynomial.FirstOrderHold([0.0, 1.0], np.column_stack([q_start, q_goal]))
-    return SmoothTiming(HermiteLaw(knots, samples, samples), piecewise_trajectory(knots, coefficients),
-                        float(knots[-1]), path, 1.0, ratio, 0.0, 0)
+    ratio = exact_peaks(knots, coefficients) / np.stack(limits)
+    stretch = 1.0
+    for _ in range(5):  # the fit of phases a microsecond long rounds the peaks: until they hold
+        more = max(1.0, *(ratio.max(axis=1) ** (1.0 / np.arange(1, 4)) * (1 + 1e-8)))
+        if more == 1.0:
+            break
+        stretch *= more
+        knots = knots * more
+        samples = samples / more ** np.arange(3)[None, :, None]
+        coefficients = quintic_hermite_coefficients(knots, samples, samples)
+        ratio = exact_peaks(knots, coefficients) / np.stack(limits)
+    trajectory = piecewise_trajectory(knots, coefficients)
+    return SmoothTiming(HermiteLaw(knots, samples, samples), trajectory, float(knots[-1]),
+                        trajectory if path is None else path, stretch, ratio, 0.0, 0)
+
+
+def _iterate(program: _Program, iterations: int, start=None) -> tuple[np.ndarray, np.ndarray, int]:
+    """(x, p, the programs with the jerk solved) of the best of the sequential linear programs:
+    the first without the jerk (or the given ``start`` (x, p) instead), then up to
+    ``iterations`` with it, each linearised at the one before, with √x frozen at the most the
+    trust region lets x grow to (so an iterate keeps the jerk at the nodes). An iterate is judged
+    by its time stretched until the jerk at the nodes holds with its own √x; where one is longer
+    than the best so far, the trust region is halved. They stop once the best shortens by < 0.2 %
+    (after 4), or at a degenerate iterate or a failing program after the first (the best so far
+    is kept). From a ``start``, an InfeasibleTimingError where no program succeeds."""
+    x, p = best = program.solve(None, np.inf) if start is None else start
+    best_time, growth, solved = np.inf, TRUST_REGION, 0
+    while solved < iterations:
+        try:
+            x, p = program.solve((x, p), growth)
+        except InfeasibleTimingError:
+            if not solved:
+                raise
+            break
+        solved += 1
+        if not np.all(x[1:-1] > 0):  # a degenerate iterate: keep the best
+            break
+        estimate = _node_times(program.s, x, p)[-1] * max(1.0, program.jerk_ratio(x, p)) ** (1 / 3)
+        if estimate < best_time:
+            shorter = 1 - estimate / best_time
+            best, best_time = (x, p), estimate
+            if solved >= 4 and shorter < 2e-3:
+                break
+        else:
+            growth = 1 + 0.5 * (growth - 1)
+    if start is not None and best is start:
+        raise InfeasibleTimingError("no program from the coarse grid's solution gave a motion", field=("path",))
+    return (*best, solved)
+
+
+class _Pieces(NamedTuple):
+    """The quintic pieces of a solution (x, p), stretched so every limit holds."""
+
+    t: np.ndarray  # knots [s]
+    joint_samples: np.ndarray  # (K, q/q̇/q̈, n)
+    path_samples: np.ndarray  # (K, s/ṡ/s̈)
+    coefficients: np.ndarray  # (K - 1, 6, n)
+    ratio: np.ndarray  # exact peaks over the limits (3, n)
+    stretch: float
+    deviation: float  # [rad] from the path (without the spline's fit)
+
+
+def _better(coarse: _Pieces, fine: _Pieces, tolerance: float) -> _Pieces:
+    """The finer grid's motion where it keeps to the path within ``tolerance`` [rad] and is no
+    longer, or where the coarse one strays; else the coarse grid's."""
+    if coarse.deviation > tolerance or (fine.deviation <= tolerance and fine.t[-1] <= coarse.t[-1]):
+        return fine
+    return coarse
+
+
+def _pieces(path, program: _Program, x: np.ndarray, p: np.ndarray, limits: np.ndarray) -> _Pieces:
+    """The motion of the solution (x, p) as quintic Hermite pieces through the nodes and the
+    middle of every interval, with the repair: time stretched by k (which scales q̇, q̈, q⃛ by 1/k,
+    1/k², 1/k³) until the exact peaks of every piece hold the limits."""
+    t, joint_samples, path_samples = _samples(path, program, x, p)
+    coefficients = quintic_hermite_coefficients(t, joint_samples, joint_samples)
+    ratio = exact_peaks(t, coefficients) / limits
+    stretch = max(1.0, *(ratio.max(axis=1) ** (1.0 / np.arange(1, 4)) * (1 + 1e-6)))
+    if stretch > 1.0:
+        t = t * stretch
+        joint_samples = joint_samples / stretch ** np.arange(3)[None, :, None]
+        path_samples = path_samples / stretch ** np.arange(3)[None, :]
+        coefficients = quintic_hermite_coefficients(t, joint_samples, joint_samples)
+        ratio = exact_peaks(t, coefficients) / limits
+    return _Pieces(t, joint_samples, path_samples, coefficients, ratio, stretch,
+                   _deviation(path, t, coefficients, path_samples))
 
 
 def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 250,
@@ -629,48 +813,40 @@ def _time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, gri
                 f"the limits are too small for the path: {joint_label(j)} travels {travel[j]:.4g} rad with at most "
                 f"{limit[j]:.4g} {unit} ({name}): at least {least[j]:.4g} s, longer than max_duration {max_duration:g} s",
                 field=("path",))
-    s = _grid(path, velocity, acceleration, jerk, grid_points)
+    limits = np.stack([velocity, acceleration, jerk])
+    s = _grid(path, velocity, acceleration, jerk, min(grid_points, COARSE_GRID_POINTS))
     program = _Program(path, s, velocity, acceleration, jerk)
-    x, p = program.solve(None, np.inf)
-    done, duration = 0, np.inf
-    for done in range(1, iterations + 1):
-        candidate = program.solve((x, p), TRUST_REGION)
-        if not np.all(candidate[0][1:-1] > 0):  # a degenerate iterate: keep the last good one
-            break
-        x, p = candidate
-        shorter = 1 - (updated := _node_times(s, x, p)[-1]) / duration
-        duration = updated
-        if done >= 4 and abs(shorter) < 2e-3:
-            break
+    x, p, solved = _iterate(program, iterations)
     if not np.all(x[1:-1] > 0):
         k = int(np.argmin(x[1:-1])) + 1
         raise InfeasibleTimingError(
             f"the limits are too small for the path: the path speed falls to 0 at s = {s[k]:.6g} (velocity_limit, "
             "acceleration_limit or jerk_limit)", field=("path",))
-    t, joint_samples, path_samples = _samples(path, program, x, p)
+    pieces = _pieces(path, program, x, p, limits)
+    if grid_points > COARSE_GRID_POINTS:  # the requested grid, started from the coarse one's solution
+        fine_s, x, p = _refined(path, s, x, p, grid_points)
+        fine = _Program(path, fine_s, velocity, acceleration, jerk)
+        try:
+            x, p, more = _iterate(fine, iterations, start=(x, p))
+        except InfeasibleTimingError:
+            more = 0  # the coarse grid's motion stands
+        else:
+            pieces = _better(pieces, _pieces(path, fine, x, p, limits), PATH_TOLERANCE - fit)
+        solved += more
+    t, joint_samples, coefficients, ratio, stretch = (pieces.t, pieces.joint_samples, pieces.coefficients,
+                                                      pieces.ratio, pieces.stretch)
     if not t[-1] <= max_duration:
         raise InfeasibleTimingError(
             f"the limits are too small for the path: the motion would last {t[-1]:.4g} s > max_duration "
             f"{max_duration:g} s (velocity_limit, acceleration_limit or jerk_limit)", field=("path",))
-    coefficients = quintic_hermite_coefficients(t, joint_samples, joint_samples)
-    limits = np.stack([velocity, acceleration, jerk])
-    ratio = exact_peaks(t, coefficients) / limits
-    # the repair: stretch time by k, which scales q̇, q̈, q⃛ by 1/k, 1/k², 1/k³
-    stretch = max(1.0, *(ratio.max(axis=1) ** (1.0 / np.arange(1, 4)) * (1 + 1e-6)))
-    if stretch > 1.0:
-        t = t * stretch
-        joint_samples = joint_samples / stretch ** np.arange(3)[None, :, None]
-        path_samples = path_samples / stretch ** np.arange(3)[None, :]
-        coefficients = quintic_hermite_coefficients(t, joint_samples, joint_samples)
-        ratio = exact_peaks(t, coefficients) / limits
     if not np.all(ratio <= 1.0):
         k, j = np.unravel_index(np.argmax(ratio), ratio.shape)
         raise InfeasibleTimingError(f"the timed motion exceeds the {('velocity', 'acceleration', 'jerk')[k]} limit of "
                                     f"{joint_label(j)} by a factor {ratio[k, j]:.6g} after the repair", field=("path",))
-    deviation = fit + _deviation(path, t, coefficients, path_samples)
+    deviation = fit + pieces.deviation
     if deviation > PATH_TOLERANCE:
         raise InfeasibleTimingError(
             f"the timed motion leaves the path by {deviation:.3g} rad > {PATH_TOLERANCE:g} rad (grid_points "
             f"{grid_points} too few for this path's curvature: give more)", field=("path",))
     law = HermiteLaw(t, joint_samples, joint_samples)
-    return SmoothTiming(law, piecewise_trajectory(t, coefficients), float(t[-1]), path, stretch, ratio, deviation, done)
+    return SmoothTiming(law, piecewise_trajectory(t, coefficients), float(t[-1]), path, stretch, ratio, deviation, solved)
