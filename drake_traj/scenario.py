@@ -68,7 +68,7 @@ def default_plant_config() -> MultibodyPlantConfig:
 def default_simulator_config() -> SimulatorConfig:
     """Fixed-step second-order Runge-Kutta at 1 ms for the planner's continuous reference.
 
-    Chosen by measurement (README "Speed"): it evaluates the planner twice per millisecond (the
+    Chosen by measurement (docs/benchmarks.md, "Speed"): it evaluates the planner twice per millisecond (the
     error-controlled default RK3 3.75-4.2 times), keeps every Table 2 duration of Pająk 2024 to the
     millisecond and the reference within 2e-6 rad of RK3 at accuracy 1e-8; semi-explicit Euler
     (one evaluation) moved sim 3's T by 5 ms and the reference by 2.3e-4 rad.

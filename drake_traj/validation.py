@@ -120,7 +120,7 @@ def tracking_tolerance_check(tracking_tolerance, clearance) -> None:
                   f"{2e3 * tolerance:g} mm")
 
 
-# The bounds of a run's times and pace (README "When something goes wrong"): every run ends, and
+# The bounds of a run's times and pace (docs/troubleshooting.md): every run ends, and
 # its log (1 ms samples by default, about 0.3 kB each) fits in memory.
 MAX_RUN_DURATION = 600.0  # [s] max_duration, and the preflight's horizon: 10 minutes of simulated motion
 MAX_SETTLE_TIME = 60.0  # [s] settle_time, the run after the planner finishes

@@ -1,4 +1,4 @@
-"""The README's free-motion picture: diagrams/free_motion_shelf.yaml's shelf seen from the robot, the
+"""The free-motion picture of docs/free-motion.md: diagrams/free_motion_shelf.yaml's shelf seen from the robot, the
 TCP path of the planned motion round the boards, and the straight joint move it replaces (which
 the cell check refuses), with the configurations where the straight move comes into the shelf.
 

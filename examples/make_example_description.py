@@ -1,5 +1,5 @@
 """Write models/example_arm_description/: an arm description laid out as engineers get one from
-a ROS package, made by us for the tests (README "Your arm").
+a ROS package, made by us for the tests (docs/arm.md).
 
 The arm is our UR5e model (models/ur5e.urdf, written from UR's published data) with every
 collision and visual shape replaced by a mesh file of its own: cylinders as 32-sided prisms and

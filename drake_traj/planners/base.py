@@ -156,7 +156,7 @@ class PlannerSystem(LeafSystem):
         ``tests/test_plan.py``: the difference there is the simulator's integration error.
 
         Made at the first call and kept (the law does not change); each call returns a copy. Use
-        it in a diagram of your own as ``TrajectorySource(planner.plan())`` (README).
+        it in a diagram of your own as ``TrajectorySource(planner.plan())`` (docs/drake-api.md).
 
         Raises:
             PlanningError: the task cannot be planned ahead: what :meth:`preflight` raises (Pająk:

@@ -48,7 +48,7 @@ JOINT_NAMES = (
 # UR controller defaults for joint moves, used by Pająk 2024 for every joint.
 DEFAULT_JOINT_MOVE_VELOCITY = 1.05  # [rad/s] (60 deg/s)
 DEFAULT_JOINT_MOVE_ACCELERATION = 1.40  # [rad/s^2] (80 deg/s^2)
-# The UR10e's PD gains [N m/rad], [N m s/rad] (README "Controller"); every other arm's are these
+# The UR10e's PD gains [N m/rad], [N m s/rad] (docs/drake-api.md, "The controller"); every other arm's are these
 # scaled joint by joint by its torque limit over the UR10e's (:attr:`URArm.default_gains`).
 UR10E_KP = (4000.0, 4000.0, 2000.0, 500.0, 500.0, 300.0)
 UR10E_KD = (200.0, 200.0, 100.0, 20.0, 20.0, 10.0)
