@@ -631,19 +631,26 @@ def _move_inputs(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit
     jerk = default_jerk_limit(acceleration) if jerk_limit is None else positive_vector(jerk_limit, "jerk_limit", n)
     if not np.any(step > 0):
         raise InfeasibleTimingError("path does not move: the goal equals the start", field=("path",))
-    max_duration = positive_scalar(max_duration, "max_duration", "s")
-    # each joint's rest-to-rest move lasts at least d / v, 2 sqrt(d / a) and (32 d / J)^(1/3)
-    bounds = {"velocity_limit": (step / velocity, velocity, "rad/s"),
-              "acceleration_limit": (2 * np.sqrt(step / acceleration), acceleration, "rad/s²"),
-              "jerk_limit": (np.cbrt(32 * step / jerk), jerk, "rad/s³")}
+    _check_least_durations(step, (velocity, acceleration, jerk), positive_scalar(max_duration, "max_duration", "s"),
+                           "moves")
+    return q_start, q_goal, (velocity, acceleration, jerk)
+
+
+def _check_least_durations(distance: np.ndarray, limits, max_duration: float, verb: str) -> None:
+    """An InfeasibleTimingError naming the joint and the limit where one limit alone makes a
+    rest-to-rest move of ``distance`` [rad] per joint last longer than ``max_duration`` [s]: it
+    lasts at least d / v, 2 sqrt(d / a) and (32 d / J)^(1/3)."""
+    velocity, acceleration, jerk = limits
+    bounds = {"velocity_limit": (distance / velocity, velocity, "rad/s"),
+              "acceleration_limit": (2 * np.sqrt(distance / acceleration), acceleration, "rad/s²"),
+              "jerk_limit": (np.cbrt(32 * distance / jerk), jerk, "rad/s³")}
     for name, (least, limit, unit) in bounds.items():
         if not np.max(least) <= max_duration:
             j = int(np.argmax(least))
             raise InfeasibleTimingError(
-                f"the limits are too small for the path: {joint_label(j)} moves {step[j]:.4g} rad with at most "
-                f"{limit[j]:.4g} {unit} ({name}): at least {least[j]:.4g} s, longer than max_duration "
-                f"{max_duration:g} s", field=("path",))
-    return q_start, q_goal, (velocity, acceleration, jerk)
+                f"the limits are too small for the path: {joint_label(j)} {verb} {distance[j]:.4g} rad with at most "
+                f"{limit[j]:.4g} {unit} ({name}): at least {least[j]:.4g} s, longer than max_duration {max_duration:g} s",
+                field=("path",))
 
 
 def _ruckig_states(law: RuckigStopLaw, max_duration: float) -> tuple[np.ndarray, np.ndarray]:
@@ -800,19 +807,10 @@ def _time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, gri
     max_duration = positive_scalar(max_duration, "max_duration", "s")
     s_all = np.linspace(path.start_time(), path.end_time(), 2001)
     travel = np.trapezoid(np.abs(path.MakeDerivative(1).vector_values(s_all)), s_all, axis=1)  # per joint [rad]
-    # Lower bounds on T from each limit alone: a joint's travel D is made of rest-to-rest pieces (it
-    # stops where it turns back), each at least d / v, 2 sqrt(d / a) and (32 d / j)^(1/3) long, and
-    # the sums are at least those of D (the roots are concave). Checked before any array is made.
-    bounds = {"velocity_limit": (travel / velocity, velocity, "rad/s"),
-              "acceleration_limit": (2 * np.sqrt(travel / acceleration), acceleration, "rad/s²"),
-              "jerk_limit": (np.cbrt(32 * travel / jerk), jerk, "rad/s³")}
-    for name, (least, limit, unit) in bounds.items():
-        if not np.max(least) <= max_duration:
-            j = int(np.argmax(least))
-            raise InfeasibleTimingError(
-                f"the limits are too small for the path: {joint_label(j)} travels {travel[j]:.4g} rad with at most "
-                f"{limit[j]:.4g} {unit} ({name}): at least {least[j]:.4g} s, longer than max_duration {max_duration:g} s",
-                field=("path",))
+    # A joint's travel D is made of rest-to-rest pieces (it stops where it turns back), and the sums
+    # of their least durations are at least those of D (the roots are concave). Checked before any
+    # array is made.
+    _check_least_durations(travel, (velocity, acceleration, jerk), max_duration, "travels")
     limits = np.stack([velocity, acceleration, jerk])
     s = _grid(path, velocity, acceleration, jerk, min(grid_points, COARSE_GRID_POINTS))
     program = _Program(path, s, velocity, acceleration, jerk)
