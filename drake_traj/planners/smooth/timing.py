@@ -39,7 +39,7 @@ from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coeffic
 from drake_traj.planners.laws.polynomials import rate_peaks
 from drake_traj.validation import positive_scalar, positive_vector, real_array, require_finite, whole_number
 
-__all__ = ["InfeasibleTimingError", "SmoothTiming", "check_path", "exact_peaks", "line_timing", "move_timing", "time_path"]
+__all__ = ["InfeasibleTimingError", "SmoothTiming", "check_path", "exact_peaks", "line_timing", "stop_timing", "time_path"]
 
 PATH_TOLERANCE = 1e-4
 """The largest joint-space deviation [rad] of the timed motion from the given path."""
@@ -589,51 +589,48 @@ def line_timing(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit=
     ``q_start`` to ``q_goal`` [rad]: the seven-phase profile of the path parameter s in [0, 1]
     (Ruckig on one degree of freedom) under the tightest of the joints' limits on s
     (v_j / |Δq_j|, a_j / |Δq_j|, J_j / |Δq_j|), which is Ruckig's phase-synchronised motion; no
-    linear program, no stretch, exact on the line (its pieces are cubic in t). T grows with the
-    distance. Limits as :func:`time_path`'s; an :class:`InfeasibleTimingError` where the motion
-    would last longer than ``max_duration`` [s] or the segment has no length."""
-    q_start, q_goal, limits = _move_inputs(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit,
-                                           max_duration)
-    step = q_goal - q_start
+    linear program, exact on the line (its pieces are cubic in t). T grows with the distance.
+    Limits as :func:`time_path`'s; an :class:`InfeasibleTimingError` where the motion would last
+    longer than ``max_duration`` [s] or the segment has no length."""
+    q, limits = _stop_inputs([q_start, q_goal], velocity_limit, acceleration_limit, jerk_limit, max_duration)
+    step = q[1] - q[0]
     moving = step != 0
     line_limits = [[float(np.min(limit[moving] / np.abs(step[moving])))] for limit in limits]
-    knots, s = _ruckig_states(RuckigStopLaw([[0.0], [1.0]], *line_limits), max_duration)  # s: (K, s/ṡ/s̈, 1)
+    knots, s, s_jerk = _ruckig_states(RuckigStopLaw([[0.0], [1.0]], *line_limits), max_duration)  # s: (K, s/ṡ/s̈, 1)
     samples = s * step[None, None, :]
-    samples[:, 0] += q_start
-    path = PiecewisePolynomial.FirstOrderHold([0.0, 1.0], np.column_stack([q_start, q_goal]))
-    return _exact_timing(knots, samples, limits, path)
+    samples[:, 0] += q[0]
+    path = PiecewisePolynomial.FirstOrderHold([0.0, 1.0], q.T)
+    return _exact_timing(knots, samples, s_jerk * step[None, :], limits, path)
 
 
-def move_timing(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit=None, *,
+def stop_timing(q_waypoints, velocity_limit, acceleration_limit, jerk_limit=None, *,
                 max_duration: float = 600.0) -> SmoothTiming:
-    """The time-optimal jerk-limited rest-to-rest move from ``q_start`` to ``q_goal`` [rad]:
-    Ruckig's time-synchronised motion (every joint starts and stops together, the limiting joint
-    on its own time-optimal profile, the others on profiles of the same duration), the fastest a
-    rest-to-rest move can be under per-joint limits and never slower than the straight line
-    (:func:`line_timing`). The joints do not keep to the straight segment between the two: the
-    timing's ``path`` is the motion itself (s = t). Exact (cubic pieces in t), no stretch; T
-    grows with the distance. Limits and errors as :func:`line_timing`'s."""
-    q_start, q_goal, limits = _move_inputs(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit,
-                                           max_duration)
-    knots, samples = _ruckig_states(RuckigStopLaw([q_start, q_goal], *limits), max_duration)
-    return _exact_timing(knots, samples, limits, None)
+    """Time-optimal jerk-limited rest-to-rest moves through joint waypoints (m + 1, n) [rad],
+    stopping at each: Ruckig's time-synchronised moves (every joint starts and stops together,
+    the limiting joint on its own time-optimal profile, the others on profiles of the same
+    duration). One move is the fastest a rest-to-rest move can be under per-joint limits, never
+    slower than the straight line (:func:`line_timing`); the joints do not keep to the straight
+    segments between the waypoints, so the timing's ``path`` is the motion itself (s = t). Exact
+    (cubic pieces in t); T grows with the distance. Limits and errors as :func:`line_timing`'s."""
+    q, limits = _stop_inputs(q_waypoints, velocity_limit, acceleration_limit, jerk_limit, max_duration)
+    return _exact_timing(*_ruckig_states(RuckigStopLaw(q, *limits), max_duration), limits, None)
 
 
-def _move_inputs(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit, max_duration):
-    """(q_start, q_goal, (velocity, acceleration, jerk)) of a rest-to-rest move, checked: the goal
-    differs from the start, and no limit alone makes the move last longer than ``max_duration``
-    [s] (checked before Ruckig sees limits of 1e-300)."""
-    q_start, q_goal = np.asarray(q_start, dtype=float), np.asarray(q_goal, dtype=float)
-    step = np.abs(q_goal - q_start)
-    n = len(step)
+def _stop_inputs(q_waypoints, velocity_limit, acceleration_limit, jerk_limit, max_duration):
+    """(waypoints (m + 1, n), (velocity, acceleration, jerk)) of rest-to-rest moves, checked: the
+    motion moves, and no limit alone makes a move last longer than ``max_duration`` [s] (checked
+    before Ruckig sees limits of 1e-300)."""
+    q = np.asarray(q_waypoints, dtype=float)
+    steps = np.abs(np.diff(q, axis=0))
+    n = q.shape[1]
     velocity = positive_vector(velocity_limit, "velocity_limit", n)
     acceleration = positive_vector(acceleration_limit, "acceleration_limit", n)
     jerk = default_jerk_limit(acceleration) if jerk_limit is None else positive_vector(jerk_limit, "jerk_limit", n)
-    if not np.any(step > 0):
+    if not np.any(steps > 0):
         raise InfeasibleTimingError("path does not move: the goal equals the start", field=("path",))
-    _check_least_durations(step, (velocity, acceleration, jerk), positive_scalar(max_duration, "max_duration", "s"),
-                           "moves")
-    return q_start, q_goal, (velocity, acceleration, jerk)
+    _check_least_durations(steps.max(axis=0), (velocity, acceleration, jerk),
+                           positive_scalar(max_duration, "max_duration", "s"), "moves")
+    return q, (velocity, acceleration, jerk)
 
 
 def _check_least_durations(distance: np.ndarray, limits, max_duration: float, verb: str) -> None:
@@ -653,10 +650,11 @@ def _check_least_durations(distance: np.ndarray, limits, max_duration: float, ve
                 field=("path",))
 
 
-def _ruckig_states(law: RuckigStopLaw, max_duration: float) -> tuple[np.ndarray, np.ndarray]:
-    """(knots (K,) [s], states (K, position/rate/acceleration, n)) of a one-move Ruckig law at its
-    knots (every joint is one cubic between them), at rest at both ends; an
-    :class:`InfeasibleTimingError` naming the limit where it lasts longer than ``max_duration``."""
+def _ruckig_states(law: RuckigStopLaw, max_duration: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(knots (K,) [s], states (K, position/rate/acceleration, n), jerk (K - 1, n)) of a Ruckig law
+    at its knots (every joint is one cubic between them, of that constant jerk), at rest at both
+    ends; an :class:`InfeasibleTimingError` naming the limits where it lasts longer than
+    ``max_duration``."""
     if not law.duration <= max_duration:
         raise InfeasibleTimingError(f"the limits are too small for the path: the move takes {law.duration:.4g} s, longer "
                                     f"than max_duration {max_duration:g} s (velocity_limit, acceleration_limit or "
@@ -667,27 +665,24 @@ def _ruckig_states(law: RuckigStopLaw, max_duration: float) -> tuple[np.ndarray,
     states = np.stack(law.sample(knots), axis=1)
     states[0, 1:] = states[-1, 1:] = 0.0
     states[-1, 0] = law.q_waypoints[-1]
-    return knots, states
+    return knots, states, law.jerk(0.5 * (knots[:-1] + knots[1:]))
 
 
-def _exact_timing(knots, samples, limits, path) -> SmoothTiming:
-    """The SmoothTiming of cubic pieces given exactly by their states at ``knots`` along ``path``
-    (None: the motion itself), stretched in time where Ruckig's profile exceeds a limit by its
-    rounding (the jerk by up to 5e-6 of the limit)."""
-    coefficients = quintic_hermite_coefficients(knots, samples, samples)  # the cubic pieces, exactly
+def _exact_timing(knots, states, jerk, limits, path) -> SmoothTiming:
+    """The SmoothTiming of the cubic pieces from ``states`` (K, q/q̇/q̈, n) at ``knots`` with
+    constant ``jerk`` (K - 1, n) between, along ``path`` (None: the motion itself), stretched in
+    time where Ruckig's profile exceeds a limit by its rounding (the jerk by up to 5e-6 of it)."""
+    coefficients = np.zeros((len(knots) - 1, 6, states.shape[2]))
+    coefficients[:, :3] = states[:-1] / np.array([1.0, 1.0, 2.0])[None, :, None]
+    coefficients[:, 3] = jerk / 6
     ratio = exact_peaks(knots, coefficients) / np.stack(limits)
-    stretch = 1.0
-    for _ in range(5):  # the fit of phases a microsecond long rounds the peaks: until they hold
-        more = max(1.0, *(ratio.max(axis=1) ** (1.0 / np.arange(1, 4)) * (1 + 1e-8)))
-        if more == 1.0:
-            break
-        stretch *= more
-        knots = knots * more
-        samples = samples / more ** np.arange(3)[None, :, None]
-        coefficients = quintic_hermite_coefficients(knots, samples, samples)
+    stretch = max(1.0, *(ratio.max(axis=1) ** (1.0 / np.arange(1, 4)) * (1 + 1e-9))) if ratio.max() > 1 else 1.0
+    if stretch > 1.0:  # q̇, q̈, q⃛ scale by 1/k, 1/k², 1/k³, each coefficient c_i by 1/k^i
+        knots, states = knots * stretch, states / stretch ** np.arange(3)[None, :, None]
+        coefficients = coefficients / stretch ** np.arange(6)[None, :, None]
         ratio = exact_peaks(knots, coefficients) / np.stack(limits)
     trajectory = piecewise_trajectory(knots, coefficients)
-    return SmoothTiming(HermiteLaw(knots, samples, samples), trajectory, float(knots[-1]),
+    return SmoothTiming(HermiteLaw(knots, states, states), trajectory, float(knots[-1]),
                         trajectory if path is None else path, stretch, ratio, 0.0, 0)
 
 
