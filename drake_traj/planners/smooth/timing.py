@@ -248,14 +248,15 @@ def _limits(path, velocity_limit, acceleration_limit, jerk_limit):
 
 
 def _grid(path, velocity, acceleration, jerk, points: int) -> np.ndarray:
-    """Grid nodes s: evenly spaced in the time of the bang-bang optimum (Drake's Toppra, on
-    as many points evenly spaced in s plus the path's breaks: its default grid takes over a
+    """Grid nodes s: ``points`` evenly spaced in the time of the bang-bang optimum (Drake's Toppra,
+    on as many points evenly spaced in s plus the path's breaks: its default grid takes over a
     thousand points on a tight turn, and 5 times longer), so the nodes crowd where the path is
-    slow and near the ends (s ∝ t² there), plus the path's breaks. Where Toppra finds no
+    slow and near the ends (s ∝ t² there), plus the path's breaks (on a path through hundreds of
+    dense goals the breaks alone left a hairpin turn two nodes, where the program stopped the
+    path: "the path speed falls to 0"). Where Toppra finds no
     parameterisation (its reachability analysis fails on some paths with tight turns), the bang-bang profile of our own first linear program on nodes
     evenly spaced in s takes its place."""
     breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
-    points = max(points - len(breaks), points // 2)
     even = _merged(np.linspace(path.start_time(), path.end_time(), points), breaks)
     try:
         optimal, trajectory = time_optimal_along_path(path, velocity, acceleration, grid_points=even)
@@ -269,13 +270,12 @@ def _grid(path, velocity, acceleration, jerk, points: int) -> np.ndarray:
 
 
 def _refined(path, coarse: np.ndarray, x: np.ndarray, p: np.ndarray, points: int):
-    """(nodes s, x, p) of a finer grid of about ``points`` nodes evenly spaced in the time of the
-    coarse grid's solution (x, p) at its nodes ``coarse`` (plus the path's breaks), with x and p
+    """(nodes s, x, p) of a finer grid of ``points`` nodes evenly spaced in the time of the coarse
+    grid's solution (x, p) at its nodes ``coarse``, plus the path's breaks, with x and p
     interpolated there: the start of the finer grid's programs. On the end intervals x follows
     the end law, x ∝ distance^(4/3)."""
-    breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
     times = _node_times(coarse, x, p)
-    s = _with_breaks(path, np.interp(np.linspace(0.0, times[-1], max(points - len(breaks), points // 2)), times, coarse))
+    s = _with_breaks(path, np.interp(np.linspace(0.0, times[-1], points), times, coarse))
     x_fine, p_fine = np.interp(s, coarse, x), np.interp(s, coarse, p)
     first, last = s < coarse[1], s > coarse[-2]
     x_fine[first] = x[1] * ((s[first] - coarse[0]) / (coarse[1] - coarse[0])) ** (4 / 3)
@@ -453,11 +453,13 @@ class _Program:
             ends = [1, 2, N - 3, N - 2]  # the nodes next to the ends weigh nothing in the sum but their time,
             lower[ends] = np.minimum(previous[0][ends] / growth, high[ends])  # 3 h / √x, is long: they fall by the trust region's factor at most
             self._set_jerk_rows(previous[0] * growth)
+            self._set_time_weights(previous[0])
         z = self._run(lower, high)
         if z is None and previous is not None:  # from a fresh start, scaled to the last iterate
             self._start(self._scale(*previous))
             self.jerk_programs = 1
             self._set_jerk_rows(previous[0] * growth)
+            self._set_time_weights(previous[0])
             z = self._run(lower, high)
         if z is None and previous is not None and lower[1] > 0:  # without the floor at the ends
             lower[[1, 2, N - 3, N - 2]] = 0.0
@@ -471,6 +473,16 @@ class _Program:
                 "to each other in size across the joints", field=("path",))
         z = z * self.scale
         return np.maximum(z[:N], 0.0), z[N:]
+
+    def _set_time_weights(self, x_previous: np.ndarray) -> None:
+        """The objective of a jerk program: the time's decrease to first order at the last iterate,
+        Σ h / (2 x^(3/2)) δx (the plain Σ h x let a program stop the path at a node, x = 0, to
+        speed up its neighbours: an infinite time)."""
+        x = np.maximum(x_previous, 1e-6 * x_previous.max())
+        weights = self.weights / x**1.5
+        weights = weights / weights[1:-1].max()
+        columns = np.arange(self.num_nodes, dtype=np.int32)
+        self.solver.changeColsCost(self.num_nodes, columns, -weights * self.scale[:self.num_nodes])
 
     def _set_jerk_rows(self, x_previous: np.ndarray) -> None:
         """The jerk rows' bounds: the jerk limit over √x frozen at the last iterate."""
