@@ -23,6 +23,7 @@ distance to the end), q̈ = 0 at the end and the end interval lasts 3 h / √x.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -75,9 +76,11 @@ class SmoothTiming:
     Attributes:
         law: the motion as a time law (:class:`HermiteLaw`, quintic pieces between ``knots``)
             for a :class:`~drake_traj.planners.base.TimeLawPlanner`.
-        trajectory: the same motion as Drake's PiecewisePolynomial q(t) [rad], t in [0, duration].
+        coefficients: the pieces' monomial coefficients in t - knots[k], (K - 1, 6, n).
+        trajectory: the same motion as Drake's PiecewisePolynomial q(t) [rad], t in [0, duration]
+            (made on first use).
         duration: T [s].
-        path: the geometric path q(s) that was timed.
+        path: the geometric path q(s) that was timed (None: the motion itself, s = t).
         stretch: the factor (>= 1) the repair stretched the time by so every limit holds (1: none).
         peaks: max |q̇|, |q̈|, |q⃛| over the limit per joint, exact ((3, n)).
         deviation: the largest joint deviation [rad] from the given path, as checked: the
@@ -88,13 +91,21 @@ class SmoothTiming:
     """
 
     law: HermiteLaw
-    trajectory: PiecewisePolynomial
+    coefficients: np.ndarray
     duration: float
-    path: Trajectory
+    given_path: Trajectory | None
     stretch: float
     peaks: np.ndarray
     deviation: float
     iterations: int
+
+    @functools.cached_property
+    def trajectory(self) -> PiecewisePolynomial:
+        return piecewise_trajectory(self.law.knots, self.coefficients)
+
+    @property
+    def path(self) -> Trajectory:
+        return self.trajectory if self.given_path is None else self.given_path
 
 
 def check_path(path, name: str = "path") -> tuple[Trajectory, float]:
@@ -680,9 +691,7 @@ def _exact_timing(knots, states, jerk, limits, path) -> SmoothTiming:
         knots, states = knots * stretch, states / stretch ** np.arange(3)[None, :, None]
         coefficients = coefficients / stretch ** np.arange(6)[None, :, None]
         ratio = exact_peaks(knots, coefficients) / np.stack(limits)
-    trajectory = piecewise_trajectory(knots, coefficients)
-    return SmoothTiming(HermiteLaw(knots, states, states), trajectory, float(knots[-1]),
-                        trajectory if path is None else path, stretch, ratio, 0.0, 0)
+    return SmoothTiming(HermiteLaw(knots, states, states), coefficients, float(knots[-1]), path, stretch, ratio, 0.0, 0)
 
 
 def _iterate(program: _Program, iterations: int, start=None) -> tuple[np.ndarray, np.ndarray, int]:
@@ -841,4 +850,4 @@ def _time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, gri
             f"the timed motion leaves the path by {deviation:.3g} rad > {PATH_TOLERANCE:g} rad (grid_points "
             f"{grid_points} too few for this path's curvature: give more)", field=("path",))
     law = HermiteLaw(t, joint_samples, joint_samples)
-    return SmoothTiming(law, piecewise_trajectory(t, coefficients), float(t[-1]), path, stretch, ratio, deviation, solved)
+    return SmoothTiming(law, coefficients, float(t[-1]), path, stretch, ratio, deviation, solved)
