@@ -370,7 +370,7 @@ def test_a_failing_linear_program_names_its_rows_and_what_to_change(monkeypatch)
 
     q, velocity, acceleration = next(_waypoint_tasks(3, 1))
     path = waypoint_path(q)
-    reference = time_path(path, velocity, acceleration, grid_points=100)
+    reference = time_path(path, velocity, acceleration, grid_points=20)
     run = timing._Program._run
     calls = []
 
@@ -386,15 +386,15 @@ def test_a_failing_linear_program_names_its_rows_and_what_to_change(monkeypatch)
     monkeypatch.setattr(timing._Program, "_run", fail_after(0))
     with pytest.raises(InfeasibleTimingError, match=r"linear program on \d+ nodes \(velocity_limit and acceleration_limit\) "
                                                     r"failed: HiGHS reports 'Unknown'.*give fewer grid_points"):
-        time_path(path, velocity, acceleration, grid_points=100)
+        time_path(path, velocity, acceleration, grid_points=20)
     calls.clear()
     monkeypatch.setattr(timing._Program, "_run", fail_after(1))  # the first jerk program fails, and its retries
     with pytest.raises(InfeasibleTimingError, match=r"velocity_limit, acceleration_limit and jerk_limit \(the jerk "
                                                     r"linearised at the last iterate\)"):
-        time_path(path, velocity, acceleration, grid_points=100)
+        time_path(path, velocity, acceleration, grid_points=20)
     calls.clear()
     monkeypatch.setattr(timing._Program, "_run", fail_after(4))  # a later program fails: the best so far is kept
-    kept = time_path(path, velocity, acceleration, grid_points=100)
+    kept = time_path(path, velocity, acceleration, grid_points=20)
     assert kept.peaks.max() <= 1 and reference.duration <= kept.duration < 1.1 * reference.duration
 
 

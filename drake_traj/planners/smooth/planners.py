@@ -118,7 +118,8 @@ class SmoothWaypointsConfig:
         goals: joint waypoints after the start [rad], one row of n per waypoint.
         velocity_limit, acceleration_limit: per joint; empty: the robot's joint-move limits.
         jerk_limit: per joint [rad/s³]; empty: 10 /s × the acceleration limit.
-        grid_points: nodes of the timing's linear programs.
+        grid_points: nodes of the timing's linear programs evenly in time, besides the path's
+            breaks (more: never longer, slower).
     """
 
     goals: list[list[float]] = field(default_factory=list)

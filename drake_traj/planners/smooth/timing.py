@@ -52,11 +52,12 @@ TRUST_REGION = 1.3
 _REVERSAL_COSINE = -0.5  # consecutive sample steps turning by more than 120°: a reversal
 
 
-COARSE_GRID_POINTS = 100
-"""Nodes of the first grid: a finer grid asked for is solved from its solution (evenly spaced in
-its time, x interpolated), and the finer motion kept where it is no longer (from the bang-bang
-start, x near the ends grew only by the trust region's factor per program: a fine grid solved
-alone ended up to 3 times longer than a coarse one)."""
+GRID_LEVELS = (20, 50, 100, 250, 1000)
+"""The grids solved before the one asked for (those with fewer nodes, and at least a quarter as
+many as the path's breaks, which are nodes of every grid): each is started from the last one's solution (nodes evenly spaced in its time, x interpolated) and the shortest motion on
+the path is kept, so more ``grid_points`` are not longer. Solved alone from the bang-bang start,
+x near the ends grew only by the trust region's factor per program: 1000 nodes ended up to 3 times
+longer than 200, and 100 nodes 1.7 % longer than 20 on a short path."""
 
 MAX_GRID_POINTS = 4000
 """Nodes of the timing's linear programs at most (a program of N nodes has 2N variables and about
@@ -766,7 +767,7 @@ def _pieces(path, program: _Program, x: np.ndarray, p: np.ndarray, limits: np.nd
                    _deviation(path, t, coefficients, path_samples))
 
 
-def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 250,
+def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 200,
               iterations: int = 8, max_duration: float = 600.0) -> SmoothTiming:
     """Time ``path`` from rest to rest under per-joint velocity, acceleration and jerk limits.
 
@@ -775,7 +776,9 @@ def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid
             (N, n) [rad] in path order (:func:`check_path`).
         velocity_limit, acceleration_limit: per joint [rad/s, rad/s²], > 0 (scalar or (n,)).
         jerk_limit: per joint [rad/s³], > 0; None: 10 /s × the acceleration limit.
-        grid_points: nodes of the linear programs (more: closer to the optimum, slower).
+        grid_points: nodes of the linear programs evenly in time, besides the path's breaks (more:
+            never longer, slower; 100 is within 0.05 % of 4000 on seeded waypoint paths, and 2.3
+            times Toppra's CPU against 3.9 at 200, but 200 times dense goals up to 8 % faster).
         iterations: the most linear programs with the jerk (they stop once T shortens by < 0.2 %).
         max_duration: the longest motion accepted [s]: limits so small that the motion would
             last longer are refused.
@@ -801,7 +804,7 @@ def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid
                                     field=("path",)) from None
 
 
-def _time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 250,
+def _time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 200,
                iterations: int = 8, max_duration: float = 600.0) -> SmoothTiming:
     """The work of :func:`time_path`."""
     grid_points = whole_number(grid_points, "grid_points", minimum=20, maximum=MAX_GRID_POINTS)
@@ -815,25 +818,37 @@ def _time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, gri
     # array is made.
     _check_least_durations(travel, (velocity, acceleration, jerk), max_duration, "travels")
     limits = np.stack([velocity, acceleration, jerk])
-    s = _grid(path, velocity, acceleration, min(grid_points, COARSE_GRID_POINTS))
-    program = _Program(path, s, velocity, acceleration, jerk)
-    x, p, solved = _iterate(program, iterations)
-    if not np.all(x[1:-1] > 0):
+    pieces, solved, previous = None, 0, None
+    breaks = len(path.get_segment_times()) - 2  # nodes of every grid: levels they dwarf are skipped
+    levels = [points for points in GRID_LEVELS if breaks <= 4 * points and points < grid_points] + [grid_points]
+    for points in levels:
+        # each grid started from the last one's solution (s, x, p), the first (or one after a grid
+        # whose path speed fell to 0: too few nodes at a tight turn) from the bang-bang profile
+        if previous is None:
+            s, initial = _grid(path, velocity, acceleration, points), None
+        else:
+            s, *initial = _refined(path, *previous, points)
+        program = _Program(path, s, velocity, acceleration, jerk)
+        try:
+            x, p, more = _iterate(program, iterations, start=initial)
+        except InfeasibleTimingError:
+            if pieces is None and points == grid_points:
+                raise
+            continue  # the coarser grids' motion stands
+        solved += more
+        if not np.all(x[1:-1] > 0):
+            previous = None
+            if pieces is None and points == levels[-1] and 2 * points <= min(4 * grid_points, MAX_GRID_POINTS):
+                levels.append(2 * points)  # no motion yet: twice the nodes in time (a hairpin two nodes wide)
+            continue
+        previous = (s, x, p)
+        finer = _pieces(path, program, x, p, limits)
+        pieces = finer if pieces is None else _better(pieces, finer, PATH_TOLERANCE - fit)
+    if pieces is None:
         k = int(np.argmin(x[1:-1])) + 1
         raise InfeasibleTimingError(
             f"the limits are too small for the path: the path speed falls to 0 at s = {s[k]:.6g} (velocity_limit, "
             "acceleration_limit or jerk_limit)", field=("path",))
-    pieces = _pieces(path, program, x, p, limits)
-    if grid_points > COARSE_GRID_POINTS:  # the requested grid, started from the coarse one's solution
-        fine_s, x, p = _refined(path, s, x, p, grid_points)
-        fine = _Program(path, fine_s, velocity, acceleration, jerk)
-        try:
-            x, p, more = _iterate(fine, iterations, start=(x, p))
-        except InfeasibleTimingError:
-            more = 0  # the coarse grid's motion stands
-        else:
-            pieces = _better(pieces, _pieces(path, fine, x, p, limits), PATH_TOLERANCE - fit)
-        solved += more
     t, joint_samples, coefficients, ratio, stretch = (pieces.t, pieces.joint_samples, pieces.coefficients,
                                                       pieces.ratio, pieces.stretch)
     if not t[-1] <= max_duration:
