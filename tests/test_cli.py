@@ -59,13 +59,27 @@ def test_list_gives_each_shipped_files_path_above_its_scenarios(capsys):
 
 
 
-def test_list_and_show_say_which_copy_of_the_shipped_files_runs(capsys):
+def test_list_and_show_say_which_copy_of_the_shipped_files_runs(capsys, monkeypatch, tmp_path):
+    """A source tree's diagrams/ (a checkout, an editable install: an edit changes what runs) or
+    the installed package's (CI installs it so): list's first line and show's note say which."""
+    import drake_traj.scenario as scenario_module
+
     directory = shipped_scenarios()[0].path.parent
-    here = f"from this source tree's diagrams/ ({directory}; an edit there changes what runs)"  # the tests run in a checkout
+    here = scenario_module.shipped_copy()
+    in_tree = (directory.parent / "pyproject.toml").is_file()
+    assert here.startswith("this source tree's diagrams/" if in_tree else "the installed package") and str(directory) in here
     assert cli.main(["list"]) == cli.EXIT_OK
-    assert capsys.readouterr().out.splitlines()[0] == f"shipped scenarios, {here}"
+    assert capsys.readouterr().out.splitlines()[0] == f"shipped scenarios, from {here}"
     assert cli.main(["show", "quintic_ptp"]) == cli.EXIT_OK
-    assert f"that is {directory / 'quintic_ptp.yaml'}, {here}; run a copy with" in capsys.readouterr().err
+    assert f"that is {directory / 'quintic_ptp.yaml'}, from {here}; run a copy with" in capsys.readouterr().err
+    for tree in (True, False):  # both wordings, whichever way this copy is installed
+        folder = tmp_path / str(tree) / "diagrams"
+        folder.mkdir(parents=True)
+        if tree:
+            (folder.parent / "pyproject.toml").write_text("[project]\n")
+        monkeypatch.setattr(scenario_module, "shipped_directory", lambda folder=folder: folder)
+        said = scenario_module.shipped_copy()
+        assert said.startswith("this source tree's diagrams/" if tree else "the installed package") and str(folder) in said
 
 
 def test_an_installed_copy_says_a_checkouts_diagrams_are_not_read(tmp_path, monkeypatch, capsys):
