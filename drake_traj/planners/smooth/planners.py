@@ -13,7 +13,8 @@ from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import TimeLawPlanner, start_and_goals
 from drake_traj.planners.baselines.ruckig import jerk_limited_limits
 from drake_traj.planners.pajak import PajakConfig, PajakPlanner
-from drake_traj.planners.smooth.timing import MAX_GRID_POINTS, SmoothTiming, line_timing, stop_timing, time_path
+from drake_traj.planners.smooth.moves import line_timing, stop_timing
+from drake_traj.planners.smooth.timing import MAX_GRID_POINTS, SmoothTiming, time_path
 from drake_traj.robots import Robot
 from drake_traj.validation import instance_of, positive_vector, whole_number
 

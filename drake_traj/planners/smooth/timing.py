@@ -34,12 +34,12 @@ from pydrake.trajectories import PiecewisePolynomial, Trajectory
 
 from drake_traj.errors import Cause, DrakeTrajError, joint_label
 from drake_traj.planners.base import piecewise_trajectory
-from drake_traj.planners.baselines.ruckig import RuckigStopLaw, default_jerk_limit
+from drake_traj.planners.baselines.ruckig import default_jerk_limit
 from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coefficients, sigma_derivatives
 from drake_traj.planners.laws.polynomials import rate_peaks
 from drake_traj.validation import positive_scalar, positive_vector, real_array, require_finite, whole_number
 
-__all__ = ["InfeasibleTimingError", "SmoothTiming", "check_path", "exact_peaks", "line_timing", "stop_timing", "time_path"]
+__all__ = ["InfeasibleTimingError", "SmoothTiming", "check_path", "exact_peaks", "time_path"]
 
 PATH_TOLERANCE = 1e-4
 """The largest joint-space deviation [rad] of the timed motion from the given path."""
@@ -250,12 +250,30 @@ def _check_cusps(path: Trajectory, name: str) -> None:
             "there and time each part", field=(name,))
 
 
-def _limits(path, velocity_limit, acceleration_limit, jerk_limit):
-    n = path.rows()
+def joint_limits(n: int, velocity_limit, acceleration_limit, jerk_limit):
+    """(velocity [rad/s], acceleration [rad/s²], jerk [rad/s³]) per joint of n, checked; a jerk
+    limit of None is 10 /s × the acceleration limit."""
     velocity = positive_vector(velocity_limit, "velocity_limit", n)
     acceleration = positive_vector(acceleration_limit, "acceleration_limit", n)
     jerk = default_jerk_limit(acceleration) if jerk_limit is None else positive_vector(jerk_limit, "jerk_limit", n)
     return velocity, acceleration, jerk
+
+
+def check_least_durations(distance: np.ndarray, limits, max_duration: float, verb: str) -> None:
+    """An InfeasibleTimingError naming the joint and the limit where one limit alone makes a
+    rest-to-rest move of ``distance`` [rad] per joint last longer than ``max_duration`` [s]: it
+    lasts at least d / v, 2 sqrt(d / a) and (32 d / J)^(1/3)."""
+    velocity, acceleration, jerk = limits
+    bounds = {"velocity_limit": (distance / velocity, velocity, "rad/s"),
+              "acceleration_limit": (2 * np.sqrt(distance / acceleration), acceleration, "rad/s²"),
+              "jerk_limit": (np.cbrt(32 * distance / jerk), jerk, "rad/s³")}
+    for name, (least, limit, unit) in bounds.items():
+        if not np.max(least) <= max_duration:
+            j = int(np.argmax(least))
+            raise InfeasibleTimingError(
+                f"the limits are too small for the path: {joint_label(j)} {verb} {distance[j]:.4g} rad with at most "
+                f"{limit[j]:.4g} {unit} ({name}): at least {least[j]:.4g} s, longer than max_duration {max_duration:g} s",
+                field=("path",))
 
 
 def _grid(path, velocity, acceleration, points: int) -> np.ndarray:
@@ -594,107 +612,6 @@ def _deviation(path, knots, joint_coefficients, path_samples) -> float:
     return float(np.abs(q - path.vector_values(s).T).max())
 
 
-def line_timing(q_start, q_goal, velocity_limit, acceleration_limit, jerk_limit=None, *,
-                max_duration: float = 600.0) -> SmoothTiming:
-    """The time-optimal jerk-limited rest-to-rest motion along the straight joint segment from
-    ``q_start`` to ``q_goal`` [rad]: the seven-phase profile of the path parameter s in [0, 1]
-    (Ruckig on one degree of freedom) under the tightest of the joints' limits on s
-    (v_j / |Δq_j|, a_j / |Δq_j|, J_j / |Δq_j|), which is Ruckig's phase-synchronised motion; no
-    linear program, exact on the line (its pieces are cubic in t). T grows with the distance.
-    Limits as :func:`time_path`'s; an :class:`InfeasibleTimingError` where the motion would last
-    longer than ``max_duration`` [s] or the segment has no length."""
-    q, limits = _stop_inputs([q_start, q_goal], velocity_limit, acceleration_limit, jerk_limit, max_duration)
-    step = q[1] - q[0]
-    moving = step != 0
-    line_limits = [[float(np.min(limit[moving] / np.abs(step[moving])))] for limit in limits]
-    knots, s, s_jerk = _ruckig_states(RuckigStopLaw([[0.0], [1.0]], *line_limits), max_duration)  # s: (K, s/ṡ/s̈, 1)
-    samples = s * step[None, None, :]
-    samples[:, 0] += q[0]
-    path = PiecewisePolynomial.FirstOrderHold([0.0, 1.0], q.T)
-    return _exact_timing(knots, samples, s_jerk * step[None, :], limits, path)
-
-
-def stop_timing(q_waypoints, velocity_limit, acceleration_limit, jerk_limit=None, *,
-                max_duration: float = 600.0) -> SmoothTiming:
-    """Time-optimal jerk-limited rest-to-rest moves through joint waypoints (m + 1, n) [rad],
-    stopping at each: Ruckig's time-synchronised moves (every joint starts and stops together,
-    the limiting joint on its own time-optimal profile, the others on profiles of the same
-    duration). One move is the fastest a rest-to-rest move can be under per-joint limits, never
-    slower than the straight line (:func:`line_timing`); the joints do not keep to the straight
-    segments between the waypoints, so the timing's ``path`` is the motion itself (s = t). Exact
-    (cubic pieces in t); T grows with the distance. Limits and errors as :func:`line_timing`'s."""
-    q, limits = _stop_inputs(q_waypoints, velocity_limit, acceleration_limit, jerk_limit, max_duration)
-    return _exact_timing(*_ruckig_states(RuckigStopLaw(q, *limits), max_duration), limits, None)
-
-
-def _stop_inputs(q_waypoints, velocity_limit, acceleration_limit, jerk_limit, max_duration):
-    """(waypoints (m + 1, n), (velocity, acceleration, jerk)) of rest-to-rest moves, checked: the
-    motion moves, and no limit alone makes a move last longer than ``max_duration`` [s] (checked
-    before Ruckig sees limits of 1e-300)."""
-    q = np.asarray(q_waypoints, dtype=float)
-    steps = np.abs(np.diff(q, axis=0))
-    n = q.shape[1]
-    velocity = positive_vector(velocity_limit, "velocity_limit", n)
-    acceleration = positive_vector(acceleration_limit, "acceleration_limit", n)
-    jerk = default_jerk_limit(acceleration) if jerk_limit is None else positive_vector(jerk_limit, "jerk_limit", n)
-    if not np.any(steps > 0):
-        raise InfeasibleTimingError("path does not move: the goal equals the start", field=("path",))
-    _check_least_durations(steps.max(axis=0), (velocity, acceleration, jerk),
-                           positive_scalar(max_duration, "max_duration", "s"), "moves")
-    return q, (velocity, acceleration, jerk)
-
-
-def _check_least_durations(distance: np.ndarray, limits, max_duration: float, verb: str) -> None:
-    """An InfeasibleTimingError naming the joint and the limit where one limit alone makes a
-    rest-to-rest move of ``distance`` [rad] per joint last longer than ``max_duration`` [s]: it
-    lasts at least d / v, 2 sqrt(d / a) and (32 d / J)^(1/3)."""
-    velocity, acceleration, jerk = limits
-    bounds = {"velocity_limit": (distance / velocity, velocity, "rad/s"),
-              "acceleration_limit": (2 * np.sqrt(distance / acceleration), acceleration, "rad/s²"),
-              "jerk_limit": (np.cbrt(32 * distance / jerk), jerk, "rad/s³")}
-    for name, (least, limit, unit) in bounds.items():
-        if not np.max(least) <= max_duration:
-            j = int(np.argmax(least))
-            raise InfeasibleTimingError(
-                f"the limits are too small for the path: {joint_label(j)} {verb} {distance[j]:.4g} rad with at most "
-                f"{limit[j]:.4g} {unit} ({name}): at least {least[j]:.4g} s, longer than max_duration {max_duration:g} s",
-                field=("path",))
-
-
-def _ruckig_states(law: RuckigStopLaw, max_duration: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(knots (K,) [s], states (K, position/rate/acceleration, n), jerk (K - 1, n)) of a Ruckig law
-    at its knots (every joint is one cubic between them, of that constant jerk), at rest at both
-    ends; an :class:`InfeasibleTimingError` naming the limits where it lasts longer than
-    ``max_duration``."""
-    if not law.duration <= max_duration:
-        raise InfeasibleTimingError(f"the limits are too small for the path: the move takes {law.duration:.4g} s, longer "
-                                    f"than max_duration {max_duration:g} s (velocity_limit, acceleration_limit or "
-                                    "jerk_limit)", field=("path",))
-    knots = np.asarray(law.polynomial_breaks, dtype=float)
-    knots = knots[np.concatenate([[True], np.diff(knots) > 1e-12])]
-    knots[-1] = law.duration
-    states = np.stack(law.sample(knots), axis=1)
-    states[0, 1:] = states[-1, 1:] = 0.0
-    states[-1, 0] = law.q_waypoints[-1]
-    return knots, states, law.jerk(0.5 * (knots[:-1] + knots[1:]))
-
-
-def _exact_timing(knots, states, jerk, limits, path) -> SmoothTiming:
-    """The SmoothTiming of the cubic pieces from ``states`` (K, q/q̇/q̈, n) at ``knots`` with
-    constant ``jerk`` (K - 1, n) between, along ``path`` (None: the motion itself), stretched in
-    time where Ruckig's profile exceeds a limit by its rounding (the jerk by up to 5e-6 of it)."""
-    coefficients = np.zeros((len(knots) - 1, 6, states.shape[2]))
-    coefficients[:, :3] = states[:-1] / np.array([1.0, 1.0, 2.0])[None, :, None]
-    coefficients[:, 3] = jerk / 6
-    ratio = exact_peaks(knots, coefficients) / np.stack(limits)
-    stretch = max(1.0, *(ratio.max(axis=1) ** (1.0 / np.arange(1, 4)) * (1 + 1e-9))) if ratio.max() > 1 else 1.0
-    if stretch > 1.0:  # q̇, q̈, q⃛ scale by 1/k, 1/k², 1/k³, each coefficient c_i by 1/k^i
-        knots, states = knots * stretch, states / stretch ** np.arange(3)[None, :, None]
-        coefficients = coefficients / stretch ** np.arange(6)[None, :, None]
-        ratio = exact_peaks(knots, coefficients) / np.stack(limits)
-    return SmoothTiming(HermiteLaw(knots, states, states), coefficients, float(knots[-1]), path, stretch, ratio, 0.0, 0)
-
-
 def _iterate(program: _Program, iterations: int, start=None) -> tuple[np.ndarray, np.ndarray, int]:
     """(x, p, the programs with the jerk solved) of the best of the sequential linear programs:
     the first without the jerk (or the given ``start`` (x, p) instead), then up to
@@ -751,20 +668,27 @@ def _better(coarse: _Pieces, fine: _Pieces, tolerance: float) -> _Pieces:
 
 def _pieces(path, program: _Program, x: np.ndarray, p: np.ndarray, limits: np.ndarray) -> _Pieces:
     """The motion of the solution (x, p) as quintic Hermite pieces through the nodes and the
-    middle of every interval, with the repair: time stretched by k (which scales q̇, q̈, q⃛ by 1/k,
-    1/k², 1/k³) until the exact peaks of every piece hold the limits."""
+    middle of every interval, with the repair (:func:`stretched`)."""
     t, joint_samples, path_samples = _samples(path, program, x, p)
     coefficients = quintic_hermite_coefficients(t, joint_samples, joint_samples)
-    ratio = exact_peaks(t, coefficients) / limits
-    stretch = max(1.0, *(ratio.max(axis=1) ** (1.0 / np.arange(1, 4)) * (1 + 1e-6)))
-    if stretch > 1.0:
-        t = t * stretch
-        joint_samples = joint_samples / stretch ** np.arange(3)[None, :, None]
-        path_samples = path_samples / stretch ** np.arange(3)[None, :]
-        coefficients = quintic_hermite_coefficients(t, joint_samples, joint_samples)
-        ratio = exact_peaks(t, coefficients) / limits
+    t, joint_samples, coefficients, ratio, stretch = stretched(t, joint_samples, coefficients, limits, 1e-6)
+    path_samples = path_samples / stretch ** np.arange(3)[None, :]
     return _Pieces(t, joint_samples, path_samples, coefficients, ratio, stretch,
                    _deviation(path, t, coefficients, path_samples))
+
+
+def stretched(knots, states, coefficients, limits: np.ndarray, margin: float):
+    """The repair: (knots, states, coefficients, exact peaks over ``limits`` (3, n), stretch) of
+    pieces (monomial ``coefficients`` (K - 1, 6, n) in t - knots[k], ``states`` (K, q/q̇/q̈, n) at
+    the knots) with time stretched by k >= 1, (1 + ``margin``) × the least that keeps every exact
+    peak within its limit (q̇, q̈, q⃛ scale by 1/k, 1/k², 1/k³, a coefficient c_i by 1/k^i)."""
+    ratio = exact_peaks(knots, coefficients) / limits
+    if not ratio.max() > 1:
+        return knots, states, coefficients, ratio, 1.0
+    stretch = float(max(ratio.max(axis=1) ** (1.0 / np.arange(1, 4)))) * (1 + margin)
+    knots, states = knots * stretch, states / stretch ** np.arange(3)[None, :, None]
+    coefficients = coefficients / stretch ** np.arange(6)[None, :, None]
+    return knots, states, coefficients, exact_peaks(knots, coefficients) / limits, stretch
 
 
 def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 200,
@@ -810,14 +734,14 @@ def _time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, gri
     """The work of :func:`time_path`."""
     grid_points = whole_number(grid_points, "grid_points", minimum=20, maximum=MAX_GRID_POINTS)
     path, fit = check_path(path)
-    velocity, acceleration, jerk = _limits(path, velocity_limit, acceleration_limit, jerk_limit)
+    velocity, acceleration, jerk = joint_limits(path.rows(), velocity_limit, acceleration_limit, jerk_limit)
     max_duration = positive_scalar(max_duration, "max_duration", "s")
     s_all = np.linspace(path.start_time(), path.end_time(), 2001)
     travel = np.trapezoid(np.abs(path.MakeDerivative(1).vector_values(s_all)), s_all, axis=1)  # per joint [rad]
     # A joint's travel D is made of rest-to-rest pieces (it stops where it turns back), and the sums
     # of their least durations are at least those of D (the roots are concave). Checked before any
     # array is made.
-    _check_least_durations(travel, (velocity, acceleration, jerk), max_duration, "travels")
+    check_least_durations(travel, (velocity, acceleration, jerk), max_duration, "travels")
     limits = np.stack([velocity, acceleration, jerk])
     pieces, solved, previous = None, 0, None
     breaks = len(path.get_segment_times()) - 2  # nodes of every grid: levels they dwarf are skipped
