@@ -354,13 +354,6 @@ def test_relative_links_point_at_files_and_headings(page):
     assert not broken, f"{page.relative_to(ROOT)}:\n" + "\n".join(broken)
 
 
-def test_no_link_to_shipped_models_outside_the_package():
-    for page in PAGES:
-        text = page.read_text(encoding="utf-8")
-        assert "package://drake_models" not in text, page
-        assert "../shared" not in text, page
-
-
 # ---------------------------------------------------------------------------------------------
 # the site
 
