@@ -29,14 +29,7 @@ _SOURCES = {
 }
 
 
-__all__ = [
-    "add_station", "BorygaConfig", "build_station", "Cause", "ControllerGains", "DrakeTrajError", "Failure",
-    "FreeMotionConfig",
-    "get_robot", "LiConfig", "load_scenario", "make_planner", "make_station", "Metrics", "MovejConfig",
-    "PajakConfig", "PlanningError", "preflight", "QuinticConfig", "RetimedPajakConfig", "Robot", "RuckigConfig",
-    "run_station", "Scenario", "simulate", "SimulationResult", "SingularConfigurationError", "SmoothWaypointsConfig",
-    "SpeedOverride", "ToppraConfig",
-]
+__all__ = sorted(_SOURCES)
 
 
 def __getattr__(name: str):
