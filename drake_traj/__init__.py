@@ -22,7 +22,7 @@ _SOURCES = {
                     "drake_traj.errors"),
     **dict.fromkeys(("BorygaConfig", "FreeMotionConfig", "LiConfig", "MovejConfig", "PajakConfig", "QuinticConfig",
                      "RetimedPajakConfig", "RuckigConfig", "SmoothWaypointsConfig", "ToppraConfig"), "drake_traj.planners"),
-    **dict.fromkeys(("Metrics", "SimulationResult"), "drake_traj.result"),
+    **dict.fromkeys(("Metrics", "SimulationResult"), "drake_traj.results"),
     **dict.fromkeys(("Robot", "get_robot"), "drake_traj.robots"),
     **dict.fromkeys(("ControllerGains", "Scenario", "SpeedOverride", "load_scenario", "make_planner", "preflight"),
                     "drake_traj.scenario"),

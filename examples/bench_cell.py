@@ -26,12 +26,10 @@ import numpy as np
 from pydrake.planning import RobotDiagramBuilder, SceneGraphCollisionChecker
 
 from drake_traj import load_scenario, make_planner, simulate
-from drake_traj.cell import Box, Cell, Cylinder, add_cell
-from drake_traj.clearance import CellChecker, CollisionError, JointRangeError
+from drake_traj.cell import Box, Cell, CellChecker, CollisionError, Cylinder, JointRangeError, add_cell
 from drake_traj.errors import PlanningError
 from drake_traj.planners import pajak
-from drake_traj.robots import UR10E
-from drake_traj.robots import ur10e as robot
+from drake_traj.robots import UR10E, ur10e as robot
 
 UR10E_SCENARIOS = ("pajak_sim3", "quintic_ptp", "boryga_loop_ur10e", "li_closed_path_ur10e", "fixture_cell")
 

@@ -23,8 +23,7 @@ import numpy as np
 from tqdm import tqdm
 
 from drake_traj import FreeMotionConfig, get_robot, simulate
-from drake_traj.cell import Box, Cell, Cylinder
-from drake_traj.clearance import CellChecker
+from drake_traj.cell import Box, Cell, CellChecker, Cylinder
 from drake_traj.errors import PlanningError
 from drake_traj.planners import make_planner
 from drake_traj.planners.baselines.toppra import time_optimal_along_path

@@ -13,7 +13,7 @@ import argparse
 import statistics
 import time
 
-from drake_traj import bench
+from drake_traj.bench import suite as bench
 from drake_traj.station import simulate
 from drake_traj.planners import ToppraConfig, make_planner
 from drake_traj.planners.baselines.toppra import ToppraLaw, geometric_path_from_samples, time_optimal_along_path

@@ -5,7 +5,7 @@ The arm is our UR5e model (models/ur5e.urdf, written from UR's published data) w
 collision and visual shape replaced by a mesh file of its own: cylinders as 32-sided prisms and
 capsules as trimesh's capsule meshes,
 written as OBJ for the base, shoulder, upper arm and forearm and as binary STL for the wrists
-(STL collision meshes are converted to OBJ when the model is read: drake_traj.model_files), all
+(STL collision meshes are converted to OBJ when the model is read: drake_traj.robots.model_files), all
 named by ``package://example_arm_description/meshes/...`` URLs, and the base fixed to a ``world``
 link by the file itself. Run from the repository's top folder:
 

@@ -23,7 +23,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import LogVectorOutput, TrajectorySource
 
 from drake_traj import SimulationResult, get_robot
-from drake_traj.result import ResultFileError
+from drake_traj.results import ResultFileError
 from drake_traj.scenario import default_plant_config
 
 # the main job's folders: the README's `drake-traj run --out out`, and `drake-traj run` without --out

@@ -31,17 +31,16 @@ from drake_traj import (
     SimulationResult,
     ToppraConfig,
     cli,
-    commands,
     get_robot,
     load_scenario,
     make_station,
     simulate,
 )
+from drake_traj.cli import commands
 from drake_traj.planners import make_planner
 from drake_traj.planners.pajak import PajakPlanner, paper_parameters
 from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
-from drake_traj.result import ResultFileError
-from drake_traj.rundir import OutputError
+from drake_traj.results import OutputError, ResultFileError
 from drake_traj.scenario import SpeedOverride
 from drake_traj.station import build_station
 

@@ -13,7 +13,8 @@ import warnings
 import numpy as np
 import pytest
 
-from drake_traj import bench, cli
+from drake_traj import cli
+from drake_traj.bench import suite as bench
 from drake_traj.planners import QuinticConfig
 
 

@@ -18,14 +18,13 @@ from pydrake.systems.analysis import Simulator, SimulatorConfig
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from drake_traj import Cause, DrakeTrajError, PlanningError, SimulationResult, cli, load_scenario, make_planner, simulate
-from drake_traj import bench as bench_module
+from drake_traj.bench import suite as bench_module
 from drake_traj.data import data_directory
-from drake_traj.meshcat import SPEED_SLIDER, SpeedSlider, start_meshcat
+from drake_traj.station import SPEED_SLIDER, SpeedSlider, add_station, build_station, make_station, run_station, start_meshcat
 from drake_traj.planners.pajak.system import MAX_PREFLIGHT_STEPS, PajakPlanner
 from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
 from drake_traj.robots import UR10E
 from drake_traj.scenario import ScenarioError, SpeedOverride, find_scenario, preflight
-from drake_traj.station import add_station, build_station, make_station, run_station
 from drake_traj.validation import MAX_RUN_DURATION, MAX_SETTLE_TIME, REALTIME_RATES
 
 DIAGRAMS = Path(__file__).resolve().parents[1] / "diagrams"

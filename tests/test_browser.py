@@ -14,7 +14,7 @@ import pytest
 from pydrake.geometry import Meshcat
 
 import browser
-from drake_traj.meshcat import export_html
+from drake_traj.station import export_html
 
 CHROMIUM = browser.find_chromium()
 pytestmark = pytest.mark.skipif(

@@ -178,7 +178,7 @@ BLOCK_SDF = """\
 
 
 def test_a_motion_into_a_directives_model_is_refused_at_its_directive(tmp_path):
-    from drake_traj.clearance import CollisionError
+    from drake_traj.cell import CollisionError
     from drake_traj.scenario import make_planner, preflight
 
     (tmp_path / "block.sdf").write_text(BLOCK_SDF)
@@ -204,7 +204,7 @@ def test_a_directives_model_welded_to_nothing_is_refused_at_its_directive(tmp_pa
     import subprocess
     import sys
 
-    from drake_traj.scenario import check_in_cell, make_planner
+    from drake_traj.scenario.scenario import check_in_cell, make_planner
 
     (tmp_path / "block.sdf").write_text(BLOCK_SDF)
     path = scenario_file(tmp_path, """\
@@ -335,7 +335,7 @@ def test_a_directives_arm_beside_the_robot_is_refused_at_its_directive(tmp_path,
     from drake_traj.data import data_directory
 
     MODELS = data_directory("models")
-    from drake_traj.scenario import check_in_cell, make_planner
+    from drake_traj.scenario.scenario import check_in_cell, make_planner
 
     path = scenario_file(tmp_path, f"cell:\n  directives:\n  - add_model: {{name: arm2, file: "
                                    f"{MODELS / 'boryga_anthropomorphic.urdf'}}}\n  " + weld)

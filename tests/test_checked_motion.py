@@ -13,12 +13,10 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource
 
 from drake_traj import QuinticConfig, get_robot, load_scenario, make_station, run_station, simulate
-from drake_traj.cell import Box, Cell
-from drake_traj.clearance import CellChecker, CollisionError
+from drake_traj.cell import Box, Cell, CellChecker, CollisionError, UncheckedMotionError
 from drake_traj.errors import Cause
-from drake_traj.guard import UncheckedMotionError
 from drake_traj.planners import make_planner
-from drake_traj.result import SimulationResult
+from drake_traj.results import SimulationResult
 from drake_traj.scenario import default_simulator_config
 from drake_traj.station import build_station
 

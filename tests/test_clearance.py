@@ -14,14 +14,12 @@ from pydrake.planning import RobotDiagramBuilder, SceneGraphCollisionChecker
 from pydrake.trajectories import PiecewisePolynomial
 
 from drake_traj import load_scenario, make_planner, simulate
-from drake_traj.cell import Box, Cell
-from drake_traj.clearance import CellChecker, CollisionError, JointRangeError, planner_target_word
+from drake_traj.cell import Box, Cell, CellChecker, CollisionError, JointRangeError, planner_target_word
 from drake_traj.errors import Cause
-from drake_traj.meshcat import draw_refusal
-from drake_traj.planners import QuinticConfig
-from drake_traj.planners import make_planner as planner_from_config
+from drake_traj.station import draw_refusal
+from drake_traj.planners import QuinticConfig, make_planner as planner_from_config
 from drake_traj.robots import UR10E
-from drake_traj.scenario import check_in_cell, preflight, shipped_scenarios
+from drake_traj.scenario.scenario import check_in_cell, preflight, shipped_scenarios
 
 from conftest import DIAGRAMS
 
@@ -54,7 +52,7 @@ def test_the_reach_bounds_every_point_speed(checker):
     from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
     from pydrake.systems.framework import DiagramBuilder
 
-    from drake_traj.clearance import _bounding_radius
+    from drake_traj.cell.clearance import _bounding_radius
 
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
@@ -304,7 +302,7 @@ def test_a_motion_too_long_to_sample_is_refused_before_it_is_sampled():
     clearance, at once."""
     import time
 
-    from drake_traj.clearance import MAX_SAMPLES
+    from drake_traj.cell.clearance import MAX_SAMPLES
     from drake_traj.errors import DrakeTrajError
 
     checker = CellChecker(UR10E, Cell(clearance=0.0))

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 import browser
-from drake_traj import cli, commands, scenario
+from drake_traj import cli, scenario
+from drake_traj.cli import commands
 from drake_traj.robots import ROBOT_NAMES, get_robot
 from drake_traj.scenario import load_scenario, shipped_scenarios
 
@@ -62,7 +63,7 @@ def test_list_gives_each_shipped_files_path_above_its_scenarios(capsys):
 def test_list_and_show_say_which_copy_of_the_shipped_files_runs(capsys, monkeypatch, tmp_path):
     """A source tree's diagrams/ (a checkout, an editable install: an edit changes what runs) or
     the installed package's (CI installs it so): list's first line and show's note say which."""
-    import drake_traj.scenario as scenario_module
+    from drake_traj.scenario import scenario as scenario_module
 
     directory = shipped_scenarios()[0].path.parent
     here = scenario_module.shipped_copy()

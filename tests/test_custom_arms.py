@@ -12,7 +12,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj import QuinticConfig, cli, load_scenario, simulate
-from drake_traj.clearance import CellChecker
+from drake_traj.cell import CellChecker
 from drake_traj.errors import DrakeTrajError
 from drake_traj.planners import make_planner
 from drake_traj.robots.chain import SerialChain
@@ -21,8 +21,7 @@ from drake_traj.robots.chain_arm import ChainArm
 from drake_traj.robots.custom import DhArm, resolve_robot
 from drake_traj.robots.task_space import orientation_error
 from drake_traj.robots.urdf_writer import touching_pairs
-from drake_traj.scenario import ScenarioError
-from drake_traj.scenario import make_planner as make_scenario_planner
+from drake_traj.scenario import ScenarioError, make_planner as make_scenario_planner
 
 from conftest import DIAGRAMS
 

@@ -13,7 +13,7 @@ import yaml
 
 from drake_traj import SimulationResult, cli
 from drake_traj.errors import Failure
-from drake_traj.export import UR_CONTROLLER_ARMS, ExportError, resample
+from drake_traj.results.exports import UR_CONTROLLER_ARMS, ExportError, resample
 from drake_traj.robots import ROBOT_NAMES, get_robot
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -273,7 +273,7 @@ def test_an_export_into_a_read_only_folder_names_the_folder(result, quintic_run_
         assert cli.main(["export", str(quintic_run_dir), "--format", "csv", "--out", str(folder / "ref.csv")]) == 2
         assert message in capsys.readouterr().err
     else:
-        from drake_traj.output import OutputError
+        from drake_traj.results import OutputError
 
         with pytest.raises(OutputError) as caught:
             result.export(folder / "ref.csv", "csv")
@@ -284,8 +284,7 @@ def test_an_export_into_a_read_only_folder_names_the_folder(result, quintic_run_
 
 def test_an_export_whose_folder_fails_while_writing_is_a_write_error(result, tmp_path, monkeypatch):
     """Writable when checked, read-only when written (remounted meanwhile): still an OutputError."""
-    import drake_traj.export as export_module
-    from drake_traj.output import OutputError
+    from drake_traj.results import OutputError, exports as export_module
 
     folder = tmp_path / "remounted"
     folder.mkdir()

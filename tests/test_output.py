@@ -16,7 +16,10 @@ from pathlib import Path
 
 import pytest
 
-from drake_traj import SimulationResult, bench, cli, commands, output
+from drake_traj import SimulationResult, cli
+from drake_traj.bench import suite as bench
+from drake_traj.cli import commands
+from drake_traj.results import output
 
 SIGNS = ("result.npz", "metrics.json", "run.json")
 
@@ -112,7 +115,7 @@ def test_two_runs_into_one_folder_one_wins_the_other_names_it(tmp_path, capsys):
 def test_a_lock_left_by_a_dead_process_is_taken_over(tmp_path):
     out = tmp_path / "run"
     holder = subprocess.Popen(
-        [sys.executable, "-c", "import sys, time; from drake_traj.output import claim; "
+        [sys.executable, "-c", "import sys, time; from drake_traj.results.output import claim; "
          f"held = claim({str(out)!r}, 'run', command='the holder'); print('held', flush=True); time.sleep(120)"],
         stdout=subprocess.PIPE, text=True)
     try:

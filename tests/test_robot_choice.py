@@ -9,8 +9,7 @@ import pytest
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj import QuinticConfig, RuckigConfig, load_scenario
-from drake_traj.cell import Cell, Tool
-from drake_traj.clearance import CellChecker
+from drake_traj.cell import Cell, CellChecker, Tool
 from drake_traj.errors import Cause, DrakeTrajError
 from drake_traj.planners import make_planner
 from drake_traj.planners.pajak.parameters import paper_parameters

@@ -12,7 +12,7 @@ from pydrake.systems.primitives import ConstantVectorSource
 from drake_traj.robots import ur10e as robot
 from drake_traj.station import simulate
 from drake_traj.planners.quintic import QuinticLaw, QuinticPtpPlanner, plan_synchronized_quintic
-from drake_traj.result import ARRAY_NAMES, SimulationResult, joint_style
+from drake_traj.results import ARRAY_NAMES, SimulationResult, joint_style
 from drake_traj.scenario import ControllerGains, load_scenario, make_planner
 
 from conftest import DIAGRAMS

@@ -15,7 +15,7 @@ from pydrake.systems.primitives import ConstantVectorSource
 
 import drake_traj
 from drake_traj import SimulationResult, load_scenario, make_planner, make_station, run_station, simulate
-from drake_traj.result import ARRAY_NAMES, LOGGERS
+from drake_traj.results import ARRAY_NAMES, LOGGERS
 from drake_traj.scenario import find_scenario
 from drake_traj.station import build_station
 from drake_traj.robots.ur10e import flange_pose
@@ -132,8 +132,8 @@ def test_a_planning_failure_in_ones_own_run_is_a_record_with_the_log(scenario):
 
 
 def test_public_modules_declare_their_api():
-    for module in ("drake_traj.station", "drake_traj.result", "drake_traj.scenario", "drake_traj.meshcat",
-                   "drake_traj.errors", "drake_traj.robots", "drake_traj.planners"):
+    for module in ("drake_traj.station", "drake_traj.results", "drake_traj.scenario", "drake_traj.cell",
+                   "drake_traj.bench", "drake_traj.cli", "drake_traj.errors", "drake_traj.robots", "drake_traj.planners"):
         imported = __import__(module, fromlist=["__all__"])
         assert imported.__all__ and all(hasattr(imported, name) for name in imported.__all__), module
 

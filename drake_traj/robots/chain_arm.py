@@ -16,13 +16,12 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_label
-from drake_traj.model_files import add_model_file, joint_efforts
+from drake_traj.robots.model_files import add_model_file, joint_efforts
 from drake_traj.robots import ROBOT_NAMES, arm_checks
 from drake_traj.robots.base import Robot, TaskKinematics, format_point, joint_actuators
 from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_reach, chain_singularity_factors,
                                      inverse_kinematics_all, inverse_kinematics_near, plant_chain, plant_frame)
-from drake_traj.robots.compiled_kinematics import task_kinematics as arm_kinematics
-from drake_traj.robots.compiled_kinematics import task_kinematics_into
+from drake_traj.robots.compiled_kinematics import task_kinematics as arm_kinematics, task_kinematics_into
 from drake_traj.robots.task_space import orientation_error, pose_error, wrap_angle, wrapped
 from drake_traj.robots.urdf_writer import dh_table_urdf
 from drake_traj.validation import finite_array, invalid, joint_bound, joint_limit, path_argument

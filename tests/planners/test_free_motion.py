@@ -6,8 +6,7 @@ import pytest
 from pydrake.planning import RobotDiagramBuilder, SceneGraphCollisionChecker
 
 from drake_traj import FreeMotionConfig, get_robot, load_scenario, make_station, run_station, simulate
-from drake_traj.cell import Box, Cell, add_cell
-from drake_traj.clearance import CellChecker, CollisionError
+from drake_traj.cell import Box, Cell, CellChecker, CollisionError, add_cell
 from drake_traj.errors import Cause, DrakeTrajError, PlanningError
 from drake_traj.planners import make_planner
 from drake_traj.planners.free import Scene, search

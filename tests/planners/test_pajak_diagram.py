@@ -13,11 +13,10 @@ from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
 from drake_traj.errors import Cause, PlanningError
 from drake_traj.robots import ur10e as robot
-from drake_traj.scenario import default_plant_config, default_simulator_config
+from drake_traj.scenario import default_plant_config, default_simulator_config, load_scenario, make_planner
 from drake_traj.station import build_station, run_station, simulate
 from drake_traj.planners import pajak as P
-from drake_traj.result import SimulationResult
-from drake_traj.scenario import load_scenario, make_planner
+from drake_traj.results import SimulationResult
 
 from conftest import DIAGRAMS
 

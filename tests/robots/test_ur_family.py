@@ -13,8 +13,7 @@ from pydrake.multibody.tree import JacobianWrtVariable, JointActuatorIndex
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj import load_scenario, simulate
-from drake_traj.cell import Cell, Tool
-from drake_traj.clearance import CellChecker
+from drake_traj.cell import Cell, CellChecker, Tool
 from drake_traj.errors import DrakeTrajError
 from drake_traj.robots import ROBOT_NAMES, UR10E, UR_ARMS, get_robot
 from drake_traj.robots.task_space import rotation_from_zyx_euler, wrap_angle

@@ -30,7 +30,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import Trajectory
 
-from drake_traj.cell import Cell, add_cell, refuse_free_bodies
+from drake_traj.cell.cell import Cell, add_cell, refuse_free_bodies
 from drake_traj.errors import Cause, DrakeTrajError, Field, PlanningError, joint_label
 from drake_traj.robots import Robot
 from drake_traj.validation import MAX_RUN_DURATION

@@ -12,7 +12,7 @@ other files, not a run (a bench, say), is never written into.
 import json
 from pathlib import Path
 
-from drake_traj.output import FOLDER_KINDS, OutputError, claim, folder_kind, write_file
+from drake_traj.results.output import FOLDER_KINDS, OutputError, claim, folder_kind, write_file
 
 __all__ = ["MANIFEST", "REFUSAL", "OutputError", "add_to_manifest", "claim_run_folder", "earlier_run", "estimated_size",
            "manifest_text", "run_files", "write_manifest"]

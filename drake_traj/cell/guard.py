@@ -22,8 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from drake_traj.cell import Cell
-from drake_traj.clearance import CellChecker
+from drake_traj.cell.cell import Cell
+from drake_traj.cell.clearance import CellChecker
 from drake_traj.errors import Cause, Failure, PlanningError
 from drake_traj.robots import Robot
 

@@ -19,7 +19,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drake_traj.version import __version__
 from drake_traj.errors import DrakeTrajError
-from drake_traj.output import OutputError, WriteError, check_writable, write_file
+from drake_traj.results.output import OutputError, WriteError, check_writable, write_file
 from drake_traj.robots import UR_ARMS, Robot, get_robot
 
 __all__ = ["FORMATS", "ExportError", "export", "reference_trajectory", "resample"]

@@ -13,7 +13,7 @@ SCENARIO is a YAML file or the name of a shipped scenario (``drake-traj list``: 
 scenarios under their files' paths, with their robots); ``robots`` tabulates the known robots
 (joints, reach, rated payload, speeds and torques, where the data come from); ``show`` prints the
 file of one scenario, to copy. ``export``
-writes a run's reference for a robot or another tool (drake_traj.export). ``bench`` runs
+writes a run's reference for a robot or another tool (drake_traj.results.exports). ``bench`` runs
 every planner and baseline on Pająk 2024's task and N seeded tasks and writes DIR/bench.csv,
 bench.md and bench.png.
 
@@ -24,7 +24,7 @@ stopped by SIGTERM (in both, what was logged is kept). ``--debug`` shows the tra
 printed as escapes (``\u0105``), never an error.
 
 This module is light: ``--version``, ``--help`` and a command's name are answered without importing
-Drake or numpy; the commands themselves are in :mod:`drake_traj.commands`, loaded once one is given.
+Drake or numpy; the commands themselves are in :mod:`drake_traj.cli.commands`, loaded once one is given.
 """
 
 import argparse
@@ -34,8 +34,10 @@ import sys
 
 from drake_traj.version import __version__
 
-EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_TERMINATED = 0, 1, 2, 130, 143
-# each command and its one-line help (``drake-traj --help``); its options are in drake_traj.commands
+from drake_traj.cli.exit_codes import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, EXIT_TERMINATED
+
+__all__ = ["COMMANDS", "EXIT_BAD_INPUT", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_RUN_FAILED", "EXIT_TERMINATED", "build_parser", "main"]
+# each command and its one-line help (``drake-traj --help``); its options are in drake_traj.cli.commands
 COMMANDS = {
     "run": "simulate a scenario and write its results",
     "list": "list the shipped scenarios under their files' paths",
@@ -48,7 +50,7 @@ COMMANDS = {
 
 def build_parser(options: dict | None = None) -> argparse.ArgumentParser:
     """The parser of ``drake-traj``. ``options``: per command of :data:`COMMANDS`, the function
-    that adds its options and its handler (:data:`drake_traj.commands.OPTIONS`); without them each
+    that adds its options and its handler (:data:`drake_traj.cli.commands.OPTIONS`); without them each
     command takes anything, which is enough to answer ``--version`` and ``--help`` and to check
     the command's name."""
     parser = argparse.ArgumentParser(prog="drake-traj", description=__doc__.splitlines()[0],
@@ -68,7 +70,7 @@ def main(argv=None) -> int:
     """``drake-traj`` with the arguments ``argv`` (default: the command line's); returns the exit code."""
     try:
         build_parser().parse_known_args(argv)  # --version, --help, no command or an unknown one: Drake not imported
-        commands = importlib.import_module("drake_traj.commands")  # the commands import Drake: only now
+        commands = importlib.import_module("drake_traj.cli.commands")  # the commands import Drake: only now
         args = build_parser(commands.OPTIONS).parse_args(argv)
     except SystemExit as done:  # --help, --version, or a usage error argparse printed (code 2)
         return done.code
@@ -76,6 +78,3 @@ def main(argv=None) -> int:
     args.command_line = shlex.join(["drake-traj", *(sys.argv[1:] if argv is None else argv)])
     return commands.execute(args)
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -59,9 +59,9 @@ from distributed import Client, LocalCluster, as_completed
 from distributed.comm import connect as dask_connect
 from tqdm import tqdm
 
-from drake_traj.clearance import CellChecker
+from drake_traj.cell import CellChecker
 from drake_traj.errors import DrakeTrajError
-from drake_traj.output import OutputError, claim
+from drake_traj.results import OutputError, claim
 from drake_traj.station import simulate
 from drake_traj.planners import (
     MovejConfig,
@@ -75,8 +75,7 @@ from drake_traj.planners import (
 )
 from drake_traj.planners import pajak
 from drake_traj.planners.baselines.toppra import geometric_path_from_samples, time_optimal_along_path
-from drake_traj.robots import UR10E
-from drake_traj.robots import ur10e as robot
+from drake_traj.robots import UR10E, ur10e as robot
 
 __all__ = [
     "COLUMNS", "CONFIG_BUILDERS", "PLANNERS", "BenchSetupError", "Task", "bench", "bench_figure", "medians", "optimal_duration",

@@ -21,11 +21,11 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from drake_traj.errors import Cause, DrakeTrajError, Failure, joint_label
-from drake_traj.export import export, reference_trajectory
+from drake_traj.results.exports import export, reference_trajectory
 from drake_traj.robots import ROBOT_NAMES, get_robot
 from drake_traj.robots.task_space import pose_error
-from drake_traj.output import OutputError, check_writable
-from drake_traj.rundir import claim_run_folder
+from drake_traj.results.output import OutputError, check_writable
+from drake_traj.results.rundir import claim_run_folder
 from drake_traj.validation import invalid, path_argument, positive_scalar, real_array
 
 __all__ = ["ARRAY_NAMES", "DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "Metrics", "ResultFileError", "SimulationResult",

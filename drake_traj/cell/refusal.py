@@ -5,7 +5,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from pydrake.geometry import Box, Capsule, Cylinder, Role, Sphere
 
-from drake_traj.clearance import CellChecker, CollisionError
+from drake_traj.cell.clearance import CellChecker, CollisionError
 
 __all__ = ["refusal_figure"]
 

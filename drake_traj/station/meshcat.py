@@ -19,7 +19,7 @@ from pydrake.geometry import Meshcat, MeshcatParams, Rgba, Role, Sphere
 from pydrake.math import RigidTransform
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
-from drake_traj.clearance import CellChecker, CollisionError
+from drake_traj.cell import CellChecker, CollisionError
 from drake_traj.errors import DrakeTrajError
 from drake_traj.robots import Robot
 from drake_traj.scenario import SpeedOverride

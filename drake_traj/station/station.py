@@ -42,12 +42,11 @@ from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, Trigg
 from pydrake.systems.primitives import (ConstantVectorSource, Demultiplexer, LogVectorOutput, MatrixGain,
                                         Multiplexer, TrajectorySource)
 
-from drake_traj.cell import Cell, add_cell, refuse_free_bodies
-from drake_traj.clearance import CellChecker, geometry_owner, scene_fingerprint, unprotected_links
+from drake_traj.cell import Cell, MotionGuard, add_cell, refuse_free_bodies
+from drake_traj.cell.clearance import CellChecker, geometry_owner, scene_fingerprint, unprotected_links
 from drake_traj.errors import Cause, Failure
-from drake_traj.guard import MotionGuard
 from drake_traj.planners.base import PlannerSystem
-from drake_traj.result import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
+from drake_traj.results import DEFAULT_TRACKING_TOLERANCE, LOGGERS, SimulationResult
 from drake_traj.robots import UR10E, Robot
 from drake_traj.robots.base import joint_actuators
 from drake_traj.robots.custom import robot_label

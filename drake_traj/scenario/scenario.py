@@ -31,20 +31,18 @@ from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import PiecewisePolynomial
 
-from drake_traj.cell import Cell
-from drake_traj.clearance import CellChecker
+from drake_traj.cell import Cell, CellChecker
 from drake_traj.data import data_directory
 from drake_traj.errors import Cause, DrakeTrajError, Field, field_text, joint_label
-from drake_traj.planners import PLANNER_CONFIGS, PlannerConfig, PlannerSystem, QuinticConfig
-from drake_traj.planners import make_planner as make_planner_from_config
-from drake_traj.result import DEFAULT_TRACKING_TOLERANCE
+from drake_traj.planners import PLANNER_CONFIGS, PlannerConfig, PlannerSystem, QuinticConfig, make_planner as make_planner_from_config
+from drake_traj.results import DEFAULT_TRACKING_TOLERANCE
 from drake_traj.robots import Robot
 from drake_traj.robots.base import joint_actuators
 from drake_traj.robots.custom import CustomArm, DhArm, RobotChoice, resolve_robot, robot_label
 from drake_traj.validation import (MAX_RUN_DURATION, flag, instance_of, invalid, log_period_check, path_argument,
                                    real_array, realtime_rate, run_duration, settle_duration, step_size,
                                    tracking_tolerance_check)
-from drake_traj.yaml_schema import ScenarioError, checked_document, locate
+from drake_traj.scenario.yaml_schema import ScenarioError, checked_document, locate
 
 __all__ = [
     "ControllerGains", "Scenario", "ScenarioError", "ScenarioSource", "ShippedScenario", "SpeedOverride",

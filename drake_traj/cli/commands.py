@@ -18,22 +18,19 @@ import numpy as np
 from tqdm import tqdm
 
 from drake_traj.version import __version__
-from drake_traj.cli import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, EXIT_TERMINATED
+from drake_traj.cli.exit_codes import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, EXIT_TERMINATED
 from drake_traj.bench import bench
-from drake_traj.clearance import CollisionError
+from drake_traj.cell import CollisionError, refusal_figure
 from drake_traj.errors import Cause, DrakeTrajError, Failure, PlanningError
-from drake_traj.export import FORMATS, UR_CYCLE, ExportError
-from drake_traj.meshcat import add_live_view, draw_refusal, draw_task, draw_tcp_path, export_html, frame_task, start_meshcat, wait_for_browser
-from drake_traj.refusal import refusal_figure
-from drake_traj.result import SimulationResult
+from drake_traj.results.exports import FORMATS, UR_CYCLE, ExportError
+from drake_traj.station import add_live_view, draw_refusal, draw_task, draw_tcp_path, export_html, frame_task, simulate, start_meshcat, wait_for_browser
+from drake_traj.results import SimulationResult, WriteError, locked, working_folder
 from drake_traj.robots import ROBOT_NAMES, get_robot
-from drake_traj.output import WriteError, locked, working_folder
-from drake_traj.rundir import (MANIFEST, REFUSAL, add_to_manifest, claim_run_folder, earlier_run, run_files,
+from drake_traj.results import (MANIFEST, REFUSAL, add_to_manifest, claim_run_folder, earlier_run, run_files,
                                write_manifest)
-from drake_traj.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
+from drake_traj.scenario.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
                                  load_scenario, preflight, scenario_variants, shipped_copy, shipped_directory,
                                  shipped_scenarios)
-from drake_traj.station import simulate
 from drake_traj.validation import REALTIME_RATES
 
 # [s] how long the live view's recording stays served after the run when no terminal is attached

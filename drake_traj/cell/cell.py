@@ -41,7 +41,7 @@ from pydrake.multibody.tree import RotationalInertia, SpatialInertia
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj.errors import Cause, DrakeTrajError, Field, field_text
-from drake_traj.model_files import missing_package, model_parser
+from drake_traj.robots.model_files import missing_package, model_parser
 from drake_traj.robots import UR10E, PointRobot, Robot
 from drake_traj.validation import invalid, real_array
 

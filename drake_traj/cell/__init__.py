@@ -1,0 +1,11 @@
+"""The robot's cell and the checks that keep every motion clear of it: the cell as a scenario
+describes it (:mod:`.cell`: mounting, obstacles, directives, tool) and its geometry in a plant,
+the check of a planned motion (:mod:`.clearance`), the guard that every route into a station
+passes (:mod:`.guard`) and the picture of a refused configuration (:mod:`.refusal`)."""
+
+from drake_traj.cell.cell import (Box, Cell, Cylinder, DEFAULT_CLEARANCE, NoMounting, Obstacle, Pedestal, Sphere, Table, Tool, add_cell, refuse_free_bodies)
+from drake_traj.cell.clearance import (CellChecker, CollisionError, Contact, JointRangeError, MotionCheck, geometry_owner, joint_reach, planner_target_word)
+from drake_traj.cell.guard import (ClearanceWatch, MotionGuard, UncheckedMotionError)
+from drake_traj.cell.refusal import (refusal_figure)
+
+__all__ = ['Box', 'Cell', 'CellChecker', 'ClearanceWatch', 'CollisionError', 'Contact', 'Cylinder', 'DEFAULT_CLEARANCE', 'JointRangeError', 'MotionCheck', 'MotionGuard', 'NoMounting', 'Obstacle', 'Pedestal', 'Sphere', 'Table', 'Tool', 'UncheckedMotionError', 'add_cell', 'geometry_owner', 'joint_reach', 'planner_target_word', 'refusal_figure', 'refuse_free_bodies']
