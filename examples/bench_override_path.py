@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from drake_traj import PajakConfig, QuinticConfig, RuckigConfig, SmoothWaypointsConfig, get_robot, simulate
-from drake_traj.bench.suite import joint_waypoints, random_tasks
+from drake_traj.bench.task_sets import joint_waypoints, random_tasks
 from drake_traj.cell import CellChecker
 from drake_traj.errors import PlanningError
 from drake_traj.planners import make_planner

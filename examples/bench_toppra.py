@@ -13,7 +13,7 @@ import argparse
 import statistics
 import time
 
-from drake_traj.bench import suite as bench
+from drake_traj.bench import optimum, task_sets, units
 from drake_traj.station import simulate
 from drake_traj.planners import ToppraConfig, make_planner
 from drake_traj.planners.baselines.toppra import ToppraLaw, geometric_path_from_samples, time_optimal_along_path
@@ -25,8 +25,8 @@ PLANNING_TARGET_S = 0.5
 
 def paper_path():
     """pajak_blend's planned joint path on the paper task, as the bench computes it."""
-    task = bench.tasks(count=0, repeats=1)[0]
-    output = bench.run_planner(task, bench.REFERENCE, bench.CONFIG_BUILDERS[bench.REFERENCE], keep_path=True)
+    task = task_sets.tasks(count=0, repeats=1)[0]
+    output = units.run_planner(task, units.REFERENCE, units.CONFIG_BUILDERS[units.REFERENCE], keep_path=True)
     return output["path"]
 
 
@@ -37,8 +37,8 @@ def stages(path) -> dict:
     spline = geometric_path_from_samples(start_and_goals(path[0], path[1:], 6))
     times["path spline"] = time.perf_counter() - start
     start = time.perf_counter()
-    optimal, trajectory = time_optimal_along_path(spline, bench.VELOCITY, bench.ACCELERATION,
-                                                  grid_points=bench.TOPPRA_GRID_POINTS)
+    optimal, trajectory = time_optimal_along_path(spline, optimum.VELOCITY, optimum.ACCELERATION,
+                                                  grid_points=units.TOPPRA_GRID_POINTS)
     times["Toppra solve"] = time.perf_counter() - start
     start = time.perf_counter()
     law = ToppraLaw(trajectory)
@@ -52,14 +52,14 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=7)
     args = parser.parse_args()
     path = paper_path()
-    config = ToppraConfig(path=path[1:].tolist(), grid_points=bench.TOPPRA_GRID_POINTS)
+    config = ToppraConfig(path=path[1:].tolist(), grid_points=units.TOPPRA_GRID_POINTS)
     runs = [stages(path) for _ in range(args.repeats)]
     planning = []
     for _ in range(args.repeats):
         start = time.perf_counter()
         make_planner(config, UR10E, path[0])
         planning.append(time.perf_counter() - start)
-    loops = [simulate(make_planner(config, UR10E, path[0]), name="toppra", settle_time=bench.SETTLE_TIME)
+    loops = [simulate(make_planner(config, UR10E, path[0]), name="toppra", settle_time=units.SETTLE_TIME)
              for _ in range(args.repeats)]
     print(f"| quantity | median of {args.repeats} |")
     print("|---|---|")

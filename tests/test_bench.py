@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 from drake_traj import cli
-from drake_traj.bench import suite as bench
+from drake_traj.bench import engine, optimum, report, task_sets, units
+from drake_traj.bench import run as bench_run
 from drake_traj.planners import QuinticConfig
 
 
@@ -27,7 +28,7 @@ def broken_config(poses, joints):
 def rows(tmp_path_factory):
     """Serial run (``--workers 1``): the paper task and one random task."""
     out = tmp_path_factory.mktemp("bench")
-    table = bench.bench(out, count=1, repeats=1, workers=1)
+    table = bench_run.bench(out, count=1, repeats=1, workers=1)
     with open(out / "bench.csv") as handle:
         assert len(list(csv.DictReader(handle))) == len(table)
     assert (out / "bench.md").read_text().startswith("## Paper task")
@@ -40,7 +41,7 @@ def cluster_rows(tmp_path_factory):
     """The same two tasks on a two-worker Dask LocalCluster (Toppra, the Pająk run it depends on
     and a quick planner, to keep it short), with a planner that cannot be made."""
     out = tmp_path_factory.mktemp("bench_cluster")
-    table = bench.bench(out, count=1, repeats=1, workers=2, planners=("pajak_blend", "quintic_stop", "toppra"),
+    table = bench_run.bench(out, count=1, repeats=1, workers=2, planners=("pajak_blend", "quintic_stop", "toppra"),
                         extra_planners={"broken": broken_config})
     with open(out / "bench.csv") as handle:
         assert [row["failure"] for row in csv.DictReader(handle)] == [row["failure"] for row in table]
@@ -56,8 +57,8 @@ def test_a_cluster_run_equals_the_serial_run_apart_from_timings(rows, cluster_ro
     serial_rows = [row for row in rows if row["planner"] in ("pajak_blend", "quintic_stop", "toppra")]
     assert [(row["task"], row["planner"]) for row in ours] == [(row["task"], row["planner"]) for row in serial_rows]
     for serial, parallel in zip(serial_rows, ours):
-        different = [column for column in bench.COLUMNS
-                     if column not in bench.TIMING_COLUMNS and not same(serial[column], parallel[column])]
+        different = [column for column in units.COLUMNS
+                     if column not in units.TIMING_COLUMNS and not same(serial[column], parallel[column])]
         assert not different, (serial, parallel)
 
 
@@ -72,7 +73,7 @@ def test_a_run_that_raises_is_a_failed_row_with_its_reason(cluster_rows):
 
 def test_every_planner_ran_on_every_task(rows):
     assert {(row["task"], row["planner"]) for row in rows} == {
-        (task, name) for task in ("paper", "random_0") for name in bench.PLANNERS}
+        (task, name) for task in ("paper", "random_0") for name in units.PLANNERS}
     assert all(row["succeeded"] for row in rows)
 
 
@@ -104,12 +105,12 @@ def test_continuity_column(rows):
 
 
 def test_random_tasks_are_reachable_and_seeded():
-    first, again = bench.random_tasks(3, seed=7), bench.random_tasks(3, seed=7)
+    first, again = task_sets.random_tasks(3, seed=7), task_sets.random_tasks(3, seed=7)
     for (q0, poses), (_, poses_again) in zip(first, again):
         np.testing.assert_array_equal(poses, poses_again)
-        joints = bench.joint_waypoints(q0, poses)
+        joints = task_sets.joint_waypoints(q0, poses)
         for q, pose in zip(joints[1:], poses):
-            np.testing.assert_allclose(bench.robot.task_pose(q)[:3], pose[:3], atol=1e-9)
+            np.testing.assert_allclose(task_sets.robot.task_pose(q)[:3], pose[:3], atol=1e-9)
 
 
 @pytest.mark.parametrize("arguments, option", [
@@ -128,7 +129,7 @@ def test_bad_arguments_stop_before_any_run(tmp_path, capsys, arguments, option):
 
 def test_an_unreachable_scheduler_is_an_error_naming_the_option(tmp_path, capsys, monkeypatch):
     out = tmp_path / "out"
-    monkeypatch.setattr(bench, "SCHEDULER_TIMEOUT", 1.0)  # 10 s as shipped (tests/test_bounds.py)
+    monkeypatch.setattr(engine, "SCHEDULER_TIMEOUT", 1.0)  # 10 s as shipped (tests/test_bounds.py)
     assert cli.main(["bench", "--out", str(out), "--scheduler", "tcp://127.0.0.1:1"]) == 2
     error = capsys.readouterr().err
     assert "--scheduler tcp://127.0.0.1:1: no Dask scheduler answered there" in error
@@ -145,11 +146,11 @@ def test_an_output_that_is_or_lies_below_a_file_is_refused(tmp_path, capsys):
 
 
 def test_the_plot_has_the_task_count_in_its_title_and_a_legend_on_each_panel(rows, cluster_rows):
-    figure = bench.bench_figure(rows)
-    assert figure.get_suptitle() == f"{len(bench.PLANNERS)} planners on 2 UR10e tasks: Pająk 2024's and 1 seeded random ones"
+    figure = report.bench_figure(rows)
+    assert figure.get_suptitle() == f"{len(units.PLANNERS)} planners on 2 UR10e tasks: Pająk 2024's and 1 seeded random ones"
     assert all(ax.get_legend() is not None for ax in figure.axes)
     # a box over fewer runs than tasks (a failed run has no value) says how many
-    labels = [label.get_text() for label in bench.bench_figure(cluster_rows).axes[0].get_xticklabels()]
+    labels = [label.get_text() for label in report.bench_figure(cluster_rows).axes[0].get_xticklabels()]
     assert labels == ["pajak_blend", "quintic_stop", "toppra", "broken\n(0 of 2)"]
 
 
@@ -160,9 +161,9 @@ class Terminal(io.StringIO):
 
 def test_progress_without_a_terminal_is_a_line_at_a_time(monkeypatch):
     # a log or CI: no bar redrawn in place; a first line, then the runs done, failed and time left
-    monkeypatch.setattr(bench, "LOG_INTERVAL", 0.0)  # a line after every run (30 s apart as shipped)
+    monkeypatch.setattr(engine, "LOG_INTERVAL", 0.0)  # a line after every run (30 s apart as shipped)
     stream = io.StringIO()
-    progress = bench._Progress(4, stream, "in this process, one after another")
+    progress = engine._Progress(4, stream, "in this process, one after another")
     progress.done({"succeeded": True})
     progress.done({"succeeded": False})
     progress.close()
@@ -175,7 +176,7 @@ def test_progress_without_a_terminal_is_a_line_at_a_time(monkeypatch):
 
 def test_progress_on_a_terminal_is_a_bar_with_the_time_left():
     stream = Terminal()
-    progress = bench._Progress(4, stream, "on a local Dask cluster of 2 processes")
+    progress = engine._Progress(4, stream, "on a local Dask cluster of 2 processes")
     progress.done({"succeeded": False})
     progress.close()
     text = stream.getvalue()
@@ -185,7 +186,7 @@ def test_progress_on_a_terminal_is_a_bar_with_the_time_left():
 
 def test_a_bench_names_what_it_wrote(tmp_path, capsys):
     out = tmp_path / "out"
-    bench.bench(out, count=0, repeats=1, workers=1, planners=("quintic_stop",), progress=None)
+    bench_run.bench(out, count=0, repeats=1, workers=1, planners=("quintic_stop",), progress=None)
     assert capsys.readouterr().out.splitlines()[-1] == f"wrote {out}: bench.csv, bench.md, bench.png"
 
 
@@ -196,7 +197,7 @@ def test_the_local_cluster_serves_http_on_a_free_port_without_a_warning():
         with contextlib.suppress(OSError):  # already taken is as good
             taken.bind(("127.0.0.1", 8787))
             taken.listen()
-        with bench._engine(2, None) as client:
+        with engine._engine(2, None) as client:
             assert client.submit(sum, [1, 2]).result() == 3
             assert client.scheduler_info()["services"].get("dashboard") != 8787  # a free port, not Dask's default
 
@@ -244,10 +245,10 @@ def test_the_optimal_and_jerk_columns_against_our_own_computation():
     # pajak_blend on the paper task: T_over_optimal is T over the time-optimal T along its own
     # path (Toppra in the bench; here our own integration on ṡ², same spline of the path), and
     # max_jerk the largest rate of change of the reference q̈ (here third differences of q)
-    task = bench.tasks(count=0, repeats=1)[0]
-    output = bench.run_planner(task, "pajak_blend", bench.CONFIG_BUILDERS["pajak_blend"], keep_path=True)
+    task = task_sets.tasks(count=0, repeats=1)[0]
+    output = units.run_planner(task, "pajak_blend", units.CONFIG_BUILDERS["pajak_blend"], keep_path=True)
     row, path = output["row"], output["path"]
-    optimal = independent_optimal_time(bench.geometric_path_from_samples(path), bench.VELOCITY, bench.ACCELERATION)
+    optimal = independent_optimal_time(optimum.geometric_path_from_samples(path), optimum.VELOCITY, optimum.ACCELERATION)
     assert row["T_over_optimal"] == pytest.approx(row["T_s"] / optimal, rel=0.01)
     assert row["optimal_failure"] == ""
     jerk = np.abs(np.diff(path, 3, axis=0)).max() / 1e-3**3
@@ -258,19 +259,19 @@ def test_a_path_toppra_cannot_parameterise_gives_its_reason_not_a_log_line(capfd
     # task 69 of the Pająk sweep's 0.7 rad set: Drake's Toppra fails on the 200-knot spline of the
     # law's own path (it logs "Toppra failed to find the maximum path acceleration at knot ..."
     # through spdlog); optimal_duration then tries coarser splines of the same samples
-    task = bench.pajak_walk_tasks(70, seed=9, step=0.7)[69]
-    result = bench.pajak.integrate(bench.pajak.PajakLaw(task), bench.pajak.paper_initial_configuration())
+    task = task_sets.pajak_walk_tasks(70, seed=9, step=0.7)[69]
+    result = task_sets.pajak.integrate(task_sets.pajak.PajakLaw(task), task_sets.pajak.paper_initial_configuration())
     q, qd = result["q"][: result["finish_index"] + 1], result["qd"][: result["finish_index"] + 1]
     drake_log = logging.getLogger("drake")
     handlers, propagate = list(drake_log.handlers), drake_log.propagate
     with pytest.raises(ValueError) as info:
-        bench.time_optimal_along_path(bench.geometric_path_from_samples(q, max_knots=200), task.velocity_limit,
+        optimum.time_optimal_along_path(optimum.geometric_path_from_samples(q, max_knots=200), task.velocity_limit,
                                       task.acceleration_limit)
     assert "Toppra failed to find the maximum path acceleration at knot" in str(info.value)
     printed = capfd.readouterr()
     assert "Toppra failed" not in printed.err + printed.out
     assert drake_log.handlers == handlers and drake_log.propagate == propagate  # the logger as it was
-    optimal, reason = bench.optimal_duration(q, qd, task.velocity_limit, task.acceleration_limit)
+    optimal, reason = optimum.optimal_duration(q, qd, task.velocity_limit, task.acceleration_limit)
     assert reason == "" and 1.0 < result["T"] / optimal < 2.0
 
 
@@ -305,7 +306,7 @@ def test_the_optimum_of_a_stop_and_go_path_is_the_sum_of_its_moves():
     q[t > sum(durations)] = legs[0] + legs[1]
     corner = np.searchsorted(t, first)
     speed = np.linalg.norm(qd, axis=1)[corner - 1 : corner + 1]
-    assert np.all((speed > 1e-6) & (speed < bench.STOP_SPEED))  # no sample at rest at the corner
-    optimal, reason = bench.optimal_duration(q, qd, velocity, acceleration)
+    assert np.all((speed > 1e-6) & (speed < optimum.STOP_SPEED))  # no sample at rest at the corner
+    optimal, reason = optimum.optimal_duration(q, qd, velocity, acceleration)
     assert reason == ""
     assert optimal == pytest.approx(straight(legs[0]) + straight(legs[1]), rel=2e-3)

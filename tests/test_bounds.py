@@ -18,7 +18,7 @@ from pydrake.systems.analysis import Simulator, SimulatorConfig
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from drake_traj import Cause, DrakeTrajError, PlanningError, SimulationResult, cli, load_scenario, make_planner, simulate
-from drake_traj.bench import suite as bench_module
+from drake_traj.bench import engine as bench_module
 from drake_traj.data import data_directory
 from drake_traj.station import SPEED_SLIDER, SpeedSlider, add_station, build_station, make_station, run_station, start_meshcat
 from drake_traj.planners.pajak.system import MAX_PREFLIGHT_STEPS, PajakPlanner

@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from drake_traj import SimulationResult, cli
-from drake_traj.bench import suite as bench
+from drake_traj.bench import run as bench
 from drake_traj.cli import commands
 from drake_traj.results import output
 

@@ -7,7 +7,7 @@ from scipy.spatial import cKDTree
 
 from drake_traj import (BorygaConfig, FreeMotionConfig, LiConfig, MovejConfig, PajakConfig, QuinticConfig,
                         RetimedPajakConfig, RuckigConfig, SmoothWaypointsConfig, ToppraConfig, get_robot, simulate)
-from drake_traj.bench.suite import joint_waypoints, paper_task
+from drake_traj.bench.task_sets import joint_waypoints, paper_task
 from drake_traj.planners import make_planner
 from drake_traj.scenario import SpeedOverride
 

@@ -1,6 +1,14 @@
 """``drake-traj bench``: every planner and baseline on the Pająk 2024 task and seeded random
-tasks through the same closed loop, on Dask distributed (:mod:`.suite`)."""
+tasks through the same closed loop, on Dask distributed: the tasks (:mod:`.task_sets`), T_opt
+along a planner's path (:mod:`.optimum`), the planner configs and the work unit of one run
+(:mod:`.units`), where the units run and their progress (:mod:`.engine`), the CSV, Markdown and
+figure (:mod:`.report`) and the entry point :func:`bench` (:mod:`.run`)."""
 
-from drake_traj.bench.suite import (COLUMNS, CONFIG_BUILDERS, PLANNERS, BenchSetupError, Task, bench, bench_figure, medians, optimal_duration, pajak_walk_tasks, paper_task, random_tasks, run_planner, run_toppra, tasks)
+from drake_traj.bench.task_sets import (Task, joint_waypoints, pajak_walk_tasks, paper_task, random_tasks, tasks)
+from drake_traj.bench.optimum import (converged_optimum, optimal_duration)
+from drake_traj.bench.units import (COLUMNS, CONFIG_BUILDERS, PLANNERS, run_planner, run_toppra)
+from drake_traj.bench.engine import (BenchSetupError)
+from drake_traj.bench.report import (bench_figure, medians)
+from drake_traj.bench.run import (bench)
 
-__all__ = ['BenchSetupError', 'COLUMNS', 'CONFIG_BUILDERS', 'PLANNERS', 'Task', 'bench', 'bench_figure', 'medians', 'optimal_duration', 'pajak_walk_tasks', 'paper_task', 'random_tasks', 'run_planner', 'run_toppra', 'tasks']
+__all__ = ['BenchSetupError', 'COLUMNS', 'CONFIG_BUILDERS', 'PLANNERS', 'Task', 'bench', 'bench_figure', 'converged_optimum', 'joint_waypoints', 'medians', 'optimal_duration', 'pajak_walk_tasks', 'paper_task', 'random_tasks', 'run_planner', 'run_toppra', 'tasks']

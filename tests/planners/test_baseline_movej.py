@@ -5,7 +5,7 @@ import pytest
 from pydrake.systems.analysis import Simulator
 
 from drake_traj.robots import ur10e as robot
-from drake_traj.bench.suite import joint_waypoints, paper_task
+from drake_traj.bench.task_sets import joint_waypoints, paper_task
 from drake_traj.planners.baselines.movej import (
     MovejBlendLaw,
     MovejPlanner,
