@@ -32,7 +32,8 @@ import numpy as np
 from drake_traj.data import data_directory
 from drake_traj.planners.pajak import PajakLaw
 from drake_traj.planners.pajak.integration import integrate
-from drake_traj.planners.pajak.kernel import Discrete, Evaluation, Log, evaluate_kernel, integrate_kernel
+from drake_traj.planners.pajak.kernel import Discrete, Evaluation, Log, evaluate_kernel
+from drake_traj.planners.pajak.stepping import integrate_kernel
 from drake_traj.robots import chain, ur10e
 from drake_traj.robots.compiled_kinematics import kinematics_many
 from drake_traj.robots.chain_arm import ChainArm

@@ -12,13 +12,10 @@ import math
 import numpy as np
 import pytest
 
+from drake_traj.planners.li.acc_dec import AccDecCase, acc_dec_profile, average_acceleration, classify_acc_dec
 from drake_traj.planners.li.cartesian import (
-    AccDecCase,
-    acc_dec_profile,
-    average_acceleration,
     break_point_geometry,
     break_point_limits,
-    classify_acc_dec,
     forward_backward_pass,
     look_ahead,
     plan_cartesian_path,

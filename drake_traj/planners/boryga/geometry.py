@@ -114,6 +114,72 @@ class LoopGeometry:
         return self.O1 + self.R * (np.cos(angle) * self.xi + np.sin(angle) * self.eta)
 
 
+def _corner(B: np.ndarray, M: np.ndarray, E: np.ndarray):
+    """The corner at M (section 2.2) from B, M, E [m], shape (3,) each.
+
+    Returns:
+        (|BM| [m], |ME| [m], a_hat, d_hat, a_hat x d_hat, sin(angle BME), angle BME [rad]) with
+        a = M - B and d = M - E; the angle BME = angle(a_hat, d_hat), in (0, pi).
+
+    Raises:
+        ValueError: B or E coinciding with M, or B, M, E collinear (no corner to loop through).
+    """
+    a = M - B
+    d = M - E
+    norm_a = float(np.linalg.norm(a))
+    norm_d = float(np.linalg.norm(d))
+    if norm_a == 0.0:
+        raise invalid("B", f"B and M coincide (both {M}): segment BM has no length, no corner")
+    if norm_d == 0.0:
+        raise invalid("E", f"E and M coincide (both {M}): segment ME has no length, no corner")
+    a_hat = a / norm_a
+    d_hat = d / norm_d
+    cross = np.cross(a_hat, d_hat)
+    sin_angle = float(np.linalg.norm(cross))
+    cos_angle = float(a_hat @ d_hat)
+    if sin_angle < _COLLINEAR_SIN_TOL:
+        if cos_angle > 0.0:
+            raise ValueError(
+                "B, M and E are collinear with B and E on the same side of M (angle BME = 0): "
+                "the path reverses at M, there is no corner to loop through"
+            )
+        raise ValueError(
+            "B, M and E are collinear with M between B and E (angle BME = pi): "
+            "the path is straight, there is no corner to loop through"
+        )
+    corner_angle = float(np.arctan2(sin_angle, cos_angle))  # angle BME = angle(a_hat, d_hat)
+    return norm_a, norm_d, a_hat, d_hat, cross, sin_angle, corner_angle
+
+
+def _loop_delta(delta, radius, corner_angle: float, half_sin: float) -> float:
+    """Delta [m], the distance from M to the loop centre, from ``delta`` [m] or ``radius`` R [m]
+    (section 2.2: Delta = R / sin(angle BME / 2), ``half_sin`` = sin(``corner_angle`` / 2), the
+    angle BME [rad]).
+
+    Raises:
+        ValueError: neither given, a non-positive or non-finite one, or both given and not
+            describing the same loop (to a relative 1e-9).
+    """
+    if delta is None and radius is None:
+        raise ValueError(
+            "delta or radius must be given (Delta [m] or R [m] of the loop), got neither"
+        )
+    if delta is not None:
+        delta = positive_scalar(delta, "delta", "m")
+    if radius is not None:
+        radius = positive_scalar(radius, "radius", "m")
+        delta_from_radius = radius / half_sin  # section 2.2: Delta from R and the half angle BME
+        if delta is None:
+            delta = delta_from_radius
+        elif abs(delta - delta_from_radius) > _FIT_RTOL * delta:
+            raise ValueError(
+                f"radius = {radius} m does not fit delta = {delta} m for the angle BME = "
+                f"{corner_angle} rad: the loop tangent to BM and EM with centre at distance delta "
+                f"from M has R = delta sin(angle / 2) = {delta * half_sin} m"
+            )
+    return delta
+
+
 def loop_geometry(B, M, E, delta=None, radius=None) -> LoopGeometry:
     """Loop path geometry from B, M, E and Delta or R (section 2.2, flowchart of Fig. 3).
 
@@ -145,50 +211,10 @@ def loop_geometry(B, M, E, delta=None, radius=None) -> LoopGeometry:
     B = finite_array(B, "B", "m", shape=(3,))
     M = finite_array(M, "M", "m", shape=(3,))
     E = finite_array(E, "E", "m", shape=(3,))
-    a = M - B
-    d = M - E
-    norm_a = float(np.linalg.norm(a))
-    norm_d = float(np.linalg.norm(d))
-    if norm_a == 0.0:
-        raise invalid("B", f"B and M coincide (both {M}): segment BM has no length, no corner")
-    if norm_d == 0.0:
-        raise invalid("E", f"E and M coincide (both {M}): segment ME has no length, no corner")
-    a_hat = a / norm_a
-    d_hat = d / norm_d
-    cross = np.cross(a_hat, d_hat)
-    sin_angle = float(np.linalg.norm(cross))
-    cos_angle = float(a_hat @ d_hat)
-    if sin_angle < _COLLINEAR_SIN_TOL:
-        if cos_angle > 0.0:
-            raise ValueError(
-                "B, M and E are collinear with B and E on the same side of M (angle BME = 0): "
-                "the path reverses at M, there is no corner to loop through"
-            )
-        raise ValueError(
-            "B, M and E are collinear with M between B and E (angle BME = pi): "
-            "the path is straight, there is no corner to loop through"
-        )
-    corner_angle = float(np.arctan2(sin_angle, cos_angle))  # angle BME = angle(a_hat, d_hat)
+    norm_a, norm_d, a_hat, d_hat, cross, sin_angle, corner_angle = _corner(B, M, E)
     half_sin = np.sin(0.5 * corner_angle)
     half_cos = np.cos(0.5 * corner_angle)
-
-    if delta is None and radius is None:
-        raise ValueError(
-            "delta or radius must be given (Delta [m] or R [m] of the loop), got neither"
-        )
-    if delta is not None:
-        delta = positive_scalar(delta, "delta", "m")
-    if radius is not None:
-        radius = positive_scalar(radius, "radius", "m")
-        delta_from_radius = radius / half_sin  # section 2.2: Delta from R and the half angle BME
-        if delta is None:
-            delta = delta_from_radius
-        elif abs(delta - delta_from_radius) > _FIT_RTOL * delta:
-            raise ValueError(
-                f"radius = {radius} m does not fit delta = {delta} m for the angle BME = "
-                f"{corner_angle} rad: the loop tangent to BM and EM with centre at distance delta "
-                f"from M has R = delta sin(angle / 2) = {delta * half_sin} m"
-            )
+    delta = _loop_delta(delta, radius, corner_angle, half_sin)
 
     b = a_hat + d_hat  # bisector direction of the angle BME, away from B and E
     b_hat = _unit(b)

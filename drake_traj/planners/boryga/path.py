@@ -291,6 +291,20 @@ class LoopPath:
             raise ValueError("t must be finite [s]")
         return array
 
+    def _on_arc(self, t: np.ndarray):
+        """Position [m], velocity [m/s], acceleration [m/s^2] and jerk [m/s^3] on the arc at times
+        ``t`` [s] of shape (N,), each (N, 3) in the base frame xyz."""
+        g, v = self.geometry, self.timing.v_max
+        # beta(t) = beta_b + (v_max / R)(t - t_BT1) (eq. 11), S^A = T Xi^A (eq. 12) and its time
+        # derivatives (centripetal acceleration v^2 / R towards O1).
+        omega = v / g.R
+        angle = g.beta_b + omega * (t - self.timing.t_T1)
+        c = np.cos(angle)[:, None]
+        s = np.sin(angle)[:, None]
+        radial = c * g.xi + s * g.eta  # unit vector from O1 to the tool
+        tangent = -s * g.xi + c * g.eta  # unit direction of motion
+        return g.O1 + g.R * radial, v * tangent, -(v * omega) * radial, -(v * omega**2) * tangent
+
     def sample(self, t, side: str = "right"):
         """Position, velocity, acceleration and jerk of the tool at time ``t`` (base frame xyz).
 
@@ -337,20 +351,10 @@ class LoopPath:
             pos[k] = g.M + (v * (tt[k] - tl.t_M1))[:, None] * g.a_hat
             vel[k] = v * g.a_hat
 
-        # Arc: beta(t) = beta_b + (v_max / R)(t - t_BT1) (eq. 11), S^A = T Xi^A (eq. 12) and
-        # its time derivatives (centripetal acceleration v^2 / R towards O1).
+        # Arc: eq. 11-12 at constant v_max (:meth:`_on_arc`).
         k = phase == 2
         if np.any(k):
-            omega = v / g.R
-            angle = g.beta_b + omega * (tt[k] - tl.t_T1)
-            c = np.cos(angle)[:, None]
-            s = np.sin(angle)[:, None]
-            radial = c * g.xi + s * g.eta  # unit vector from O1 to the tool
-            tangent = -s * g.xi + c * g.eta  # unit direction of motion
-            pos[k] = g.O1 + g.R * radial
-            vel[k] = v * tangent
-            acc[k] = -(v * omega) * radial
-            jerk[k] = -(v * omega**2) * tangent
+            pos[k], vel[k], acc[k], jerk[k] = self._on_arc(tt[k])
 
         # T2M: constant v_max along -d_hat (time t_T2M = t_MT1).
         k = phase == 3

@@ -359,6 +359,53 @@ def _needs(needed_stretch, law: JointSplineLaw) -> np.ndarray:
     return need
 
 
+def _warp_inputs(times, q, needed_stretch, max_step, initial_log_stretch, target, max_iterations):
+    """:func:`smooth_time_warp`'s arguments checked (each ValueError names the argument): the knot
+    times [s] (N,), the joint samples [rad] (N, n), max_step (N - 2,), the starting log-stretch G
+    (N - 1,) and the target, as arrays and a float."""
+    t = finite_array(times, "times", "s")
+    if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) <= 0.0):
+        raise ValueError(f"times must be a strictly increasing vector of at least two knot times [s], got shape "
+                         f"{t.shape}" + (f" with times[{int(np.argmax(np.diff(t) <= 0.0)) + 1}] <= the one before"
+                                         if t.ndim == 1 and t.size >= 2 else ""))
+    joints = finite_array(q, "q", "rad")
+    if joints.ndim != 2 or joints.shape[0] != t.size:
+        raise ValueError(f"q must have shape ({t.size}, n) (one row per knot time) [rad], got {joints.shape}")
+    if not callable(needed_stretch):
+        raise ValueError(f"needed_stretch must be callable (law -> stretch per interval), got {type(needed_stretch).__name__}")
+    step = np.array(max_step, dtype=float)
+    if step.shape != (t.size - 2,):
+        raise ValueError(f"max_step must have shape ({t.size - 2},) (one per pair of neighbouring intervals), got {step.shape}")
+    if initial_log_stretch is None:
+        g = np.zeros(t.size - 1)
+    else:
+        g = finite_array(initial_log_stretch, "initial_log_stretch", "-", shape=(t.size - 1,))
+        if np.any(g < 0.0):
+            raise ValueError("initial_log_stretch must be >= 0 (a warp only stretches time)")
+    target = float(target)
+    if not 0.0 < target <= 1.0:
+        raise ValueError(f"target must be in (0, 1], got {target}")
+    if isinstance(max_iterations, bool) or int(max_iterations) != max_iterations or max_iterations < 0:
+        raise ValueError(f"max_iterations must be an integer >= 0, got {max_iterations!r}")
+    return t, joints, step, g, target
+
+
+def _uniform_fallback(t, g, joints, needed_stretch, iterations: int, uniform: float) -> JointSplineLaw:
+    """The law at knot intervals d_k exp(G_k), G already raised by log(``uniform``) after
+    ``iterations`` rounds; ValueError if a requirement is still broken (a ``needed_stretch`` that
+    does not scale as 1 / c under a uniform stretch by c)."""
+    law = _law(t, g, joints)
+    need = _needs(needed_stretch, law)
+    if np.any(need > 1.0):
+        k = int(np.argmax(need))
+        raise ValueError(
+            f"smooth_time_warp: interval {k} still needs a stretch of {need[k]:.6g} after {iterations} "
+            f"rounds and a uniform stretch by {uniform:.6g}; needed_stretch must scale as 1 / c under a "
+            "uniform stretch by c"
+        )
+    return law
+
+
 def smooth_time_warp(
     times,
     q,
@@ -400,31 +447,8 @@ def smooth_time_warp(
         ValueError: bad arguments (named), or requirements still broken after the uniform
             stretch (a ``needed_stretch`` that does not scale as required).
     """
-    t = finite_array(times, "times", "s")
-    if t.ndim != 1 or t.size < 2 or np.any(np.diff(t) <= 0.0):
-        raise ValueError(f"times must be a strictly increasing vector of at least two knot times [s], got shape "
-                         f"{t.shape}" + (f" with times[{int(np.argmax(np.diff(t) <= 0.0)) + 1}] <= the one before"
-                                         if t.ndim == 1 and t.size >= 2 else ""))
-    joints = finite_array(q, "q", "rad")
-    if joints.ndim != 2 or joints.shape[0] != t.size:
-        raise ValueError(f"q must have shape ({t.size}, n) (one row per knot time) [rad], got {joints.shape}")
-    if not callable(needed_stretch):
-        raise ValueError(f"needed_stretch must be callable (law -> stretch per interval), got {type(needed_stretch).__name__}")
-    step = np.array(max_step, dtype=float)
-    if step.shape != (t.size - 2,):
-        raise ValueError(f"max_step must have shape ({t.size - 2},) (one per pair of neighbouring intervals), got {step.shape}")
-    if initial_log_stretch is None:
-        g = np.zeros(t.size - 1)
-    else:
-        g = finite_array(initial_log_stretch, "initial_log_stretch", "-", shape=(t.size - 1,))
-        if np.any(g < 0.0):
-            raise ValueError("initial_log_stretch must be >= 0 (a warp only stretches time)")
-    target = float(target)
-    if not 0.0 < target <= 1.0:
-        raise ValueError(f"target must be in (0, 1], got {target}")
-    if isinstance(max_iterations, bool) or int(max_iterations) != max_iterations or max_iterations < 0:
-        raise ValueError(f"max_iterations must be an integer >= 0, got {max_iterations!r}")
-
+    t, joints, step, g, target = _warp_inputs(times, q, needed_stretch, max_step, initial_log_stretch, target,
+                                              max_iterations)
     law = _law(t, g, joints)
     need = _needs(needed_stretch, law)
     iterations = 0
@@ -438,15 +462,7 @@ def smooth_time_warp(
     if np.any(need > 1.0):
         uniform = float(np.max(need)) * (1.0 + 1e-12)
         g = g + np.log(uniform)
-        law = _law(t, g, joints)
-        need = _needs(needed_stretch, law)
-        if np.any(need > 1.0):
-            k = int(np.argmax(need))
-            raise ValueError(
-                f"smooth_time_warp: interval {k} still needs a stretch of {need[k]:.6g} after {iterations} "
-                f"rounds and a uniform stretch by {uniform:.6g}; needed_stretch must scale as 1 / c under a "
-                "uniform stretch by c"
-            )
+        law = _uniform_fallback(t, g, joints, needed_stretch, iterations, uniform)
     return law, WarpReport(
         times=law.knot_times,
         log_stretch=g,

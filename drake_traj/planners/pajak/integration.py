@@ -1,6 +1,6 @@
 """Fixed-step RK4 integration of the Pająk 2024 law outside Drake: :func:`integrate` runs one
 task (the planner's preflight, tests and benchmarks) with the compiled
-:func:`~.kernel.integrate_kernel`."""
+:func:`~.stepping.integrate_kernel`."""
 
 from __future__ import annotations
 
@@ -9,8 +9,9 @@ import math
 import numpy as np
 
 from drake_traj.errors import Cause, PlanningError
-from drake_traj.planners.pajak.kernel import Discrete, Evaluation, Log, Status, integrate_kernel
+from drake_traj.planners.pajak.kernel import Discrete, Evaluation, Log, Status
 from drake_traj.planners.pajak.law import PajakLaw
+from drake_traj.planners.pajak.stepping import integrate_kernel
 from drake_traj.validation import finite_array, invalid
 
 __all__ = ["integrate"]

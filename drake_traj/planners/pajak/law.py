@@ -37,10 +37,9 @@ from drake_traj.planners.pajak.kernel import (
     Parameter,
     Status,
     evaluate_kernel,
-    finished_kernel,
-    update_kernel,
 )
 from drake_traj.planners.pajak.parameters import TASK_JOINTS, PajakConfig
+from drake_traj.planners.pajak.stepping import finished_kernel, update_kernel
 from drake_traj.planners.pajak.terms import ORIENTATION_LENGTH
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import limit_or_default

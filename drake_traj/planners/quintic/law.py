@@ -248,6 +248,45 @@ def _too_long(k: int, d: np.ndarray, kv: np.ndarray, ka: np.ndarray, t: float, t
         "raise it", field=(name, j), cause=Cause.INFEASIBLE)
 
 
+def _goal_rows(goals, n: int) -> np.ndarray:
+    """``goals`` [rad] as an (m, n) array of finite values, m >= 1 (a single goal of shape (n,) as
+    one row); ValueError naming ``goals``."""
+    goal_array = real_array(goals, "goals", UNITS)
+    if goal_array.ndim == 1 and goal_array.shape == (n,):
+        goal_array = goal_array[None, :]
+    if goal_array.ndim != 2 or goal_array.shape[1] != n:
+        raise invalid("goals", f"goals must have shape (m, {n}) or ({n},) to match q_start, "
+                               f"got shape {goal_array.shape}")
+    if goal_array.shape[0] == 0:
+        raise invalid("goals", f"goals must contain at least one goal, got shape {goal_array.shape}")
+    require_finite(goal_array, "goals")
+    return goal_array
+
+
+def _check_position_bounds(q0: np.ndarray, goal_array: np.ndarray, position_lower, position_upper) -> None:
+    """Refuse ``position_lower`` above ``position_upper`` [rad] (scalars or shape (n,), None for
+    no bound), and ``q0`` (n,) or a row of ``goal_array`` (m, n) [rad] outside them: ValueError
+    naming the argument, the goal index and the joint."""
+    n = q0.size
+    lower = None if position_lower is None else joint_bound(position_lower, "position_lower", n, UNITS)
+    upper = None if position_upper is None else joint_bound(position_upper, "position_upper", n, UNITS)
+    if lower is not None and upper is not None and np.any(lower > upper):
+        j = int(np.argmax(lower > upper))
+        raise invalid("position_lower", f"position_lower[{j}] = {lower[j]} is above position_upper[{j}] = "
+                                        f"{upper[j]} ({joint_label(j)})", j)
+    bounds = [(bound, beyond, side) for bound, beyond, side in ((lower, np.less, "below position_lower"),
+                                                                (upper, np.greater, "above position_upper"))
+              if bound is not None]
+    rows = [("q_start", (), q0)] + [("goals", (k,), goal) for k, goal in enumerate(goal_array)]
+    for name, index, row in rows:
+        for bound, beyond, side in bounds:
+            outside = np.flatnonzero(beyond(row, bound))
+            if len(outside):
+                j = int(outside[0])
+                raise invalid(name, f"{field_text((name, *index, j))} ({joint_label(j)}) = {row[j]} rad is "
+                                    f"{side}[{j}] = {bound[j]} rad", *index, j)
+
+
 def plan_synchronized_quintic(
     q_start,
     goals,
@@ -293,36 +332,10 @@ def plan_synchronized_quintic(
     n = q0.size
     require_finite(q0, "q_start")
 
-    goal_array = real_array(goals, "goals", UNITS)
-    if goal_array.ndim == 1 and goal_array.shape == (n,):
-        goal_array = goal_array[None, :]
-    if goal_array.ndim != 2 or goal_array.shape[1] != n:
-        raise invalid("goals", f"goals must have shape (m, {n}) or ({n},) to match q_start, "
-                               f"got shape {goal_array.shape}")
-    if goal_array.shape[0] == 0:
-        raise invalid("goals", f"goals must contain at least one goal, got shape {goal_array.shape}")
-    require_finite(goal_array, "goals")
-
+    goal_array = _goal_rows(goals, n)
     kv = joint_limit(velocity_limit, "velocity_limit", n, UNITS)
     ka = joint_limit(acceleration_limit, "acceleration_limit", n, UNITS)
-
-    lower = None if position_lower is None else joint_bound(position_lower, "position_lower", n, UNITS)
-    upper = None if position_upper is None else joint_bound(position_upper, "position_upper", n, UNITS)
-    if lower is not None and upper is not None and np.any(lower > upper):
-        j = int(np.argmax(lower > upper))
-        raise invalid("position_lower", f"position_lower[{j}] = {lower[j]} is above position_upper[{j}] = "
-                                        f"{upper[j]} ({joint_label(j)})", j)
-    bounds = [(bound, beyond, side) for bound, beyond, side in ((lower, np.less, "below position_lower"),
-                                                                (upper, np.greater, "above position_upper"))
-              if bound is not None]
-    rows = [("q_start", (), q0)] + [("goals", (k,), goal) for k, goal in enumerate(goal_array)]
-    for name, index, row in rows:
-        for bound, beyond, side in bounds:
-            outside = np.flatnonzero(beyond(row, bound))
-            if len(outside):
-                j = int(outside[0])
-                raise invalid(name, f"{field_text((name, *index, j))} ({joint_label(j)}) = {row[j]} rad is "
-                                    f"{side}[{j}] = {bound[j]} rad", *index, j)
+    _check_position_bounds(q0, goal_array, position_lower, position_upper)
 
     segments: list[QuinticSegment] = []
     t = 0.0
