@@ -288,12 +288,12 @@ def export_run(args) -> int:
     """``drake-traj export``: a run's reference as CSV, URScript or a ROS 2 JointTrajectory."""
     run_dir = Path(args.run_dir)
     result = SimulationResult.load(run_dir)
-    out = Path(args.out) if args.out else run_dir / f"reference{FORMATS[args.format]}"
+    out = Path(args.out) if args.out else run_dir / f"reference{FORMATS[args.format].suffix}"
     into_run = out.parent.resolve() == run_dir.resolve()
     if into_run and out.name in {"result.npz", "metrics.json", MANIFEST} | set(run_files(run_dir)) - set(_exports()):
         raise ExportError(f"--out {out} is one of the run's own files; give another file name")
     if out.is_dir():  # before the advice to overwrite: a folder is never replaced by a file
-        raise ExportError(f"--out {out} is a folder; give a file name, e.g. --out {out / f'reference{FORMATS[args.format]}'}")
+        raise ExportError(f"--out {out} is a folder; give a file name, e.g. --out {out / f'reference{FORMATS[args.format].suffix}'}")
     if out.exists() and not args.overwrite:
         raise ExportError(f"--out {out} exists; pass --overwrite to replace it")
     # into the run's own folder: locked, so that no run replaces the folder meanwhile
@@ -309,7 +309,7 @@ def export_run(args) -> int:
 
 def _exports() -> list[str]:
     """The default export file names (reference.csv, ...), which an export may replace."""
-    return [f"reference{suffix}" for suffix in FORMATS.values()]
+    return [f"reference{form.suffix}" for form in FORMATS.values()]
 
 
 def run_bench(args) -> int:

@@ -8,9 +8,13 @@ its logged velocity; q̈ linearly interpolated between the logged q̈_ref sample
 
 Every writer checks its options and the reference first and writes nothing when something is
 wrong (:class:`ExportError`, naming the option or the joint, time and value).
+
+Each format is an :class:`ExportFormat` in :data:`FORMATS`, keyed by the name ``--format`` takes:
+its file ending, its options' checks and its text. A new format is one class here and its entry.
 """
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -22,9 +26,8 @@ from drake_traj.errors import DrakeTrajError
 from drake_traj.results.output import OutputError, WriteError, check_writable, write_file
 from drake_traj.robots import UR_ARMS, Robot, get_robot
 
-__all__ = ["FORMATS", "ExportError", "export", "reference_trajectory", "resample"]
+__all__ = ["FORMATS", "ExportError", "ExportFormat", "ExportOptions", "export", "reference_trajectory", "resample"]
 
-FORMATS = {"csv": ".csv", "urscript": ".script", "ros2": ".yaml"}
 UR_CYCLE = 0.002  # [s], the UR controller's servo cycle (500 Hz)
 MIN_PERIOD = 1e-4  # [s], the finest resampling (10 kHz): the log itself is at 1 ms
 LOOKAHEAD_RANGE = (0.03, 0.2)  # [s], servoj lookahead_time (UR script manual)
@@ -159,9 +162,81 @@ def _ros2(result, t, q, qd, qdd, joint_names) -> str:
     return comment + yaml.safe_dump(message, sort_keys=False, default_flow_style=None, width=1000)
 
 
+@dataclass(frozen=True)
+class ExportOptions:
+    """The options of an export (``drake-traj export``'s): the sampling ``period`` [s], and for
+    URScript servoj's ``lookahead_time`` [s] and ``gain`` and the ``approach_speed`` [rad/s, rad/s²]."""
+
+    period: float = UR_CYCLE
+    lookahead_time: float = 0.1
+    gain: float = 300.0
+    approach_speed: float = 0.3
+
+
+class ExportFormat:
+    """One export format: its file ending (``suffix``), the check of its own options (before any
+    work) and its text from the resampled reference."""
+
+    suffix: str = ""
+
+    def check_options(self, options: ExportOptions) -> None:
+        """Raise :class:`ExportError` for an option this format cannot take; the base takes any."""
+
+    def text(self, result, t, q, qd, qdd, options: ExportOptions) -> str:
+        """The file's text for ``result``'s reference resampled at the times ``t`` [s]: q, q̇, q̈
+        (len(t), n) [rad or m, per s, per s²]; raises :class:`ExportError` where the reference does
+        not fit the format."""
+        raise NotImplementedError(f"{type(self).__name__} does not say how to write its text")
+
+
+class CsvFormat(ExportFormat):
+    """Comma-separated values: t, q, q̇, q̈ per row, with a header naming the units."""
+
+    suffix = ".csv"
+
+    def text(self, result, t, q, qd, qdd, options):
+        return _csv(result, t, q, qd, qdd, options.period)
+
+
+class UrscriptFormat(ExportFormat):
+    """A URScript program for a UR e-Series controller: a slow movej to the start, then servoj
+    every ``period``; for the UR arms only, within their ranges, speeds and torques."""
+
+    suffix = ".script"
+
+    def check_options(self, options):
+        if not options.period >= UR_CYCLE - 1e-12:
+            raise ExportError(f"--period must be at least the UR controller's cycle {UR_CYCLE} s, got {options.period}")
+        for name, value, (low, high) in (("--lookahead-time", options.lookahead_time, LOOKAHEAD_RANGE),
+                                         ("--gain", options.gain, GAIN_RANGE)):
+            if not low <= value <= high:
+                raise ExportError(f"{name} must be in UR's range [{low:g}, {high:g}], got {value}")
+        if not 0 < options.approach_speed <= 1.0:
+            raise ExportError(f"--approach-speed must be in (0, 1] rad/s, got {options.approach_speed}")
+
+    def text(self, result, t, q, qd, qdd, options):
+        robot = _check_ur_arm(result, t, q, qd)
+        return _urscript(result, robot, t, q, options.period, options.lookahead_time, options.gain,
+                         options.approach_speed)
+
+
+class Ros2Format(ExportFormat):
+    """A ROS 2 ``trajectory_msgs/JointTrajectory`` message as YAML (``ros2 topic pub``)."""
+
+    suffix = ".yaml"
+
+    def text(self, result, t, q, qd, qdd, options):
+        return _ros2(result, t, q, qd, qdd, result.joint_names or [f"joint_{j + 1}" for j in range(q.shape[1])])
+
+
+FORMATS: dict[str, ExportFormat] = {"csv": CsvFormat(), "urscript": UrscriptFormat(), "ros2": Ros2Format()}
+"""Each export format by the name ``--format`` takes."""
+
+
 def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_time: float = 0.1, gain: float = 300.0,
            approach_speed: float = 0.3, allow_failed: bool = False, run_folder=None) -> Path:
-    """Write ``result``'s reference to ``path`` as ``format`` ("csv", "urscript" or "ros2").
+    """Write ``result``'s reference to ``path`` as ``format``, a name of :data:`FORMATS` ("csv",
+    "urscript" or "ros2").
 
     A run that failed (its planner did not finish, or the arm could not follow) is refused unless
     ``allow_failed``; then the file says so in its header.
@@ -175,10 +250,10 @@ def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_tim
             by the caller, as ``drake-traj export`` does); None: no run's or bench's folder.
 
     Returns the path written. Raises :class:`ExportError`, writing nothing, when an option is out
-    of range or the reference is not fit for the format; :class:`~drake_traj.output.OutputError`
+    of range or the reference is not fit for the format; :class:`~drake_traj.results.output.OutputError`
     when ``path`` is a symbolic link or in another run's or bench's folder, its folder cannot be
     written (a read-only file system, no permission: checked first, naming the folder), or it
-    does not fit on the disk (:func:`drake_traj.output.write_file`: the file is written whole or
+    does not fit on the disk (:func:`drake_traj.results.output.write_file`: the file is written whole or
     not at all).
     """
     if format not in FORMATS:
@@ -186,14 +261,8 @@ def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_tim
     if result.failure is not None and not allow_failed:
         raise ExportError(f"the run {result.name!r} failed ({result.failure}); its reference is not a motion to "
                           "send anywhere. Nothing was written (--allow-failed writes it anyway, marked as failed)")
-    if format == "urscript":
-        if not period >= UR_CYCLE - 1e-12:
-            raise ExportError(f"--period must be at least the UR controller's cycle {UR_CYCLE} s, got {period}")
-        for name, value, (low, high) in (("--lookahead-time", lookahead_time, LOOKAHEAD_RANGE), ("--gain", gain, GAIN_RANGE)):
-            if not low <= value <= high:
-                raise ExportError(f"{name} must be in UR's range [{low:g}, {high:g}], got {value}")
-        if not 0 < approach_speed <= 1.0:
-            raise ExportError(f"--approach-speed must be in (0, 1] rad/s, got {approach_speed}")
+    options = ExportOptions(period, lookahead_time, gain, approach_speed)
+    FORMATS[format].check_options(options)
     folder = Path(os.path.abspath(path)).parent
     if folder.is_dir():  # a missing folder is named by write_file
         try:
@@ -201,13 +270,7 @@ def export(result, path, format: str, *, period: float = UR_CYCLE, lookahead_tim
         except OutputError as error:
             raise error.relocated(error.field, f"--out {path}: {error}; nothing was written") from None
     t, q, qd, qdd = resample(result, period)
-    if format == "csv":
-        text = _csv(result, t, q, qd, qdd, period)
-    elif format == "urscript":
-        robot = _check_ur_arm(result, t, q, qd)
-        text = _urscript(result, robot, t, q, period, lookahead_time, gain, approach_speed)
-    else:
-        text = _ros2(result, t, q, qd, qdd, result.joint_names or [f"joint_{j + 1}" for j in range(q.shape[1])])
+    text = FORMATS[format].text(result, t, q, qd, qdd, options)
     if result.failure is not None:  # allowed: the first line says so (a comment in all three formats)
         text = f"# FAILED RUN: {' '.join(str(result.failure).split())}\n" + text
     try:

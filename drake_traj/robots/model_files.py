@@ -1,5 +1,10 @@
 """Robot and cell description files as engineers have them: ``package://`` URLs, xacro, meshes.
 
+- **Formats.** Each kind of description file is a :class:`ModelFormat` in :data:`MODEL_FORMATS`,
+  keyed by its file name's ending: how the file becomes URDF text for the parser (a ``.urdf`` as
+  it is, a ``.xacro`` expanded), or None where Drake's parser reads the file itself (SDF, and any
+  ending not listed). A new format is one class here and its entry in :data:`MODEL_FORMATS`.
+
 - **Packages.** A parser's package map holds the folders of ``ROS_PACKAGE_PATH`` (every package
   under them), then the packages a scenario names (``packages: {name: folder}``), which win. Drake
   also finds the package a model file itself sits in (its ``package.xml``). A ``package://`` URL
@@ -28,7 +33,8 @@ from pydrake.multibody.plant import MultibodyPlant
 
 from drake_traj.errors import Cause, DrakeTrajError
 
-__all__ = ["CONVERTED_MESH_TYPES", "add_model_file", "joint_efforts", "missing_package", "model_parser", "model_text"]
+__all__ = ["CONVERTED_MESH_TYPES", "MODEL_FORMATS", "ModelFormat", "add_model_file", "joint_efforts", "missing_package",
+           "model_format", "model_parser", "model_text"]
 
 CONVERTED_MESH_TYPES = (".stl", ".dae")
 """Collision mesh files converted to OBJ before Drake reads them (it takes OBJ, VTK and glTF)."""
@@ -132,18 +138,57 @@ def _as_obj(path: Path, field: tuple, label: str) -> Path:
     return target
 
 
+class ModelFormat:
+    """One kind of description file: how it reaches Drake's parser. The base reads a file Drake
+    parses itself (``urdf_text`` None: the file is parsed as it is, no effort limits read from it)."""
+
+    def urdf_text(self, path: Path, parser: Parser, arguments: dict, field: tuple, label: str) -> str | None:
+        """The file ``path`` as URDF text (``arguments``: the scenario's ``xacro_args``), or None
+        where the file is not URDF and Drake's parser reads it itself; errors at ``field``, ``label``."""
+        return None
+
+    def parse_as_is(self, text: str) -> bool:
+        """Whether Drake can parse the file itself although it is URDF (``text``): nothing in it
+        needs rewriting (no mesh to convert). A text made by :meth:`urdf_text` is parsed from a string."""
+        return False
+
+
+class UrdfFormat(ModelFormat):
+    """A ``.urdf`` file: its own text; parsed as it is unless a collision mesh needs converting."""
+
+    def urdf_text(self, path, parser, arguments, field, label):
+        return path.read_text()
+
+    def parse_as_is(self, text):
+        return not any(kind in text.lower() for kind in CONVERTED_MESH_TYPES)
+
+
+class XacroFormat(ModelFormat):
+    """A ``.xacro`` file, expanded with the ``xacro`` package (``$(find pkg)`` from the parser's
+    package map, ``$(arg name)`` from ``arguments``)."""
+
+    def urdf_text(self, path, parser, arguments, field, label):
+        return _expand_xacro(path, parser, arguments, field, label)
+
+
+MODEL_FORMATS: dict[str, ModelFormat] = {".urdf": UrdfFormat(), ".xacro": XacroFormat()}
+"""Each description format by its file name's ending (lower case, with its dot); any other file
+(``.sdf``, ``.xml``, ...) is read by Drake's parser as it is (:class:`ModelFormat`)."""
+
+
+def model_format(path: Path) -> ModelFormat:
+    """The :class:`ModelFormat` of the file ``path``, by its ending (Drake's own reading for one
+    not in :data:`MODEL_FORMATS`)."""
+    return MODEL_FORMATS.get(Path(path).suffix.lower(), ModelFormat())
+
+
 def model_text(path: Path, parser: Parser, *, xacro_args: dict | None = None, field: tuple = ("model_file",),
                label: str = "model_file") -> str | None:
-    """The URDF text to parse for the model file ``path``: a ``.xacro`` expanded, relative mesh
-    paths made absolute and STL/COLLADA collision meshes converted to OBJ; None where the file
-    needs none of that (Drake parses it as it is)."""
-    if path.suffix == ".xacro":
-        text = _expand_xacro(path, parser, xacro_args or {}, field, label)
-    elif path.suffix.lower() == ".urdf":
-        text = path.read_text()
-        if not any(kind in text.lower() for kind in CONVERTED_MESH_TYPES):
-            return None
-    else:
+    """The URDF text to parse for the model file ``path``: its format's text (:func:`model_format`:
+    a ``.xacro`` expanded), relative mesh paths made absolute and STL/COLLADA collision meshes
+    converted to OBJ; None where the file needs none of that (Drake parses it as it is)."""
+    text = model_format(path).urdf_text(path, parser, xacro_args or {}, field, label)
+    if text is None or model_format(path).parse_as_is(text):
         return None
     try:
         root = ElementTree.fromstring(text)
@@ -206,15 +251,12 @@ def _expand_xacro(path: Path, parser: Parser, arguments: dict, field: tuple, lab
 def joint_efforts(path: Path, packages: dict[str, Path] | None = None, *, xacro_args: dict | None = None) -> dict:
     """{joint name: effort limit [N m or N]} from a URDF's (or expanded xacro's) ``<limit effort>``
     tags: Drake keeps them only for joints with a ``<transmission>``, and ROS 2 descriptions
-    declare their drives with ``ros2_control`` instead. Empty for other files."""
-    if path.suffix not in (".urdf", ".xacro"):
+    declare their drives with ``ros2_control`` instead. Empty for a format that has no URDF text."""
+    parser = model_parser(MultibodyPlant(0.0), packages)
+    _add_own_package(parser, path)
+    text = model_format(path).urdf_text(path, parser, xacro_args or {}, ("model_file",), "model_file")
+    if text is None:
         return {}
-    if path.suffix == ".xacro":
-        parser = model_parser(MultibodyPlant(0.0), packages)
-        _add_own_package(parser, path)
-        text = _expand_xacro(path, parser, xacro_args or {}, ("model_file",), "model_file")
-    else:
-        text = path.read_text()
     efforts = {}
     for joint in ElementTree.fromstring(text).iter("joint"):
         limit = joint.find("limit")
