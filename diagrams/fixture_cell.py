@@ -26,7 +26,7 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 from drake_traj import SimulationResult, load_scenario, make_planner, make_station, run_station
 from drake_traj.cell import CollisionError, refusal_figure
 from drake_traj.station import export_html
-from drake_traj.scenario.scenario import check_in_cell
+from drake_traj.scenario import check_in_cell
 
 SCENARIO = Path(__file__).with_name("fixture_cell.yaml")
 

@@ -63,7 +63,7 @@ def test_list_gives_each_shipped_files_path_above_its_scenarios(capsys):
 def test_list_and_show_say_which_copy_of_the_shipped_files_runs(capsys, monkeypatch, tmp_path):
     """A source tree's diagrams/ (a checkout, an editable install: an edit changes what runs) or
     the installed package's (CI installs it so): list's first line and show's note say which."""
-    from drake_traj.scenario import scenario as scenario_module
+    from drake_traj.scenario import shipped as scenario_module
 
     directory = shipped_scenarios()[0].path.parent
     here = scenario_module.shipped_copy()
@@ -87,7 +87,7 @@ def test_an_installed_copy_says_a_checkouts_diagrams_are_not_read(tmp_path, monk
     installed = tmp_path / "site-packages" / "drake_traj" / "diagrams"  # no pyproject.toml beside it
     installed.mkdir(parents=True)
     (installed / "quintic_ptp.yaml").write_text((shipped_scenarios()[0].path.parent / "quintic_ptp.yaml").read_text())
-    monkeypatch.setattr(scenario, "shipped_directory", lambda: installed)
+    monkeypatch.setattr(scenario.shipped, "shipped_directory", lambda: installed)
     assert cli.main(["list"]) == cli.EXIT_OK
     assert capsys.readouterr().out.splitlines()[:2] == [
         f"shipped scenarios, from the installed package ({installed}; a checkout's diagrams/ is not read: copy a "

@@ -28,7 +28,7 @@ from drake_traj.results import SimulationResult, WriteError, locked, working_fol
 from drake_traj.robots import ROBOT_NAMES, get_robot
 from drake_traj.results import (MANIFEST, REFUSAL, add_to_manifest, claim_run_folder, earlier_run, run_files,
                                write_manifest)
-from drake_traj.scenario.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
+from drake_traj.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
                                  load_scenario, preflight, scenario_variants, shipped_copy, shipped_directory,
                                  shipped_scenarios)
 from drake_traj.validation import REALTIME_RATES

@@ -10,48 +10,41 @@ shared YAML anchors and are not variants). Unknown keys, wrong lengths and non-f
 out-of-range numbers raise :class:`ScenarioError` naming the file, the line and the field (its
 ``field`` attribute holds the field's path).
 
-:func:`load_scenario` takes a file or a shipped scenario's name, as ``drake-traj run`` does;
-:func:`make_planner` builds its planner and :func:`preflight` checks the whole task before the
-motion, both with errors located in the file. The station (``drake_traj.station``) is built from
-these types.
+This module holds the types, where a scenario was read from (:class:`ScenarioSource`,
+:func:`locate_in_scenario`) and the scenario's planner (:func:`make_planner`, which
+:meth:`Scenario.station_arguments` uses). :func:`~drake_traj.scenario.shipped.load_scenario` takes
+a file or a shipped scenario's name, as ``drake-traj run`` does (:mod:`.shipped`, reading the file
+with :mod:`.loading`); :func:`~drake_traj.scenario.checks.preflight` checks the whole task before
+the motion (:mod:`.checks`), with errors located in the file. The station (``drake_traj.station``)
+is built from these types.
 """
-
-import functools
-from dataclasses import dataclass, field, fields
-from pathlib import Path
 
 import numbers
 import re
+from dataclasses import dataclass, field, fields
+from pathlib import Path
 
 import numpy as np
-from pydrake.common.yaml import yaml_load_typed
-from pydrake.math import RollPitchYaw, RotationMatrix
 from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
 from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import PiecewisePolynomial
 
 from drake_traj.cell import Cell, CellChecker
-from drake_traj.data import data_directory
 from drake_traj.errors import Cause, DrakeTrajError, Field, field_text, joint_label
 from drake_traj.planners import PLANNER_CONFIGS, PlannerConfig, PlannerSystem, QuinticConfig, make_planner as make_planner_from_config
 from drake_traj.results import DEFAULT_TRACKING_TOLERANCE
 from drake_traj.robots import Robot
-from drake_traj.robots.base import joint_actuators
-from drake_traj.robots.custom import CustomArm, DhArm, RobotChoice, resolve_robot, robot_label
-from drake_traj.validation import (MAX_RUN_DURATION, flag, instance_of, invalid, log_period_check, path_argument,
-                                   real_array, realtime_rate, run_duration, settle_duration, step_size,
-                                   tracking_tolerance_check)
-from drake_traj.scenario.yaml_schema import ScenarioError, checked_document, locate
+from drake_traj.robots.custom import RobotChoice, resolve_robot
+from drake_traj.validation import (flag, instance_of, invalid, log_period_check, real_array, realtime_rate,
+                                   run_duration, settle_duration, step_size, tracking_tolerance_check)
+from drake_traj.scenario.yaml_schema import ScenarioError, locate
 
 __all__ = [
-    "ControllerGains", "Scenario", "ScenarioError", "ScenarioSource", "ShippedScenario", "SpeedOverride",
-    "default_plant_config", "default_scenario_path", "default_simulator_config", "find_scenario", "load_scenario",
-    "check_cell_tcp", "check_planned_duration", "check_start_torques", "locate_in_scenario", "make_planner", "preflight", "scenario_variants",
-    "shipped_copy", "shipped_scenarios",
+    "ControllerGains", "Scenario", "ScenarioSource", "SpeedOverride", "default_plant_config", "default_simulator_config",
+    "locate_in_scenario", "make_planner",
 ]
 
-DEFAULT_SCENARIO = ("pajak.yaml", "sim3")  # what ``drake-traj run`` runs when given no scenario
 _PLAIN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}")
 # The coarsest plant step and log period a run is checked with [s]: the UR controller runs at
 # 2 ms, and the limits and the continuity of q̈ are checked at the logged samples.
@@ -335,171 +328,6 @@ class ScenarioSource:
     marks: dict
 
 
-def shipped_directory() -> Path:
-    """The folder of the scenario files shipped with the package (``diagrams/``)."""
-    return data_directory("diagrams")
-
-
-def default_scenario_path() -> Path:
-    """The scenario file ``drake-traj run`` uses when none is given (its variant: ``sim3``)."""
-    return shipped_directory() / DEFAULT_SCENARIO[0]
-
-
-@dataclass(frozen=True)
-class ShippedScenario:
-    """A scenario shipped with the package: its name, file, variant (None for a file of one
-    scenario), one-line description and robot (:func:`~drake_traj.robots.custom.robot_label`)."""
-
-    name: str
-    path: Path
-    variant: str | None
-    description: str
-    robot: str
-
-
-def shipped_scenarios() -> list[ShippedScenario]:
-    """Every scenario of the shipped files, in file order. Read once per version of the files
-    (each file's modification time and size): a shipped name is looked up on every
-    :func:`load_scenario` by name, and loading every shipped scenario takes about 20 ms each."""
-    versions = tuple((path, path.stat().st_mtime_ns, path.stat().st_size)
-                     for path in sorted(shipped_directory().glob("*.yaml")))
-    return list(_shipped_entries(versions))
-
-
-@functools.lru_cache(maxsize=4)
-def _shipped_entries(versions: tuple[tuple[Path, int, int], ...]) -> tuple[ShippedScenario, ...]:
-    """The :class:`ShippedScenario` entries of the files ``versions`` ((path, mtime, size), in order)."""
-    entries = []
-    for path, _, _ in versions:
-        for variant in scenario_variants(path) or [None]:
-            scenario = load_scenario(path, variant)
-            entries.append(ShippedScenario(scenario.name, path, variant, scenario.description, robot_label(scenario.robot)))
-    return tuple(entries)
-
-
-def find_scenario(reference: str, variant: str | None = None) -> tuple[Path, str | None]:
-    """(file, variant) of a scenario given as a path, or as the name of a shipped scenario
-    (``pajak_sim3``; with ``variant``, that variant of its file: ``pajak_sim3``, ``"sim1"`` is
-    ``pajak_sim1``) or of a shipped file (``pajak``, with ``variant``)."""
-    path = Path(reference)
-    try:
-        return _find_scenario(path, reference, variant)
-    except OSError as error:  # a name too long, ...
-        raise ScenarioError(f"scenario file {str(path)[:80]}{'...' if len(str(path)) > 80 else ''} cannot be "
-                            f"used: {error.strerror}") from None
-
-
-def _find_scenario(path: Path, reference: str, variant: str | None) -> tuple[Path, str | None]:
-    if path.is_file():
-        return path, variant
-    if path.is_symlink() and not path.exists():
-        raise ScenarioError(f"scenario file {path} is a broken link or a loop of links")
-    if path.exists() and not path.is_dir():
-        raise ScenarioError(f"scenario file {path} is not a regular file (a device or a pipe)")
-    # a bare name is looked up among the shipped scenarios even when a folder of that name is
-    # here (e.g. an earlier run's --out quintic_ptp)
-    bare_name = path.suffix not in (".yaml", ".yml") and len(path.parts) == 1
-    if path.is_dir() and not (bare_name and _is_shipped_name(reference)):
-        raise ScenarioError(f"scenario file {path} is a folder, not a scenario file")
-    if not bare_name:
-        where = "" if path.is_absolute() else _in_working_folder()
-        raise ScenarioError(f"scenario file {path} not found{where}{_shipped_alternative(path, variant)}")
-    shipped = shipped_scenarios()
-    for entry in shipped:
-        if entry.name == reference:  # with a variant: that variant of the scenario's file
-            return entry.path, entry.variant if variant is None else variant
-    stem = shipped_directory() / f"{reference}.yaml"
-    if stem.is_file():
-        return stem, variant
-    names = ", ".join(entry.name for entry in shipped)
-    raise ScenarioError(f"no scenario file {reference!r} and no shipped scenario of that name; "
-                     f"shipped: {names} (drake-traj list)")
-
-
-def _in_working_folder() -> str:
-    """`` in <the working folder>``, where a relative path was looked for ("" if it is gone)."""
-    try:
-        return f" in {Path.cwd()}"
-    except OSError:  # the working folder was deleted
-        return ""
-
-
-def _shipped_alternative(path: Path, variant: str | None) -> str:
-    """For a scenario ``path`` that is not there (``diagrams/pajak.yaml`` outside the checkout): how
-    to run the shipped file of that name (by its file name, ``.yaml`` or not), or ""."""
-    file = shipped_directory() / (path.name if path.suffix in (".yaml", ".yml") else f"{path.name}.yaml")
-    entries = [entry for entry in shipped_scenarios() if entry.path.name == file.name]
-    if not entries:
-        return ""
-    chosen = [entry for entry in entries if variant is None or entry.variant == variant]
-    if len(chosen) == 1:
-        name = chosen[0].name
-        return f"; the shipped scenario of that name runs as `drake-traj run {name}` (Python: load_scenario({name!r}))"
-    name = next((entry.name for entry in entries if (file.name, entry.variant) == DEFAULT_SCENARIO), entries[0].name)
-    return (f"; the shipped file of that name holds {', '.join(entry.name for entry in entries)}: run one by its "
-            f"name, e.g. `drake-traj run {name}` (Python: load_scenario({name!r}))")
-
-
-def shipped_copy() -> str:
-    """Which copy of the shipped scenario files runs, said by ``drake-traj list`` and ``show``: a
-    source tree's ``diagrams/`` (a checkout, an editable install), where an edit changes what
-    runs, or the installed package's, which a checkout's ``diagrams/`` does not change."""
-    directory = shipped_directory()
-    if (directory.parent / "pyproject.toml").is_file():
-        return f"this source tree's diagrams/ ({directory}; an edit there changes what runs)"
-    return (f"the installed package ({directory}; a checkout's diagrams/ is not read: copy a scenario with "
-            "drake-traj show NAME > my_task.yaml, edit the copy and run it by its path)")
-
-
-def _is_shipped_name(reference: str) -> bool:
-    """True when ``reference`` names a shipped scenario or a shipped file."""
-    return (shipped_directory() / f"{reference}.yaml").is_file() or any(
-        entry.name == reference for entry in shipped_scenarios())
-
-
-def scenario_variants(path) -> list[str]:
-    """The variant names of a scenario file; empty when the file is one scenario."""
-    return list(checked_document(Path(path), Scenario)[1])
-
-
-def load_scenario(name_or_path, variant: str | None = None) -> Scenario:
-    """Read and validate a scenario: a YAML file, or the name of a shipped scenario
-    (``"quintic_ptp"``, ``"pajak_sim3"``) or of a shipped file (``"pajak"``, with ``variant``),
-    as ``drake-traj run`` takes it (:func:`find_scenario`). ``variant``: the named child of a file
-    of variants; it may be left out when the file is one scenario or has a single variant.
-
-    Raises :class:`ScenarioError` (a ValueError) naming the file, the line and the field (its
-    ``field`` attribute holds the field's path).
-    """
-    reference = path_argument(name_or_path, "name_or_path")
-    if variant is not None:
-        instance_of(variant, str, "variant")
-    path, variant = find_scenario(str(reference), variant)
-    root, variants, check = checked_document(path, Scenario)
-    if variants:
-        if variant is None and len(variants) == 1:
-            variant = next(iter(variants))
-        if variant not in variants:
-            asked = "no variant was given" if variant is None else f"there is no variant {variant!r}"
-            raise ScenarioError(f"{path}: {asked}; its variants are {list(variants)}")
-        marks = check(variants[variant])
-    elif variant is not None:
-        raise ScenarioError(f"{path} holds one scenario, not variants; got variant {variant!r}")
-    else:
-        marks = check(root)
-    try:
-        scenario = yaml_load_typed(schema=Scenario, data=path.read_text(), child_name=variant)
-    except RuntimeError as error:  # not expected after the check above; still one clear message
-        raise ScenarioError(f"{path}: {error}") from None
-    scenario.source = ScenarioSource(path, variant, marks)  # before validate(): a custom arm's file is found from it
-    try:
-        scenario.validate()
-    except ValueError as error:
-        field = error.field if isinstance(error, DrakeTrajError) else ()
-        raise ScenarioError(locate(marks, path, field, str(error)), field=field) from None
-    return scenario
-
-
 def make_planner(scenario: Scenario, *others) -> PlannerSystem:
     """The planner system the scenario describes, its limits checked against the robot's rated
     joint speeds (errors name the scenario and the ``planner`` field; their ``field`` starts
@@ -520,7 +348,7 @@ def make_planner(scenario: Scenario, *others) -> PlannerSystem:
     try:
         planner = make_planner_from_config(scenario.planner, robot, q_initial)
     except ValueError as error:
-        raise _in_planner_field(scenario, error, message_leads_with_field=True) from error
+        raise in_planner_field(scenario, error, message_leads_with_field=True) from error
     velocity = np.broadcast_to(planner.velocity_limit, (robot.num_joints,))
     above = np.flatnonzero(velocity > robot.velocity_limits * (1 + 1e-9))
     if len(above):
@@ -534,136 +362,7 @@ def make_planner(scenario: Scenario, *others) -> PlannerSystem:
     return planner
 
 
-def preflight(scenario: Scenario, planner: PlannerSystem, horizon: float | None = None) -> np.ndarray | None:
-    """``planner.preflight(horizon)`` (the whole task checked before t = 0, up to ``horizon`` [s],
-    default the scenario's ``max_duration``), its errors located in the scenario as
-    :func:`make_planner`'s are (e.g. at ``planner.waypoints[2]``'s line; a task that does not
-    finish within the horizon at ``max_duration``'s); then the planned motion in the scenario's
-    cell (:func:`check_in_cell`).
-
-    Returns the planned tool path [m], shape (N, 3) in the base frame, where the planner
-    computes one (a planner that plans in the cell, the free-motion one: once it has), else None."""
-    try:
-        path = planner.preflight(scenario.max_duration if horizon is None else horizon)
-    except DrakeTrajError as error:
-        if error.cause is not Cause.TIMEOUT:
-            raise _in_planner_field(scenario, error, message_leads_with_field=False) from error
-        field = ("max_duration",)
-        raise error.relocated(field, locate_in_scenario(
-            scenario, field, f"max_duration: {error}; raise max_duration (at most {MAX_RUN_DURATION:g} s) or the "
-                             "planner's limits")) from error
-    except ValueError as error:
-        raise _in_planner_field(scenario, error, message_leads_with_field=False) from error
-    check_in_cell(scenario, planner)
-    if path is None and getattr(planner, "needs_cell", False):  # it planned in the cell just now
-        path = planner.tool_path()
-    return path
-
-
-def check_in_cell(scenario: Scenario, planner: PlannerSystem, checker: CellChecker | None = None):
-    """The start configuration and the planned motion (``planner.plan()``) in the scenario's
-    cell: joint ranges, self-collision and collision with the cell, with its clearance
-    (:meth:`CellChecker.check <drake_traj.clearance.CellChecker.check>`). A refusal is a
-    :class:`~drake_traj.clearance.CollisionError` or
-    :class:`~drake_traj.clearance.JointRangeError` located at the cell's obstacle, the start
-    configuration or the planner in the scenario file. Returns the
-    :class:`~drake_traj.clearance.MotionCheck`."""
-    checker = checker or scenario.cell_checker()
-    try:
-        check_start_torques(checker, planner.initial_positions(), field=lambda j: _torque_field(scenario, j))
-    except DrakeTrajError as error:
-        raise error.relocated(error.field, locate_in_scenario(scenario, error.field, str(error))) from None
-    try:
-        return checker.check_planner(planner, start_field=("q_initial",) if len(scenario.q_initial) else ("planner",))
-    except DrakeTrajError as error:
-        field = error.field or ("planner",)
-        if field[0] in {item.name for item in fields(scenario.planner)}:  # a planner that plans in the cell: its goals
-            field = ("planner", *field)
-        raise error.relocated(field, locate_in_scenario(scenario, field, str(error))) from None
-
-
-def check_cell_tcp(robot: Robot, cell: Cell) -> None:
-    """A DrakeTrajError at ``cell.tool.tcp_xyz`` (or ``tcp_rpy``) when ``cell``'s tool has another
-    TCP than ``robot`` (:attr:`Robot.tcp_offset`, set by :meth:`Robot.with_tcp`): the planner
-    plans, and the station logs, the robot's TCP, so the cell's would be ignored without a word.
-    Both TCPs named, and how to make them one."""
-    tool = cell.tool
-    given = tool.tcp().GetAsMatrix4()
-    if np.allclose(given, robot.tcp_offset, rtol=0.0, atol=1e-12):
-        return
-    xyz = np.asarray(robot.tcp_offset)[:3, 3]
-    rpy = RollPitchYaw(RotationMatrix(np.asarray(robot.tcp_offset)[:3, :3])).vector()
-    field = ("cell", "tool", "tcp_xyz" if not np.allclose(given[:3, 3], xyz, rtol=0.0, atol=1e-12) else "tcp_rpy")
-
-    def numbers(values) -> str:
-        return "[" + ", ".join(f"{float(value) + 0.0:.6g}" for value in values) + "]"  # + 0.0: no -0
-
-    raise DrakeTrajError(
-        f"{field_text(field)}: the cell's tool has its TCP at tcp_xyz {numbers(tool.tcp_xyz)} m, tcp_rpy "
-        f"{numbers(tool.tcp_rpy)} rad, but the planner's robot {robot.name} has its TCP at xyz {numbers(xyz)} m, rpy "
-        f"{numbers(rpy)} rad (robot.tcp_offset) in the flange frame: the planner plans and the run logs the robot's "
-        "TCP. Make the planner for robot.with_tcp(cell.tool.tcp_xyz, cell.tool.tcp_rpy) (make_planner(config, "
-        "robot.with_tcp(...), q_initial); a scenario's: scenario.robot_with_tool()), or give the cell the robot's TCP",
-        field=field)
-
-
-def check_start_torques(checker: CellChecker, q, field=None) -> None:
-    """A DrakeTrajError (cause SATURATION) when a joint's drive cannot hold the start
-    configuration ``q`` against gravity: the gravity torque there (Drake's
-    ``CalcGravityGeneralizedForces`` in ``checker``'s plant: the robot, its tool and payload) above
-    the joint's effort limit, the first such joint named with both numbers. The drive would
-    saturate from t = 0 and the arm sag, a failure the run would report later as whatever the
-    falling arm hits. ``field(j)`` gives the error's field for joint ``j`` (default: the
-    payload's ``cell.tool.mass`` when there is one, else ``robot``)."""
-    plant, instance, robot = checker.plant, checker.instance, checker.robot
-    context = plant.CreateDefaultContext()
-    plant.SetPositions(context, instance, np.asarray(q, dtype=float))
-    gravity = plant.CalcGravityGeneralizedForces(context)
-    actuators = joint_actuators(plant, instance)
-    mass = float(checker.cell.tool.mass)
-    for j, name in enumerate(robot.joint_names):
-        actuator = actuators.get(name)
-        if actuator is None:
-            continue
-        needed = -float(gravity[actuator.joint().velocity_start()])
-        limit = float(actuator.effort_limit())
-        if abs(needed) <= limit:
-            continue
-        unit = "N m" if robot.joint_unit(j) == "rad" else "N"
-        where = field(j) if field is not None else (("cell", "tool", "mass") if mass > 0 else ("robot",))
-        payload = f" with the tool's {mass:g} kg payload" if mass > 0 else ""
-        raise DrakeTrajError(
-            f"{field_text(where)}: {joint_label(j, robot.joint_names)} of the {robot.name} cannot hold the start "
-            f"configuration against gravity{payload}: it needs {needed:.4g} {unit} there, beyond its effort limit of "
-            f"±{limit:.4g} {unit}, so its drive saturates from t = 0 and the arm falls; raise the effort limit, lighten "
-            "the payload or bring its centre of mass closer to the flange, or start in another configuration",
-            field=where, cause=Cause.SATURATION)
-
-
-def _torque_field(scenario: Scenario, j: int) -> Field:
-    """The field a start that the drives cannot hold is refused at: the arm's own effort limit
-    where the scenario gives it, else the payload where there is one, else the start."""
-    arm = scenario.robot
-    if isinstance(arm, (DhArm, CustomArm)) and len(arm.effort_limits):
-        return ("robot", "effort_limits", j)
-    if scenario.cell.tool.mass > 0:
-        return ("cell", "tool", "mass")
-    return ("q_initial",) if len(scenario.q_initial) else ("robot",)
-
-
-def check_planned_duration(scenario: Scenario, planner: PlannerSystem) -> None:
-    """A :class:`ScenarioError` (cause INFEASIBLE) at ``max_duration`` when it is shorter than
-    the motion ``planner`` plans (at its limits), which the run could never finish."""
-    duration = planner.planned_duration()
-    if np.isfinite(duration) and duration > scenario.max_duration:
-        field = ("max_duration",)
-        raise ScenarioError(locate_in_scenario(
-            scenario, field, f"max_duration ({scenario.max_duration:g} s) is shorter than the planned motion "
-                             f"({duration:.3f} s at the planner's limits); raise max_duration or the limits"),
-            field=field, cause=Cause.INFEASIBLE)
-
-
-def _in_planner_field(scenario: Scenario, error: ValueError, *, message_leads_with_field: bool) -> DrakeTrajError:
+def in_planner_field(scenario: Scenario, error: ValueError, *, message_leads_with_field: bool) -> DrakeTrajError:
     """``error`` from the scenario's planner, located at the planner field it names (a field of
     the planner's config) or at ``planner``. ``message_leads_with_field``: the error's text
     begins with its field's name (the config checks: "waypoints[2] must ...") and is continued
