@@ -2,14 +2,19 @@
 naming its field, with nothing run)."""
 
 import textwrap
+from dataclasses import dataclass, field
 
 import numpy as np
 import pytest
+from pydrake.common import MemoryFile
+from pydrake.geometry import Box as DrakeBox
+from pydrake.geometry import Convex, InMemoryMesh
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_traj import load_scenario
-from drake_traj.cell import Box, Cell, Cylinder, Pedestal, Sphere, Tool, add_cell
+from drake_traj.cell import (Box, Cell, CellChecker, CollisionError, Cylinder, NoMounting, Obstacle, Pedestal, Sphere,
+                             Tool, add_cell, refusal_figure, shape_outline)
 from drake_traj.errors import Cause, DrakeTrajError
 from drake_traj.robots import UR10E
 from drake_traj.robots.ur10e import dh_frames
@@ -204,7 +209,7 @@ def test_a_directives_model_welded_to_nothing_is_refused_at_its_directive(tmp_pa
     import subprocess
     import sys
 
-    from drake_traj.scenario.scenario import check_in_cell, make_planner
+    from drake_traj.scenario import check_in_cell, make_planner
 
     (tmp_path / "block.sdf").write_text(BLOCK_SDF)
     path = scenario_file(tmp_path, """\
@@ -335,7 +340,7 @@ def test_a_directives_arm_beside_the_robot_is_refused_at_its_directive(tmp_path,
     from drake_traj.data import data_directory
 
     MODELS = data_directory("models")
-    from drake_traj.scenario.scenario import check_in_cell, make_planner
+    from drake_traj.scenario import check_in_cell, make_planner
 
     path = scenario_file(tmp_path, f"cell:\n  directives:\n  - add_model: {{name: arm2, file: "
                                    f"{MODELS / 'boryga_anthropomorphic.urdf'}}}\n  " + weld)
@@ -344,3 +349,113 @@ def test_a_directives_arm_beside_the_robot_is_refused_at_its_directive(tmp_path,
         check_in_cell(scenario, make_planner(scenario)) if how == "check" else simulate(scenario)
     assert caught.value.field == ("cell", "directives", 0)
     assert str(caught.value).startswith(f"{path}, line 6")
+
+
+@pytest.mark.parametrize("obstacle, farthest, half", [
+    # independent: the farthest corner of the box, the farthest point of the cylinder's rims, the sphere's
+    # radius; the half extents along the shape's axes
+    (Box(size=[0.3, 0.2, 0.25], xyz=[2.0, 0.5, 0.4], rpy=[0.3, -0.2, 1.0]),
+     max(np.linalg.norm([x, y, z]) for x in (-0.15, 0.15) for y in (-0.1, 0.1) for z in (-0.125, 0.125)),
+     [0.15, 0.1, 0.125]),
+    (Cylinder(radius=0.04, length=0.3, xyz=[2.0, -0.5, 0.3], rpy=[1.2, 0.0, 0.4]),
+     max(np.linalg.norm([0.04 * np.cos(a), 0.04 * np.sin(a), z]) for a in np.linspace(0, 2 * np.pi, 73) for z in (-0.15, 0.15)),
+     [0.04, 0.04, 0.15]),
+    (Sphere(radius=0.12, xyz=[-2.0, 0.0, 0.5]), 0.12, [0.12, 0.12, 0.12]),
+], ids=["box", "cylinder", "sphere"])
+def test_each_obstacle_shape_bounds_itself_and_outlines_its_own_surface(obstacle, farthest, half):
+    name = ("cell", "obstacles", 0)
+    assert obstacle.bounding_radius(name) == pytest.approx(farthest, abs=1e-12)
+    outline = obstacle.outline()
+    points = np.vstack(outline)
+    # the outline reaches the bounding sphere (its corners, rims, great circles) and spans the shape
+    assert np.linalg.norm(points, axis=1).max() == pytest.approx(farthest, abs=1e-12)
+    shape = obstacle.shape(name)
+    assert np.allclose(points.max(axis=0), half) and np.allclose(points.min(axis=0), np.negative(half))
+    # every point of it on the shape's surface, as Drake's own geometry in the cell has it (pose included)
+    checker = CellChecker(UR10E, Cell(mounting=NoMounting(), obstacles=[obstacle]))
+    query = checker.pose_query(UR10E.home_configuration)
+    pose = obstacle.pose(name)
+    for point in pose.multiply(points.T).T:
+        (distance,) = [d.distance for d in query.ComputeSignedDistanceToPoint(point, 0.1)
+                       if checker.owner(d.id_G)[1] == checker.cell.obstacle_name(0)]
+        assert abs(distance) < 1e-9
+    assert [line.tolist() for line in outline] == [line.tolist() for line in shape_outline(shape)]  # as Drake's shape
+
+
+@pytest.mark.parametrize("cell, field, words", [
+    (Cell(obstacles=[Box(), "a cone"]), ("cell", "obstacles", 1), "'a cone' is not an obstacle shape"),
+    (Cell(tool=Tool(shapes=[DrakeBox(0.1, 0.1, 0.2)])), ("cell", "tool", "shapes", 0),
+     r"Box\(width=0\.1, depth=0\.1, height=0\.2\) is not an obstacle shape \(Box, Cylinder, Sphere, or a subclass of "
+     r"drake_traj\.cell\.Obstacle\)"),
+])
+def test_an_object_that_is_not_an_obstacle_shape_is_refused_naming_it(cell, field, words):
+    for check in (cell.validate, lambda: plant_with(cell)):
+        with pytest.raises(DrakeTrajError, match=words) as caught:
+            check()
+        assert caught.value.field == field and caught.value.cause is Cause.INVALID
+
+
+def test_an_obstacle_shape_without_an_outline_cannot_be_made():
+    @dataclass
+    class Shapeless(Obstacle):
+        name: str = ""
+
+        def shape(self, name):
+            return DrakeBox(0.1, 0.1, 0.1)
+
+    with pytest.raises(TypeError, match="abstract method.*outline"):
+        Shapeless()
+
+
+@dataclass
+class Cone(Obstacle):
+    """A toy obstacle shape, defined here the way one adds a shape: an upright cone, its base a
+    circle of ``radius`` [m] in its frame's x-y plane, its apex ``height`` [m] above."""
+
+    name: str = ""
+    radius: float = 0.1
+    height: float = 0.3
+    xyz: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    rpy: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+    def _rim(self, count: int = 32) -> np.ndarray:
+        angles = np.linspace(0.0, 2.0 * np.pi, count + 1)
+        return np.column_stack([self.radius * np.cos(angles), self.radius * np.sin(angles), np.zeros_like(angles)])
+
+    def shape(self, name):
+        vertices = [[0.0, 0.0, self.height]] + self._rim()[:-1].tolist()
+        faces = [f"f 1 {k + 2} {(k + 1) % (len(vertices) - 1) + 2}" for k in range(len(vertices) - 1)]
+        obj = "\n".join([f"v {x} {y} {z}" for x, y, z in vertices] + faces) + "\n"
+        return Convex(InMemoryMesh(mesh_file=MemoryFile(obj, ".obj", "cone.obj")))
+
+    def outline(self):
+        apex = np.array([0.0, 0.0, self.height])
+        return [self._rim()] + [np.array([point, apex]) for point in self._rim(4)[:-1]]
+
+
+def test_an_obstacle_shape_is_one_class(tmp_path):
+    """The recipe: a shape defined as one subclass of Obstacle (its Drake shape and its outline)
+    is added to the plant, bounds itself, is checked (a motion through it refused) and drawn."""
+    from drake_traj.scenario import make_planner
+
+    plan = make_planner(load_scenario(scenario_file(tmp_path, ""))).plan()
+    centre = UR10E.tool_position(plan.value(0.5 * plan.end_time()).ravel())  # where the tool passes
+    cone = Cone(name="cone", radius=0.05, height=0.15, xyz=(centre - [0.0, 0.0, 0.05]).tolist())
+    assert cone.bounding_radius(("cell", "obstacles", 0)) == pytest.approx(0.15)  # its apex
+    assert shape_outline(cone.shape(("cell", "obstacles", 0))) == []  # Drake's convex shape is not drawn as such
+    _, _, fields = plant_with(Cell(obstacles=[cone]))
+    assert fields == {"table": ("cell", "mounting"), "cone": ("cell", "obstacles", 0)}
+    checker = CellChecker(UR10E, Cell(obstacles=[cone]))
+    planner = make_planner(load_scenario(scenario_file(tmp_path, "")))
+    with pytest.raises(CollisionError) as caught:
+        checker.check_planner(planner)
+    error = caught.value
+    assert "cone" in error.bodies and error.field == ("cell", "obstacles", 0)
+    figure = refusal_figure(checker, error)
+    pose = cone.pose(("cell", "obstacles", 0))
+    for axes, (u, v) in zip(figure.axes, ((0, 2), (0, 1))):
+        drawn = [(np.column_stack(line.get_data()), line.get_color()) for line in axes.get_lines()]
+        for outline in cone.outline():  # each of its lines drawn, red (a body of the refusal)
+            points = pose.multiply(outline.T).T[:, [u, v]]
+            assert any(colour == "tab:red" and data.shape == points.shape and np.allclose(data, points)
+                       for data, colour in drawn)

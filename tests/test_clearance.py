@@ -19,7 +19,7 @@ from drake_traj.errors import Cause
 from drake_traj.station import draw_refusal
 from drake_traj.planners import QuinticConfig, make_planner as planner_from_config
 from drake_traj.robots import UR10E
-from drake_traj.scenario.scenario import check_in_cell, preflight, shipped_scenarios
+from drake_traj.scenario import check_in_cell, preflight, shipped_scenarios
 
 from conftest import DIAGRAMS
 
@@ -52,7 +52,7 @@ def test_the_reach_bounds_every_point_speed(checker):
     from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
     from pydrake.systems.framework import DiagramBuilder
 
-    from drake_traj.cell.clearance import _bounding_radius
+    from drake_traj.cell.shapes import shape_radius as _bounding_radius
 
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)

@@ -10,7 +10,8 @@ import pytest
 from pydrake.geometry import Role
 
 from drake_traj import get_robot, load_scenario, simulate
-from drake_traj.cell.clearance import CellChecker, CollisionError, _bounding_radius
+from drake_traj.cell.clearance import CellChecker, CollisionError
+from drake_traj.cell.shapes import shape_radius as _bounding_radius
 from drake_traj.data import data_directory
 from drake_traj.errors import DrakeTrajError
 from drake_traj.robots.chain_arm import ChainArm

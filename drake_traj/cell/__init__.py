@@ -1,11 +1,15 @@
 """The robot's cell and the checks that keep every motion clear of it: the cell as a scenario
 describes it (:mod:`.cell`: mounting, obstacles, directives, tool) and its geometry in a plant,
-the check of a planned motion (:mod:`.clearance`), the guard that every route into a station
-passes (:mod:`.guard`) and the picture of a refused configuration (:mod:`.refusal`)."""
+its obstacle shapes and the geometry of Drake's shapes (:mod:`.shapes`), the user's own models
+(:mod:`.directives`), the check of a planned motion (:mod:`.clearance`), the guard that every
+route into a station passes (:mod:`.guard`) and the picture of a refused configuration
+(:mod:`.refusal`)."""
 
-from drake_traj.cell.cell import (Box, Cell, Cylinder, DEFAULT_CLEARANCE, NoMounting, Obstacle, Pedestal, Sphere, Table, Tool, add_cell, refuse_free_bodies)
+from drake_traj.cell.cell import (Cell, DEFAULT_CLEARANCE, NoMounting, Pedestal, Table, Tool, add_cell)
 from drake_traj.cell.clearance import (CellChecker, CollisionError, Contact, JointRangeError, MotionCheck, geometry_owner, joint_reach, planner_target_word)
+from drake_traj.cell.directives import (refuse_free_bodies)
 from drake_traj.cell.guard import (ClearanceWatch, MotionGuard, UncheckedMotionError)
 from drake_traj.cell.refusal import (refusal_figure)
+from drake_traj.cell.shapes import (Box, Cylinder, Obstacle, ObstacleShape, Sphere, shape_outline, shape_radius)
 
-__all__ = ['Box', 'Cell', 'CellChecker', 'ClearanceWatch', 'CollisionError', 'Contact', 'Cylinder', 'DEFAULT_CLEARANCE', 'JointRangeError', 'MotionCheck', 'MotionGuard', 'NoMounting', 'Obstacle', 'Pedestal', 'Sphere', 'Table', 'Tool', 'UncheckedMotionError', 'add_cell', 'geometry_owner', 'joint_reach', 'planner_target_word', 'refusal_figure', 'refuse_free_bodies']
+__all__ = ['Box', 'Cell', 'CellChecker', 'ClearanceWatch', 'CollisionError', 'Contact', 'Cylinder', 'DEFAULT_CLEARANCE', 'JointRangeError', 'MotionCheck', 'MotionGuard', 'NoMounting', 'Obstacle', 'ObstacleShape', 'Pedestal', 'Sphere', 'Table', 'Tool', 'UncheckedMotionError', 'add_cell', 'geometry_owner', 'joint_reach', 'planner_target_word', 'refusal_figure', 'refuse_free_bodies', 'shape_outline', 'shape_radius']

@@ -25,12 +25,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import Box, Capsule, Convex, Cylinder, Ellipsoid, Mesh, Role, Sphere
+from pydrake.geometry import Role
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import Trajectory
 
-from drake_traj.cell.cell import Cell, add_cell, refuse_free_bodies
+from drake_traj.cell.cell import Cell, add_cell
+from drake_traj.cell.directives import refuse_free_bodies
+from drake_traj.cell.shapes import shape_radius
 from drake_traj.errors import Cause, DrakeTrajError, Field, PlanningError, joint_label
 from drake_traj.robots import Robot
 from drake_traj.validation import MAX_RUN_DURATION
@@ -104,24 +106,6 @@ def planner_target_word(planner) -> str:
     return str(getattr(planner, "target_word", "waypoint"))
 
 
-def _bounding_radius(shape) -> float:
-    """The radius [m] of a sphere about the shape's frame origin that contains it."""
-    if isinstance(shape, Sphere):
-        return shape.radius()
-    if isinstance(shape, Box):
-        return 0.5 * float(np.linalg.norm([shape.width(), shape.depth(), shape.height()]))
-    if isinstance(shape, Cylinder):
-        return float(np.hypot(shape.radius(), 0.5 * shape.length()))
-    if isinstance(shape, Capsule):
-        return shape.radius() + 0.5 * shape.length()
-    if isinstance(shape, Ellipsoid):
-        return max(shape.a(), shape.b(), shape.c())
-    if isinstance(shape, (Mesh, Convex)):  # checked as its convex hull (Drake's): the hull's farthest vertex
-        hull = shape.GetConvexHull()
-        return max(float(np.linalg.norm(hull.vertex(k))) for k in range(hull.num_vertices()))
-    raise TypeError(f"no bounding radius for a {type(shape).__name__} on the robot: use primitive shapes or meshes")
-
-
 def unprotected_links(plant, instance, joint_names) -> list[str]:
     """The links of a finalized plant's arm (each joint's child and the bodies welded to it) that
     have no collision geometry: the self and cell checks cannot see them."""
@@ -166,7 +150,7 @@ def joint_reach(plant, scene_graph, plant_context, instance, joint_names) -> np.
             X_OB = origin.InvertAndCompose(body.body_frame().CalcPoseInWorld(plant_context))
             for geometry in plant.GetCollisionGeometriesForBody(body):
                 X_OG = X_OB @ inspector.GetPoseInFrame(geometry)
-                bound = max(bound, float(np.linalg.norm(X_OG.translation())) + _bounding_radius(inspector.GetShape(geometry)))
+                bound = max(bound, float(np.linalg.norm(X_OG.translation())) + shape_radius(inspector.GetShape(geometry)))
         if j + 1 < len(joints):
             following = joints[j + 1]
             offset = origin.InvertAndCompose(following.frame_on_parent().CalcPoseInWorld(plant_context)).translation()
@@ -201,7 +185,7 @@ def link_reach(plant, scene_graph, instance, joint_names) -> tuple[np.ndarray, d
             for geometry in plant.GetCollisionGeometriesForBody(body):
                 links[geometry] = j + 1
                 X_OG = X_OB @ inspector.GetPoseInFrame(geometry)
-                bound = max(bound, float(np.linalg.norm(X_OG.translation())) + _bounding_radius(inspector.GetShape(geometry)))
+                bound = max(bound, float(np.linalg.norm(X_OG.translation())) + shape_radius(inspector.GetShape(geometry)))
         reach[j + 1, j] = bound
         for k in reversed(range(j)):  # the joints before it: its origin's offset to the next joint's, and on
             offset = origins[k].InvertAndCompose(joints[k + 1].frame_on_parent().CalcPoseInWorld(context)).translation()

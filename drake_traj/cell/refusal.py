@@ -3,35 +3,31 @@ the two bodies in red and their closest points marked (matplotlib, two views).""
 
 import numpy as np
 from matplotlib.figure import Figure
-from pydrake.geometry import Box, Capsule, Cylinder, Role, Sphere
+from pydrake.geometry import Role
 
+from drake_traj.cell.cell import TOOL_BODY
 from drake_traj.cell.clearance import CellChecker, CollisionError
+from drake_traj.cell.shapes import shape_outline
 
 __all__ = ["refusal_figure"]
 
-_CIRCLE = np.linspace(0.0, 2.0 * np.pi, 33)
 
-
-def _outline(shape) -> list[np.ndarray]:
-    """Polylines (k, 3) [m] in the shape's frame that outline it: a box's edges, a cylinder's
-    or capsule's end circles and four sides, a sphere's three great circles."""
-    ring = np.column_stack([np.cos(_CIRCLE), np.sin(_CIRCLE), np.zeros_like(_CIRCLE)])
-    if isinstance(shape, Box):
-        half = 0.5 * np.array([shape.width(), shape.depth(), shape.height()])
-        corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
-        edges = [(a, b) for a in range(8) for b in range(a + 1, 8) if np.sum(np.abs(corners[a] - corners[b]) > 0) == 1]
-        return [corners[[a, b]] for a, b in edges]
-    if isinstance(shape, (Cylinder, Capsule)):
-        radius, half = shape.radius(), 0.5 * shape.length()
-        lines = [ring * radius + [0, 0, z] for z in (-half, half)]
-        lines += [np.array([[radius * np.cos(a), radius * np.sin(a), -half], [radius * np.cos(a), radius * np.sin(a), half]])
-                  for a in (0, 0.5 * np.pi, np.pi, 1.5 * np.pi)]
-        if isinstance(shape, Capsule):
-            lines += [ring * radius + [0, 0, z] for z in (-half - radius, half + radius)]
-        return lines
-    if isinstance(shape, Sphere):
-        return [ring[:, order] * shape.radius() for order in ([0, 1, 2], [0, 2, 1], [2, 0, 1])]
-    return []
+def _outline(checker: CellChecker, geometry) -> list[np.ndarray]:
+    """Polylines (k, 3) [m] in the frame of the collision geometry ``geometry`` of ``checker``'s
+    plant that outline it: a cell obstacle's (on the world) or a tool shape's (on the tool body)
+    own :meth:`~drake_traj.cell.shapes.Obstacle.outline`, any other's that of its Drake shape
+    (:func:`~drake_traj.cell.shapes.shape_outline`)."""
+    inspector, plant = checker.scene_graph.model_inspector(), checker.plant
+    body, name = plant.GetBodyFromFrameId(inspector.GetFrameId(geometry)), inspector.GetName(geometry)
+    if body.index() == plant.world_body().index():
+        field = checker.cell_fields.get(name, ())  # the world's geometry names are not scoped
+        if field[:2] == ("cell", "obstacles"):
+            return checker.cell.obstacles[field[2]].outline()
+    elif body.name() == TOOL_BODY and body.model_instance() == checker.instance:
+        field = checker.cell_fields.get(name.removeprefix(f"{plant.GetModelInstanceName(checker.instance)}::"), ())
+        if field[:3] == ("cell", "tool", "shapes"):
+            return checker.cell.tool.shapes[field[3]].outline()
+    return shape_outline(inspector.GetShape(geometry))
 
 
 def refusal_figure(checker: CellChecker, error: CollisionError) -> Figure:
@@ -44,7 +40,7 @@ def refusal_figure(checker: CellChecker, error: CollisionError) -> Figure:
     for geometry in inspector.GetAllGeometryIds(Role.kProximity):
         body, _ = checker.owner(geometry)
         pose = query.GetPoseInWorld(geometry)
-        outlines = [pose.multiply(line.T).T for line in _outline(inspector.GetShape(geometry))]
+        outlines = [pose.multiply(line.T).T for line in _outline(checker, geometry)]
         lines += [(points, body in error.bodies) for points in outlines]
         if checker.plant.HasBodyNamed(body, checker.instance):
             arm += outlines
