@@ -1,8 +1,8 @@
 """Any 6-axis arm of revolute joints under the :class:`~drake_traj.robots.base.Robot` contract:
 :class:`ChainArm`, a :class:`~drake_traj.robots.chain.SerialChain` (its compiled kinematics, the
-numerical IK) with its model file, joint names, limits and gains. A module of its own so that
-:mod:`drake_traj.robots.compiled_kinematics` (which imports :mod:`~drake_traj.robots.chain`) and
-this module import one way.
+numerical IK: :mod:`~drake_traj.robots.chain_kinematics`) with its model file, joint names, limits
+and gains. A module of its own so that :mod:`drake_traj.robots.compiled_kinematics` (which imports
+:mod:`~drake_traj.robots.chain_kinematics`) and this module import one way.
 """
 
 from __future__ import annotations
@@ -19,8 +19,9 @@ from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_
 from drake_traj.robots.model_files import add_model_file, joint_efforts
 from drake_traj.robots import ROBOT_NAMES, arm_checks
 from drake_traj.robots.base import Robot, TaskKinematics, format_point, joint_actuators
-from drake_traj.robots.chain import (NUM_JOINTS, SerialChain, chain_reach, chain_singularity_factors,
-                                     inverse_kinematics_all, inverse_kinematics_near, plant_chain, plant_frame)
+from drake_traj.robots.chain import SerialChain, plant_chain, plant_frame
+from drake_traj.robots.chain_kinematics import (NUM_JOINTS, chain_reach, chain_singularity_factors,
+                                                inverse_kinematics_all, inverse_kinematics_near)
 from drake_traj.robots.compiled_kinematics import task_kinematics as arm_kinematics, task_kinematics_into
 from drake_traj.robots.task_space import orientation_error, pose_error, wrap_angle, wrapped
 from drake_traj.robots.urdf_writer import dh_table_urdf
@@ -77,7 +78,7 @@ class ChainArm(Robot):
             explicitly (``("all",)``: every link); the cell check refuses an arm with such a link
             otherwise, and a run's metrics name them.
 
-    Its :attr:`reach` is the chain's bound :func:`~drake_traj.robots.chain.chain_reach` [m].
+    Its :attr:`reach` is the chain's bound :func:`~drake_traj.robots.chain_kinematics.chain_reach` [m].
     """
 
     joint_types = ("revolute",) * NUM_JOINTS
@@ -340,7 +341,7 @@ class ChainArm(Robot):
     def point_ik(self, points, reference) -> np.ndarray:
         """IK of TCP positions (N, 3) [m] at the TCP orientation of ``reference``, on its branch:
         each point's solution is Newton's from the previous point's (the first's from
-        ``reference``: :func:`~drake_traj.robots.chain.inverse_kinematics_near`, within 0.5 rad
+        ``reference``: :func:`~drake_traj.robots.chain_kinematics.inverse_kinematics_near`, within 0.5 rad
         of it, regular, within the limits); where that fails, the solution of all
         (:meth:`inverse_kinematics_all`) nearest that start (each joint moved by whole turns
         towards it within the limits). Points along a path in order follow one branch."""
@@ -378,7 +379,8 @@ class ChainArm(Robot):
         return qd, np.linalg.solve(jacobian, np.concatenate([a, np.zeros(3)]) - bias)
 
     def task_kinematics(self) -> TaskKinematics:
-        """The compiled kinematics of the chain (:func:`chain_kinematics_into` through
+        """The compiled kinematics of the chain
+        (:func:`~drake_traj.robots.chain_kinematics.chain_kinematics_into` through
         :func:`~drake_traj.robots.compiled_kinematics.task_kinematics_into`, ``model`` =
         :meth:`SerialChain.packed`), the numerical IK within the limits and the one-factor
         singularity factors, of the TCP ``tcp_offset``."""

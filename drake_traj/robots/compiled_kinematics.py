@@ -6,9 +6,9 @@ The Pająk 2024 law is compiled once and cached on disk (:mod:`drake_traj.compil
 
 - :data:`~drake_traj.robots.ur_closed_form.UR_CLOSED_FORM`: the UR e-Series closed form,
   [kind, d1, a2, a3, d4, d5, d6] (:func:`drake_traj.robots.ur_closed_form.kinematics_into`);
-- :data:`~drake_traj.robots.chain.CHAIN`: any serial chain of six revolute joints (standard or
+- :data:`~drake_traj.robots.chain_kinematics.CHAIN`: any serial chain of six revolute joints (standard or
   modified DH, a URDF/SDF read through MultibodyPlant), :meth:`~drake_traj.robots.chain.SerialChain.packed`
-  (:func:`drake_traj.robots.chain.chain_kinematics_into`).
+  (:func:`drake_traj.robots.chain_kinematics.chain_kinematics_into`).
 """
 
 from __future__ import annotations
@@ -18,9 +18,9 @@ import math
 import numpy as np
 
 from drake_traj.compiled import compiled, sources_digest
-from drake_traj.robots import chain, task_space, ur_closed_form
+from drake_traj.robots import chain_kinematics, task_space, ur_closed_form
 from drake_traj.robots.base import FLANGE
-from drake_traj.robots.chain import CHAIN, chain_kinematics_into
+from drake_traj.robots.chain_kinematics import CHAIN, chain_kinematics_into
 from drake_traj.robots.ur_closed_form import UR_CLOSED_FORM
 from drake_traj.robots.ur_closed_form import kinematics_into as ur_kinematics_into
 
@@ -28,7 +28,7 @@ __all__ = ["SOURCES", "kinematics_many", "task_kinematics", "task_kinematics_int
 
 # The source files of the compiled code behind task_kinematics_into: it and its compiled callers
 # (the Pająk kernel) close over their digest, numba's cache key (drake_traj.compiled).
-SOURCES = (__file__, ur_closed_form.__file__, chain.__file__, task_space.__file__)
+SOURCES = (__file__, ur_closed_form.__file__, chain_kinematics.__file__, task_space.__file__)
 _DEPENDENCIES = sources_digest(*SOURCES)
 
 

@@ -1,6 +1,6 @@
 """UR10e: the e-Series arm of Pająk 2024 and of the shipped scenarios, its data and its closed
-form as module-level names (the family's implementation is :mod:`drake_traj.robots.ur_eseries`;
-data and checks: ``docs/ur10e.md``).
+form as module-level names (the family's implementation is :mod:`drake_traj.robots.ur_eseries`,
+its data :mod:`drake_traj.robots.ur_data`; data and checks: ``docs/ur10e.md``).
 
 The functions here are :data:`UR10E`'s methods (:class:`~drake_traj.robots.ur_eseries.URArm`):
 ``dh_frames(q)``, ``task_pose(q, tool)``, ``inverse_kinematics(pose, ...)`` and so on.
@@ -16,9 +16,11 @@ from drake_traj.errors import SingularConfigurationError  # noqa: F401  (callers
 from drake_traj.robots.base import FLANGE  # noqa: F401
 from drake_traj.robots.task_space import (pose_error, rotation_from_zyx_euler, wrap_angle,  # noqa: F401
                                           zyx_euler_from_rotation)
-from drake_traj.robots.ur_eseries import (BASE_FRAME, DEFAULT_JOINT_MOVE_ACCELERATION,  # noqa: F401
-                                          DEFAULT_JOINT_MOVE_VELOCITY, DH_ALPHA, FLANGE_FRAME, HOME,
-                                          IK_BRANCHES, JOINT_NAMES, NUM_JOINTS, UR10E, UR10E_DATA, UR10e)
+from drake_traj.robots.ur_data import (BASE_FRAME, DEFAULT_JOINT_MOVE_ACCELERATION,  # noqa: F401
+                                      DEFAULT_JOINT_MOVE_VELOCITY, DH_ALPHA, FLANGE_FRAME, HOME, JOINT_NAMES,
+                                      NUM_JOINTS, UR10E_DATA)
+from drake_traj.robots.ur_eseries import UR10E, UR10e
+from drake_traj.robots.ur_ik import IK_BRANCHES  # noqa: F401
 
 __all__ = ["UR10E", "UR10e"]
 

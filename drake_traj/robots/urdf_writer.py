@@ -35,7 +35,8 @@ import numpy as np
 
 from drake_traj.data import data_directory
 from drake_traj.robots.chain import NUM_JOINTS, SerialChain, dh_link_frames
-from drake_traj.robots.ur_eseries import DH_ALPHA, JOINT_NAMES, UR10E_DATA, UR_ARMS, URData
+from drake_traj.robots.ur_data import DH_ALPHA, JOINT_NAMES, UR10E_DATA, URData
+from drake_traj.robots.ur_eseries import UR_ARMS
 from drake_traj.validation import invalid
 
 __all__ = ["DH_JOINT_NAMES", "LINK_NAMES", "Shape", "capsule_between", "chain_capsules", "chain_segments", "chain_urdf",
@@ -291,44 +292,69 @@ def chain_urdf(name: str, chain: SerialChain, inertial_frames, *, masses: Sequen
         raise invalid("shapes", f"shapes must have 7 lists (the base and links 1..6), got {len(shapes)}")
     if len(joint_names) != 6:
         raise invalid("joint_names", f"joint_names must name 6 joints, got {len(joint_names)}")
-    parts = [f'<?xml version="1.0"?>\n<!--\n  {name}: written by drake_traj.robots.urdf_writer (do not edit; regenerate).\n'
-             f'  {comment}\n-->\n'
-             f'<robot name="{name}" xmlns:drake="http://drake.mit.edu">\n'
-             '  <material name="blue">\n    <color rgba="0.2 0.4 0.9 1"/>\n  </material>\n'
-             '  <material name="grey">\n    <color rgba="0.75 0.78 0.82 1"/>\n  </material>\n']
     base_mass, base_com, base_inertia = base_inertial
-    parts.append(f'  <link name="{LINK_NAMES[0]}">\n' + _inertial_xml(base_mass, base_com, base_inertia)
-                 + "".join(_shape_xml(s) for s in shapes[0]) + '  </link>\n')
+    parts = [_header_xml(name, comment),
+             _link_xml(LINK_NAMES[0], _inertial_xml(base_mass, base_com, base_inertia), shapes[0])]
     for i in range(6):
-        origin = chain.fixed[i]
-        parts.append(f'  <joint name="{joint_names[i]}" type="revolute">\n'
-                     f'    <parent link="{LINK_NAMES[i]}"/>\n    <child link="{LINK_NAMES[i + 1]}"/>\n'
-                     f'    <origin xyz="{_numbers(origin[:3, 3])}" rpy="{_numbers(_rpy(origin[:3, :3]))}"/>\n'
-                     f'    <axis xyz="{" ".join(_compact(v) for v in chain.axes[i])}"/>\n'
-                     f'    <limit lower="{float(lower[i])!r}" upper="{float(upper[i])!r}" '
-                     f'velocity="{float(velocity[i])!r}" effort="{float(effort[i])!r}"/>\n  </joint>\n')
+        parts.append(_revolute_joint_xml(joint_names[i], i, chain.fixed[i], chain.axes[i],
+                                         (lower[i], upper[i], velocity[i], effort[i])))
         position, rotation = frames[i][:3, 3], frames[i][:3, :3]
-        parts.append(f'  <link name="{LINK_NAMES[i + 1]}">\n'
-                     + _inertial_xml(masses[i], position + rotation @ coms[i], tensors[i], _rpy(rotation))
-                     + "".join(_shape_xml(s) for s in shapes[i + 1]) + '  </link>\n')
+        parts.append(_link_xml(LINK_NAMES[i + 1], _inertial_xml(masses[i], position + rotation @ coms[i], tensors[i],
+                                                                _rpy(rotation)), shapes[i + 1]))
     flange = chain.fixed[6]
     parts.append(f'  <joint name="wrist_3-tool0_fixed_joint" type="fixed">\n    <parent link="{LINK_NAMES[6]}"/>\n'
                  f'    <child link="tool0"/>\n    <origin xyz="{_numbers(flange[:3, 3])}" rpy="{_numbers(_rpy(flange[:3, :3]))}"/>\n'
                  '  </joint>\n  <link name="tool0"/>\n')
-    for joint in joint_names:
-        parts.append(f'  <transmission name="{joint}_transmission">\n'
-                     '    <type>transmission_interface/SimpleTransmission</type>\n'
-                     f'    <joint name="{joint}">\n'
-                     '      <hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>\n'
-                     f'    </joint>\n    <actuator name="{joint}_actuator">\n'
-                     '      <mechanicalReduction>1</mechanicalReduction>\n    </actuator>\n  </transmission>\n')
-    for first, second, reason in filtered_pairs:
-        group = f"{LINK_NAMES[first]}_{LINK_NAMES[second]}"
-        parts.append(f'  <!-- {reason} -->\n  <drake:collision_filter_group name="{group}">\n'
-                     f'    <drake:member link="{LINK_NAMES[first]}"/>\n    <drake:member link="{LINK_NAMES[second]}"/>\n'
-                     f'    <drake:ignored_collision_filter_group name="{group}"/>\n  </drake:collision_filter_group>\n')
+    parts += [_transmission_xml(joint) for joint in joint_names]
+    parts += [_filter_group_xml(first, second, reason) for first, second, reason in filtered_pairs]
     parts.append("</robot>\n")
     return "".join(parts)
+
+
+def _header_xml(name: str, comment: str) -> str:
+    """The URDF's XML declaration, header comment, ``robot`` element and materials."""
+    return (f'<?xml version="1.0"?>\n<!--\n  {name}: written by drake_traj.robots.urdf_writer (do not edit; regenerate).\n'
+            f'  {comment}\n-->\n'
+            f'<robot name="{name}" xmlns:drake="http://drake.mit.edu">\n'
+            '  <material name="blue">\n    <color rgba="0.2 0.4 0.9 1"/>\n  </material>\n'
+            '  <material name="grey">\n    <color rgba="0.75 0.78 0.82 1"/>\n  </material>\n')
+
+
+def _link_xml(name: str, inertial: str, shapes: Sequence[Shape]) -> str:
+    """A ``link`` element: its ``inertial`` XML, then each shape's visual and collision."""
+    return f'  <link name="{name}">\n' + inertial + "".join(_shape_xml(s) for s in shapes) + '  </link>\n'
+
+
+def _revolute_joint_xml(name: str, i: int, origin: np.ndarray, axis, limits) -> str:
+    """Joint i+1 (0-based ``i``) from link ``LINK_NAMES[i]`` to the next: at ``origin`` (4x4 [m]) in
+    its parent, about ``axis`` (in the joint frame), with ``limits`` (lower [rad], upper [rad],
+    velocity [rad/s], effort [N m])."""
+    lower, upper, velocity, effort = (float(v) for v in limits)
+    return (f'  <joint name="{name}" type="revolute">\n'
+            f'    <parent link="{LINK_NAMES[i]}"/>\n    <child link="{LINK_NAMES[i + 1]}"/>\n'
+            f'    <origin xyz="{_numbers(origin[:3, 3])}" rpy="{_numbers(_rpy(origin[:3, :3]))}"/>\n'
+            f'    <axis xyz="{" ".join(_compact(v) for v in axis)}"/>\n'
+            f'    <limit lower="{lower!r}" upper="{upper!r}" velocity="{velocity!r}" effort="{effort!r}"/>\n'
+            '  </joint>\n')
+
+
+def _transmission_xml(joint: str) -> str:
+    """The transmission of ``joint`` to its effort actuator ``{joint}_actuator``."""
+    return (f'  <transmission name="{joint}_transmission">\n'
+            '    <type>transmission_interface/SimpleTransmission</type>\n'
+            f'    <joint name="{joint}">\n'
+            '      <hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>\n'
+            f'    </joint>\n    <actuator name="{joint}_actuator">\n'
+            '      <mechanicalReduction>1</mechanicalReduction>\n    </actuator>\n  </transmission>\n')
+
+
+def _filter_group_xml(first: int, second: int, reason: str) -> str:
+    """A ``drake:collision_filter_group`` of bodies ``first`` and ``second`` (0 = base) that ignores
+    itself, after a comment with the ``reason``."""
+    group = f"{LINK_NAMES[first]}_{LINK_NAMES[second]}"
+    return (f'  <!-- {reason} -->\n  <drake:collision_filter_group name="{group}">\n'
+            f'    <drake:member link="{LINK_NAMES[first]}"/>\n    <drake:member link="{LINK_NAMES[second]}"/>\n'
+            f'    <drake:ignored_collision_filter_group name="{group}"/>\n  </drake:collision_filter_group>\n')
 
 
 DH_JOINT_NAMES = tuple(f"joint_{i}" for i in range(1, NUM_JOINTS + 1))  # the joints of an arm from a DH table

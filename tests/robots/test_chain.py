@@ -11,8 +11,9 @@ from pydrake.multibody.tree import FixedOffsetFrame, PrismaticJoint, RevoluteJoi
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
 from drake_traj.planners.pajak import PajakLaw
 from drake_traj.robots import get_robot, ur10e
-from drake_traj.robots.chain import (CHAIN, SerialChain, chain_singularity_factors,
-                                     inverse_kinematics_all, inverse_kinematics_near)
+from drake_traj.robots.chain import SerialChain
+from drake_traj.robots.chain_kinematics import (CHAIN, chain_singularity_factors, inverse_kinematics_all,
+                                                inverse_kinematics_near)
 from drake_traj.robots.chain_arm import ChainArm
 from drake_traj.robots.compiled_kinematics import task_kinematics, task_kinematics_into
 from drake_traj.robots.task_space import wrap_angle, zyx_euler_from_rotation

@@ -17,7 +17,7 @@ from drake_traj.cell import Cell, CellChecker, Tool
 from drake_traj.errors import DrakeTrajError
 from drake_traj.robots import ROBOT_NAMES, UR10E, UR_ARMS, get_robot
 from drake_traj.robots.task_space import rotation_from_zyx_euler, wrap_angle
-from drake_traj.robots.ur_eseries import UR10E_DATA
+from drake_traj.robots.ur_data import UR10E_DATA
 from drake_traj.robots.urdf_writer import Shape, dh_arm_urdf, dh_capsules, ur_urdf
 
 ARMS = {arm.name: arm for arm in UR_ARMS}
