@@ -61,12 +61,22 @@ TOOL_COLOUR = Rgba(0.3, 0.3, 0.3, 1.0)
 TOOL_BODY = "tool"  # the body welded to the flange that carries the tool's shapes and payload
 
 
+_MOUNTING = ("cell", "mounting")  # the field of the mounting's errors
+
+
 @dataclass
 class Table:
     """A table top flush with the robot's base: its top face is z = 0, ``size`` = [length x,
     width y, thickness] [m], centred on the base."""
 
     size: list[float] = field(default_factory=lambda: [*TABLE_TOP_SIZE, 0.05])
+
+    def shapes(self) -> list[tuple[str, object, RigidTransform]]:
+        """(name, Drake shape, pose in the world) of the table top; its top is z = 0."""
+        length, width, thickness = field_vector(self.size, _MOUNTING + ("size",), 3, "m")
+        for k, edge in enumerate((length, width, thickness)):
+            field_size(edge, _MOUNTING + ("size", k))
+        return [("table", BoxShape(length, width, thickness), RigidTransform([0.0, 0.0, -0.5 * thickness]))]
 
 
 @dataclass
@@ -78,10 +88,25 @@ class Pedestal:
     height: float = 0.6
     floor_size: list[float] = field(default_factory=lambda: list(TABLE_TOP_SIZE))
 
+    def shapes(self) -> list[tuple[str, object, RigidTransform]]:
+        """(name, Drake shape, pose in the world) of the pedestal and the floor; the pedestal's top is z = 0."""
+        radius, height = field_size(self.radius, _MOUNTING + ("radius",)), field_size(self.height, _MOUNTING + ("height",))
+        length, width = field_vector(self.floor_size, _MOUNTING + ("floor_size",), 2, "m")
+        for k, edge in enumerate((length, width)):
+            field_size(edge, _MOUNTING + ("floor_size", k))
+        floor_thickness = 0.05
+        return [("pedestal", CylinderShape(radius, height), RigidTransform([0.0, 0.0, -0.5 * height])),
+                ("floor", BoxShape(length, width, floor_thickness),
+                 RigidTransform([0.0, 0.0, -height - 0.5 * floor_thickness]))]
+
 
 @dataclass
 class NoMounting:
     """Nothing under or around the base (the papers' free-standing arm)."""
+
+    def shapes(self) -> list[tuple[str, object, RigidTransform]]:
+        """No shapes."""
+        return []
 
 
 Mounting = Union[Table, Pedestal, NoMounting]
@@ -196,7 +221,7 @@ class Cell:
         clearance = field_vector([self.clearance], ("cell", "clearance"), 1, "m")[0]
         if clearance < 0:
             raise invalid("cell.clearance", f"cell.clearance must be >= 0 m, got {self.clearance}")
-        _mounting_shapes(self.mounting)
+        self.mounting.shapes()
         _validate_shapes(self.obstacles, ("cell", "obstacles"))
         self.tool.tcp()
         _validate_shapes(self.tool.shapes, ("cell", "tool", "shapes"))
@@ -215,26 +240,6 @@ def _validate_shapes(shapes: list, where: Field) -> None:
         name = where + (index,)
         checked_obstacle(shape, name).shape(name)
         shape.pose(name)
-
-
-def _mounting_shapes(mounting: Mounting) -> list[tuple[str, object, RigidTransform]]:
-    """(name, shape, pose in the world) of the mounting's parts; their tops are z = 0."""
-    name = ("cell", "mounting")
-    if isinstance(mounting, Table):
-        length, width, thickness = field_vector(mounting.size, name + ("size",), 3, "m")
-        for k, edge in enumerate((length, width, thickness)):
-            field_size(edge, name + ("size", k))
-        return [("table", BoxShape(length, width, thickness), RigidTransform([0.0, 0.0, -0.5 * thickness]))]
-    if isinstance(mounting, Pedestal):
-        radius, height = field_size(mounting.radius, name + ("radius",)), field_size(mounting.height, name + ("height",))
-        length, width = field_vector(mounting.floor_size, name + ("floor_size",), 2, "m")
-        for k, edge in enumerate((length, width)):
-            field_size(edge, name + ("floor_size", k))
-        floor_thickness = 0.05
-        return [("pedestal", CylinderShape(radius, height), RigidTransform([0.0, 0.0, -0.5 * height])),
-                ("floor", BoxShape(length, width, floor_thickness),
-                 RigidTransform([0.0, 0.0, -height - 0.5 * floor_thickness]))]
-    return []
 
 
 def _proximity() -> ProximityProperties:
@@ -270,7 +275,7 @@ def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, robot: Robot 
     cell.validate(robot)
     world = plant.world_body()
     fields = {}
-    for name, shape, pose in _mounting_shapes(cell.mounting):
+    for name, shape, pose in cell.mounting.shapes():
         _register(plant, world, pose, shape, name, MOUNTING_COLOUR)
         fields[name] = ("cell", "mounting")
     for index, obstacle in enumerate(cell.obstacles):
