@@ -101,7 +101,7 @@ def nonnegative_scalar(value, name: str, unit: str) -> float:
 def tracking_tolerance_check(tracking_tolerance, clearance) -> None:
     """Refuse a ``tracking_tolerance`` [m] larger than half the cell's ``clearance`` [m] (equal
     is allowed; None, no tracking check, passes): the cell check keeps at least half the
-    clearance everywhere along the planned reference (:mod:`drake_traj.clearance`), so an arm
+    clearance everywhere along the planned reference (:mod:`drake_traj.cell.clearance`), so an arm
     that may stray further than that from its reference may touch what the check cleared. A
     :class:`~drake_traj.errors.DrakeTrajError` (a ValueError, ``field`` ``("tracking_tolerance",)``)
     naming both in mm and what to change; also for either value malformed."""

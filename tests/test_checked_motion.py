@@ -1,6 +1,6 @@
 """Every motion that runs is the motion that was checked: every route into a station checks the
 plan against the station's own scene before anything moves, and the measured motion is watched
-while it runs (drake_traj.guard)."""
+while it runs (drake_traj.cell.guard)."""
 
 import numpy as np
 import pytest

@@ -1,5 +1,5 @@
 """What leaves the process (run folders, exports, benches) goes through one writer
-(drake_traj.output): two writers of one folder, a full disk, a symbolic link out of the folder,
+(drake_traj.results.output): two writers of one folder, a full disk, a symbolic link out of the folder,
 another run's or bench's folder, a read-only folder, a deleted working folder. In each, nothing
 the user had is lost, nothing partial is left, and the message names the reason."""
 

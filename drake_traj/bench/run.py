@@ -47,7 +47,7 @@ def _check_arguments(count, seed, repeats, workers, scheduler, planners, extra_p
 
 
 def _claim_output_directory(out_dir, overwrite: bool, command: str | None):
-    """``out_dir`` claimed for this bench (:func:`drake_traj.output.claim`): created, writable,
+    """``out_dir`` claimed for this bench (:func:`drake_traj.results.output.claim`): created, writable,
     not a run's folder, not an earlier bench's unless ``overwrite``, locked; BenchSetupError if
     not (if it is or lies below a file, say)."""
     out_dir = Path(out_dir)
@@ -65,7 +65,7 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers:
     Args:
         out_dir: output directory (created; must not be or lie below a file, nor hold a run, an
             earlier bench or other files). The files are written whole beside the earlier ones
-            and replace them only once complete on disk (:mod:`drake_traj.output`).
+            and replace them only once complete on disk (:mod:`drake_traj.results.output`).
         count: seeded random tasks besides the paper task (>= 0).
         seed: seed of the random tasks (>= 0).
         repeats: planning-time repeats on the paper task (>= 1).
@@ -97,7 +97,7 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers:
 
     Raises:
         BenchSetupError: a bad argument, output directory or scheduler, before any run.
-        drake_traj.output.WriteError: the files could not be written (disk full, ...); the
+        drake_traj.results.output.WriteError: the files could not be written (disk full, ...); the
             earlier content of ``out_dir`` is intact.
     """
     planners, extra_planners = tuple(planners), dict(extra_planners or {})

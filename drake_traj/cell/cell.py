@@ -21,7 +21,7 @@ Frames: the world frame is the robot's base frame (the UR10e's DH frame 0, z up;
 on z = 0). Obstacles and the mounting are posed in it; the tool's shapes, TCP and centre of
 mass in the flange frame (``tool0``). :func:`add_cell` registers all of it in a
 ``MultibodyPlant`` before it is finalized: the same geometry serves the check before the motion
-(:mod:`drake_traj.clearance`) and the contact of the simulated arm (:mod:`drake_traj.station`).
+(:mod:`drake_traj.cell.clearance`) and the contact of the simulated arm (:mod:`drake_traj.station`).
 The obstacle shapes are :mod:`drake_traj.cell.shapes`'s, the directives are checked and added
 by :mod:`drake_traj.cell.directives`.
 """
@@ -201,7 +201,7 @@ class Cell:
             model files; a relative ``file`` is taken from the scenario file's folder. Offline
             only: a ``package://`` URL resolves through ``packages`` and ``ROS_PACKAGE_PATH``.
         packages: {package name: folder} for the directives' ``package://`` URLs (folders
-            relative to the scenario file's; :mod:`drake_traj.model_files`).
+            relative to the scenario file's; :mod:`drake_traj.robots.model_files`).
         tool: the tool on the flange.
         clearance: the distance [m] a planned motion keeps from the cell and from the arm itself
             (default :data:`DEFAULT_CLEARANCE`).
@@ -268,7 +268,7 @@ def add_cell(plant: MultibodyPlant, cell: Cell, robot_instance, *, robot: Robot 
     mounting's parts, the obstacles, the tool's shapes) and {body scoped name
     (``bin::base``): ``("cell", "directives", k)``} of the bodies each directive ``k`` adds, for
     errors that name an obstacle (:meth:`CellChecker.field_of
-    <drake_traj.clearance.CellChecker.field_of>`, :func:`refuse_free_bodies`). Raises
+    <drake_traj.cell.clearance.CellChecker.field_of>`, :func:`refuse_free_bodies`). Raises
     DrakeTrajError naming the field of a malformed part, a model file that is missing or cannot
     be parsed, or a directive naming an unknown frame or model.
     """

@@ -529,5 +529,5 @@ class CellChecker:
         self.check_configuration(planner.initial_positions(), field=start_field)
         accepted = self.check(planner.plan(), waypoints=planner.task_waypoints(),
                               target_word=planner_target_word(planner))
-        planner.checked_scenes.add(self.fingerprint)  # a station of this scene may run it (drake_traj.guard)
+        planner.checked_scenes.add(self.fingerprint)  # a station of this scene may run it (drake_traj.cell.guard)
         return accepted

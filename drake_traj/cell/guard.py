@@ -2,11 +2,11 @@
 
 A station (:func:`~drake_traj.station.add_station`) gives its planner a :class:`MotionGuard`: the
 robot, the cell, the bodies added by ``before_finalize`` and the fingerprint of the station
-plant's collision scene (:func:`~drake_traj.clearance.scene_fingerprint`). Before the motion
+plant's collision scene (:func:`~drake_traj.cell.clearance.scene_fingerprint`). Before the motion
 starts, by :func:`~drake_traj.station.run_station` or by the planner's initialization event in
 one's own ``Simulator``, the guard makes sure the planner's plan was accepted by the cell check
 against that very scene (:meth:`CellChecker.check_planner
-<drake_traj.clearance.CellChecker.check_planner>` records the fingerprints it checked on the
+<drake_traj.cell.clearance.CellChecker.check_planner>` records the fingerprints it checked on the
 planner), and checks it there where it was not: a motion that would hit the arm itself, its
 tool or its cell is refused before it starts, whatever route started it. Only an explicit
 ``check_motion=False`` (``simulate(..., preflight=False)``) runs a plan unchecked.
@@ -52,10 +52,10 @@ class MotionGuard:
         cell: the station's cell and tool.
         directory: where ``cell.directives``' relative files are read from.
         before_finalize: the station's ``before_finalize(plant, scene_graph)``, or None.
-        fingerprint: the station plant's collision scene (:func:`~drake_traj.clearance.scene_fingerprint`).
+        fingerprint: the station plant's collision scene (:func:`~drake_traj.cell.clearance.scene_fingerprint`).
         check_motion: False only where the user asked for an unchecked run.
         unprotected_links: the robot's links without collision shapes, which the robot says may run
-            unprotected (the cell check refuses any other: :func:`~drake_traj.clearance.refuse_unprotected_links`).
+            unprotected (the cell check refuses any other: :func:`~drake_traj.cell.clearance.refuse_unprotected_links`).
         preflight: ``preflight(planner, horizon)``, the scenario's preflight and cell check where
             the station was made from a scenario (a refusal then located in its file:
             :func:`drake_traj.scenario.preflight`), or None.

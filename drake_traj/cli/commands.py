@@ -171,7 +171,7 @@ def _run_folder(args, scenario) -> Path:
 
 
 def with_refusal_picture(error: CollisionError, scenario, args) -> CollisionError:
-    """``error`` with the path of ``refusal.png`` (:func:`drake_traj.refusal.refusal_figure`), written
+    """``error`` with the path of ``refusal.png`` (:func:`drake_traj.cell.refusal.refusal_figure`), written
     with a ``run.json`` naming the refusal into the run's output folder when it may be written
     (as a run's files: an earlier run there needs --overwrite); else the reason there is none.
     With --meshcat, the refused configuration is drawn there and served as after a run."""

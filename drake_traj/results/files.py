@@ -41,9 +41,9 @@ def output_folder(directory) -> Path:
 
 def save_result(result, directory, *, overwrite: bool = False) -> Path:
     """Write ``result.npz`` (arrays) and ``metrics.json`` of ``result`` into ``directory``; returns it.
-    A folder that holds another run is refused (:class:`~drake_traj.rundir.OutputError`) unless
+    A folder that holds another run is refused (:class:`~drake_traj.results.rundir.OutputError`) unless
     ``overwrite``, which replaces that run once the new files are complete on disk
-    (:mod:`drake_traj.output`); so is a bench's folder or one of other files."""
+    (:mod:`drake_traj.results.output`); so is a bench's folder or one of other files."""
     directory = path_argument(directory, "directory", "folder")
     with claim_run_folder(directory, overwrite=overwrite, samples=len(result.t), options=("directory", "overwrite=True")) \
             as claimed, claimed.replace() as staging:
@@ -53,7 +53,7 @@ def save_result(result, directory, *, overwrite: bool = False) -> Path:
 
 def write_result(result, staging) -> None:
     """Write ``result.npz`` and ``metrics.json`` of ``result`` into ``staging``, the new content of a
-    claimed run folder (:meth:`drake_traj.output.Claim.replace`); :func:`save_result` is the way from
+    claimed run folder (:meth:`drake_traj.results.output.Claim.replace`); :func:`save_result` is the way from
     Python."""
     arrays = {name: getattr(result, name) for name in ARRAY_NAMES + LIMIT_NAMES + ("goal",)}
     failure = None if result.failure is None else result.failure.to_dict()

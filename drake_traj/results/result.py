@@ -241,14 +241,14 @@ class SimulationResult:
     # --- files (drake_traj.results.files) ------------------------------------------------------
     def save(self, directory, *, overwrite: bool = False) -> Path:
         """Write ``result.npz`` (arrays) and ``metrics.json`` into ``directory``; returns it. A folder
-        that holds another run is refused (:class:`~drake_traj.rundir.OutputError`) unless
+        that holds another run is refused (:class:`~drake_traj.results.rundir.OutputError`) unless
         ``overwrite``, which replaces that run once the new files are complete on disk
-        (:mod:`drake_traj.output`); so is a bench's folder or one of other files."""
+        (:mod:`drake_traj.results.output`); so is a bench's folder or one of other files."""
         return save_result(self, directory, overwrite=overwrite)
 
     def write_into(self, staging) -> None:
         """Write ``result.npz`` and ``metrics.json`` into ``staging``, the new content of a claimed
-        run folder (:meth:`drake_traj.output.Claim.replace`); :meth:`save` is the way from Python."""
+        run folder (:meth:`drake_traj.results.output.Claim.replace`); :meth:`save` is the way from Python."""
         write_result(self, staging)
 
     @classmethod
@@ -264,8 +264,8 @@ class SimulationResult:
         return reference_trajectory(self)
 
     def export(self, path, format: str, **options) -> Path:
-        """Write the reference for a robot or another tool (:mod:`drake_traj.export`): ``format``
-        "csv", "urscript" or "ros2"; ``options`` as :func:`drake_traj.export.export`."""
+        """Write the reference for a robot or another tool (:mod:`drake_traj.results.exports`): ``format``
+        "csv", "urscript" or "ros2"; ``options`` as :func:`drake_traj.results.exports.export`."""
         return export(self, path_argument(path, "path"), format, **options)
 
     # --- figures (drake_traj.results.figures) --------------------------------------------------

@@ -4,7 +4,7 @@ A run folder holds the files of one run and ``run.json``, the manifest that list
 written into the folder are added to it). A folder that holds an earlier run (a manifest, or the
 ``result.npz`` / ``metrics.json`` of a run written before manifests) is not written into unless
 asked to overwrite; the new run is written whole beside the earlier one and replaces it only
-once complete on disk (:mod:`drake_traj.output`), so bad input, an interrupted start or a full
+once complete on disk (:mod:`drake_traj.results.output`), so bad input, an interrupted start or a full
 disk never costs the earlier run, and nothing of two runs is ever mixed. A folder that holds
 other files, not a run (a bench, say), is never written into.
 """
@@ -33,8 +33,8 @@ def estimated_size(samples: int) -> int:
 
 def claim_run_folder(directory, *, overwrite: bool = False, samples: int = 0, command: str | None = None,
                      options=("--out", "--overwrite")):
-    """Claim ``directory`` for a run before it starts (:func:`drake_traj.output.claim`): checked
-    (:func:`drake_traj.output.check_folder`: writable, not a bench's, not other files, no earlier
+    """Claim ``directory`` for a run before it starts (:func:`drake_traj.results.output.claim`): checked
+    (:func:`drake_traj.results.output.check_folder`: writable, not a bench's, not other files, no earlier
     run unless ``overwrite``), locked against a second writer, with room for about ``samples``
     logged samples. Its ``replace()`` writes the run's files and replaces the earlier run."""
     return claim(directory, "run", overwrite=overwrite, earlier_files=run_files, estimate=estimated_size(samples),
@@ -78,7 +78,7 @@ def manifest_text(files, **details) -> str:
 
 
 def write_manifest(staging, files, **details) -> Path:
-    """Write ``run.json`` (:func:`manifest_text`) into ``staging`` (a :class:`drake_traj.output.Staging`)."""
+    """Write ``run.json`` (:func:`manifest_text`) into ``staging`` (a :class:`drake_traj.results.output.Staging`)."""
     return staging.write(MANIFEST, lambda path: path.write_text(manifest_text(files, **details)))
 
 

@@ -70,7 +70,7 @@ class ChainArm(Robot):
         model_text: the model as URDF text (an arm written from its DH table), parsed by
             :meth:`add_to_plant` instead of a file.
         packages: {package name: folder} for the model's ``package://`` URLs (with those of
-            ``ROS_PACKAGE_PATH``: :mod:`drake_traj.model_files`).
+            ``ROS_PACKAGE_PATH``: :mod:`drake_traj.robots.model_files`).
         xacro_args: a ``.xacro`` model's arguments.
         base_welded: the model welds ``base_frame`` to its world itself (at the world's origin);
             :meth:`add_to_plant` then uses that weld instead of adding one.
@@ -137,7 +137,7 @@ class ChainArm(Robot):
         acceleration_limits, effort_limits, rated_payload, home, data_source) override the file;
         acceleration_limits must be given (URDF has none). ``packages`` ({name: folder}) and
         ``ROS_PACKAGE_PATH`` resolve ``package://`` URLs; a ``.xacro`` file is expanded with
-        ``xacro_args`` (:mod:`drake_traj.model_files`). A model that welds its base to a
+        ``xacro_args`` (:mod:`drake_traj.robots.model_files`). A model that welds its base to a
         ``world`` link itself is used as it is (that weld at the world's origin).
 
         Raises:
@@ -391,7 +391,7 @@ class ChainArm(Robot):
 
 def _parsed(path: Path, packages: dict | None = None, xacro_args: dict | None = None) -> MultibodyPlant:
     """A finalized plant of the model file ``path`` alone (its packages, xacro arguments:
-    :func:`~drake_traj.model_files.add_model_file`), with SceneGraph, so that a ``package://``
+    :func:`~drake_traj.robots.model_files.add_model_file`), with SceneGraph, so that a ``package://``
     URL that resolves nowhere is found here."""
     if not path.is_file():
         raise invalid("model_file", f"model file not found: {path}")

@@ -51,11 +51,11 @@ def preflight(scenario: Scenario, planner: PlannerSystem, horizon: float | None 
 def check_in_cell(scenario: Scenario, planner: PlannerSystem, checker: CellChecker | None = None):
     """The start configuration and the planned motion (``planner.plan()``) in the scenario's
     cell: joint ranges, self-collision and collision with the cell, with its clearance
-    (:meth:`CellChecker.check <drake_traj.clearance.CellChecker.check>`). A refusal is a
-    :class:`~drake_traj.clearance.CollisionError` or
-    :class:`~drake_traj.clearance.JointRangeError` located at the cell's obstacle, the start
+    (:meth:`CellChecker.check <drake_traj.cell.clearance.CellChecker.check>`). A refusal is a
+    :class:`~drake_traj.cell.clearance.CollisionError` or
+    :class:`~drake_traj.cell.clearance.JointRangeError` located at the cell's obstacle, the start
     configuration or the planner in the scenario file. Returns the
-    :class:`~drake_traj.clearance.MotionCheck`."""
+    :class:`~drake_traj.cell.clearance.MotionCheck`."""
     checker = checker or scenario.cell_checker()
     try:
         check_start_torques(checker, planner.initial_positions(), field=lambda j: _torque_field(scenario, j))

@@ -297,7 +297,7 @@ class Scenario:
         return None if self.source is None else self.source.path.parent
 
     def cell_checker(self) -> CellChecker:
-        """The :class:`~drake_traj.clearance.CellChecker` of this scenario's robot in its cell;
+        """The :class:`~drake_traj.cell.clearance.CellChecker` of this scenario's robot in its cell;
         a malformed directive raises a ScenarioError at its line."""
         try:
             return CellChecker(self.robot_with_tool(), self.cell, self.directory())
