@@ -22,8 +22,8 @@ from drake_traj import PajakConfig, get_robot
 from drake_traj.errors import DrakeTrajError
 from drake_traj.planners.baselines.toppra import time_optimal_along_path
 from drake_traj.planners.pajak import paper_initial_configuration
-from drake_traj.planners.smooth.planners import pajak_joint_path, waypoint_path
-from drake_traj.planners.smooth.timing import time_path
+from drake_traj.planners.smooth import pajak_joint_path
+from drake_traj.planners.timing import time_path, waypoint_path
 from drake_traj.robots import ur10e
 
 ROBOT = get_robot("ur10e")

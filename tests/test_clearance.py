@@ -156,7 +156,7 @@ def test_refusals_use_the_planners_word_for_its_targets(checker):
     from drake_traj.planners.li.system import LiPathPlanner
     from drake_traj.planners.pajak.system import PajakPlanner
     from drake_traj.planners.quintic.system import QuinticPtpPlanner
-    from drake_traj.planners.smooth.planners import SmoothPlanner
+    from drake_traj.planners.smooth import SmoothPlanner
 
     words = {cls: planner_target_word(cls) for cls in (QuinticPtpPlanner, RuckigPlanner, MovejPlanner, SmoothPlanner,
                                                        LiPathPlanner, BorygaLoopPlanner, PajakPlanner)}

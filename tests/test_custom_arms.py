@@ -570,7 +570,7 @@ def test_actuators_out_of_the_joints_order_are_refused(tmp_path):
 def test_boryga_loop_on_the_puma_is_the_seeded_ik_nearest_the_reference():
     """The loop law's knots (warm-started IK, each from the reference) are the seeded search's
     solutions nearest the reference (the branch of the start), to 1e-9 rad."""
-    from drake_traj.planners.boryga.config import BorygaConfig, make
+    from drake_traj.planners.boryga import BorygaConfig, make
 
     arm = load_scenario(PUMA, "quintic").base_robot()
     reference = np.array([0.2, 0.6, -2.5, 0.2, -0.9, 0.1])

@@ -2,25 +2,43 @@
 
 The scenario's ``planner`` entry is one of :data:`PLANNER_CONFIGS` (a YAML tag names the type,
 e.g. ``planner: !PajakConfig {...}``); :func:`make_planner` builds the system it describes.
+
+One layout for every planner package (quintic, pajak, boryga, li, smooth, free):
+
+- ``config.py``: the config dataclass (the scenario's entry; no ``from __future__ import
+  annotations``: pydrake's YAML reader reads the field types) with ``validate(robot=UR10E)``, the
+  config's own checks for the robot it runs on, as ``make`` runs them first (same errors, same
+  order, same messages); it returns the config checked (a copy with its arrays normalised for
+  Pająk, Boryga and Li, else the config itself);
+- the law module(s): the paper's math, plain numpy where it can be (``law.py``, and ``profile.py``,
+  ``path.py``, ``kernel.py``, ``search.py``, ... where the method has more parts);
+- ``system.py``: the LeafSystem and ``make(config, robot, q_initial)``, which calls ``validate``
+  first (Pająk's law checks the robot before it calls ``validate``, and the free-motion planner
+  validates in its constructor, which ``make`` calls first);
+- ``__init__.py``: exports the config and ``make`` (smooth has two planners: both configs in its
+  ``config.py``, ``make_smooth_waypoints`` and ``make_retimed_pajak`` in its ``system.py``).
+
+The baselines (:mod:`.baselines`) are one module each with the same parts in that order (law,
+system, config with ``validate``, ``make``). No planner package imports another, but for the
+re-timed Pająk planner (smooth), which times the Pająk planner's path: what they share is in
+:mod:`.base` (the contract, the goals and the joint-move limits of a config), :mod:`.laws` (pure
+time laws) and :mod:`.timing` (the timing of any joint path). Every maker is registered in
+``_MAKERS`` below, the one registry.
 """
 
 from __future__ import annotations
 
 from typing import Union
 
-from drake_traj.planners import boryga, free, li, pajak, quintic
-from drake_traj.planners.baselines import movej, ruckig, toppra
+from drake_traj.planners import boryga, free, li, pajak, quintic, smooth
 from drake_traj.planners.base import PlannerSystem, planner_robot
+from drake_traj.planners.baselines import MovejConfig, RuckigConfig, ToppraConfig, movej, ruckig, toppra
 from drake_traj.planners.boryga import BorygaConfig
 from drake_traj.planners.free import FreeMotionConfig
-from drake_traj.planners.baselines.movej import MovejConfig
-from drake_traj.planners.baselines.ruckig import RuckigConfig
-from drake_traj.planners.baselines.toppra import ToppraConfig
 from drake_traj.planners.li import LiConfig
 from drake_traj.planners.pajak import PajakConfig
 from drake_traj.planners.quintic import QuinticConfig
-from drake_traj.planners.smooth.planners import (RetimedPajakConfig, SmoothWaypointsConfig, make_retimed_pajak,
-                                                make_smooth_waypoints)
+from drake_traj.planners.smooth import RetimedPajakConfig, SmoothWaypointsConfig
 from drake_traj.robots.base import Robot
 from drake_traj.validation import finite_array, instance_of
 
@@ -38,8 +56,8 @@ _MAKERS = {
     MovejConfig: movej.make,
     RuckigConfig: ruckig.make,
     ToppraConfig: toppra.make,
-    SmoothWaypointsConfig: make_smooth_waypoints,
-    RetimedPajakConfig: make_retimed_pajak,
+    SmoothWaypointsConfig: smooth.make_smooth_waypoints,
+    RetimedPajakConfig: smooth.make_retimed_pajak,
     FreeMotionConfig: free.make,
 }
 PLANNER_CONFIGS = tuple(_MAKERS)

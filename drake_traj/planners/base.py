@@ -40,7 +40,7 @@ from drake_traj.planners.laws.contract import MEMBERS, missing_members
 from drake_traj.planners.laws.pieces import law_pieces
 from drake_traj.planners.laws.scaling import admissible_clock_rate, clock_at, next_clock_rate
 from drake_traj.robots import Robot
-from drake_traj.validation import finite_array, instance_of, invalid, run_duration
+from drake_traj.validation import finite_array, instance_of, invalid, limit_or_default, run_duration
 
 _DID_NOTHING = EventStatus.DidNothing()  # returned by the time-law update in the common case
 # [s] how far ahead :meth:`PlannerSystem.preflight` looks when not told: a run's default max_duration
@@ -462,12 +462,28 @@ def planner_robot(robot: Robot, num_joints: int) -> Robot:
     return robot
 
 
-def start_and_goals(q_initial, goals, num_joints: int) -> np.ndarray:
-    """The start ``q_initial`` (n,) followed by the rows of ``goals`` (m, n): shape (m + 1, n)."""
-    start = finite_array(q_initial, "q_initial", "rad", shape=(num_joints,))
+def joint_goals(goals, num_joints: int) -> np.ndarray:
+    """A config's joint ``goals`` [rad] as an array (m, n), checked: finite, at least one row of
+    ``num_joints``; ValueError naming ``goals`` otherwise."""
     rows = finite_array(goals, "goals", "rad")
     if rows.size == 0:
         raise invalid("goals", "goals must have at least one row of joint positions, got none")
     if rows.ndim != 2 or rows.shape[1] != num_joints:
         raise invalid("goals", f"goals must have shape (m, {num_joints}), got shape {rows.shape}")
-    return np.vstack([start, rows])
+    return rows
+
+
+def start_and_goals(q_initial, goals, num_joints: int) -> np.ndarray:
+    """The start ``q_initial`` (n,) followed by the rows of ``goals`` (m, n): shape (m + 1, n)."""
+    start = finite_array(q_initial, "q_initial", "rad", shape=(num_joints,))
+    return np.vstack([start, joint_goals(goals, num_joints)])
+
+
+def joint_move_limits(robot: Robot, velocity_limit, acceleration_limit) -> tuple[np.ndarray, np.ndarray]:
+    """(velocity [rad/s], acceleration [rad/s²]) per joint of ``robot`` from a config's entries,
+    each empty for the robot's joint-move limit (:attr:`~drake_traj.robots.Robot.joint_move_limits`);
+    ValueError naming the entry where it is malformed, or empty where the robot has no default."""
+    default_velocity, default_acceleration = robot.joint_move_limits
+    n = robot.num_joints
+    return (limit_or_default(velocity_limit, default_velocity, "velocity_limit", n),
+            limit_or_default(acceleration_limit, default_acceleration, "acceleration_limit", n))

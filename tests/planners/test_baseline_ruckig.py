@@ -8,8 +8,8 @@ import pytest
 import ruckig
 
 from drake_traj.robots import ur10e as robot
-from drake_traj.planners.baselines import ruckig as baseline_ruckig
-from drake_traj.planners.baselines.ruckig import RuckigPlanner, RuckigStopLaw, default_jerk_limit
+from drake_traj.planners.baselines.ruckig import RuckigPlanner
+from drake_traj.planners.timing import RuckigStopLaw, default_jerk_limit, ruckig_law
 from drake_traj.planners.quintic import plan_synchronized_quintic
 
 VELOCITY_LIMIT = 1.05  # rad/s (Pająk 2024)
@@ -203,7 +203,7 @@ class _FailingRuckig:
 
 def test_ruckig_error_names_the_segment(monkeypatch, waypoints):
     _FailingRuckig.calls = 0
-    monkeypatch.setattr(baseline_ruckig.ruckig, "Ruckig", _FailingRuckig)
+    monkeypatch.setattr(ruckig_law.ruckig, "Ruckig", _FailingRuckig)
     with pytest.raises(ValueError, match=r"segment 2 .*ErrorExecutionTimeCalculation"):
         RuckigStopLaw(waypoints, VELOCITY_LIMIT, ACCELERATION_LIMIT)
 
@@ -216,7 +216,7 @@ def test_ruckig_exception_becomes_value_error(monkeypatch, waypoints):
         def calculate(self, inp, trajectory):
             raise ruckig.RuckigError("boom")
 
-    monkeypatch.setattr(baseline_ruckig.ruckig, "Ruckig", Raising)
+    monkeypatch.setattr(ruckig_law.ruckig, "Ruckig", Raising)
     with pytest.raises(ValueError, match="segment 0 .*boom"):
         RuckigStopLaw(waypoints, VELOCITY_LIMIT, ACCELERATION_LIMIT)
 

@@ -15,8 +15,8 @@ from drake_traj.errors import DrakeTrajError
 from drake_traj.planners import make_planner
 from drake_traj.planners.baselines.toppra import time_optimal_along_path
 from drake_traj.planners.smooth import InfeasibleTimingError, exact_peaks, time_path
-from drake_traj.planners.smooth.planners import SmoothPlanner, pajak_joint_path, waypoint_path
-from drake_traj.planners.smooth.timing import sample_path
+from drake_traj.planners.smooth import SmoothPlanner, pajak_joint_path
+from drake_traj.planners.timing import sample_path, waypoint_path
 
 UR10E = get_robot("ur10e")
 VELOCITY, ACCELERATION = UR10E.joint_move_limits
@@ -366,7 +366,7 @@ def test_more_grid_points_are_never_refused_nor_longer():
 
 
 def test_a_failing_linear_program_names_its_rows_and_what_to_change(monkeypatch):
-    from drake_traj.planners.smooth import timing
+    from drake_traj.planners.timing import program as timing
 
     q, velocity, acceleration = next(_waypoint_tasks(3, 1))
     path = waypoint_path(q)
@@ -405,6 +405,6 @@ def test_the_timing_prints_nothing_and_its_module_imports_beside_the_planners(ca
     time_path(waypoint_path(q), velocity, acceleration, grid_points=100)
     assert capfd.readouterr().out == ""
     import drake_traj.planners  # noqa: F401
-    import drake_traj.planners.smooth.timing as timing_module
+    import drake_traj.planners.timing.path_timing as timing_module
 
     assert timing_module.time_path is time_path

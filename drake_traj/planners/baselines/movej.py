@@ -46,15 +46,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from drake_traj.planners.base import TimeLawPlanner, planner_robot, start_and_goals
+from drake_traj.planners.base import TimeLawPlanner, joint_goals, joint_move_limits, planner_robot, start_and_goals
 from drake_traj.robots import UR10E, Robot
-from drake_traj.validation import instance_of, invalid, limit_or_default, positive_vector
+from drake_traj.validation import instance_of, invalid, positive_vector
 
-__all__ = [
-    "MovejBlendLaw",
-    "MovejPlanner",
-    "trapezoid_profile",
-]
+__all__ = ["MovejBlendLaw", "MovejConfig", "MovejPlanner", "blend_radius_value", "make", "trapezoid_profile"]
 
 _SAMPLES_PER_SEGMENT = 200  # FK samples for locating the sphere crossings (then bisection)
 _BISECTION_STEPS = 60
@@ -91,6 +87,31 @@ def trapezoid_profile(tau, ta: float, duration: float, accel: float):
     return s, sd, sdd
 
 
+def _checked_waypoints(q_waypoints) -> np.ndarray:
+    """``q_waypoints`` as a float array (m + 1, n) [rad], a copy, with m >= 1, n >= 1 and every
+    value finite; ValueError otherwise."""
+    try:
+        waypoints = np.array(q_waypoints, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"q_waypoints must be an (m + 1, n) array of joint positions: {exc}") from exc
+    if waypoints.ndim != 2 or waypoints.shape[0] < 2 or waypoints.shape[1] < 1:
+        raise ValueError(f"q_waypoints must have shape (m + 1, n) with m >= 1, n >= 1, got shape {waypoints.shape}")
+    if not np.all(np.isfinite(waypoints)):
+        raise ValueError("q_waypoints must be finite")
+    return waypoints
+
+
+def blend_radius_value(blend_radius) -> float:
+    """``blend_radius`` [m] as a float, finite and >= 0; ValueError naming it otherwise."""
+    try:
+        radius = float(blend_radius)
+    except (TypeError, ValueError) as exc:
+        raise invalid("blend_radius", f"blend_radius must be a number of metres: {exc}") from exc
+    if not np.isfinite(radius) or radius < 0.0:
+        raise invalid("blend_radius", f"blend_radius must be finite and >= 0 [m], got {blend_radius}")
+    return radius
+
+
 class MovejBlendLaw:
     """UR-style MoveJ through joint waypoints with radius blending, as a time law (module doc).
 
@@ -113,25 +134,12 @@ class MovejBlendLaw:
     acceleration_jumps = None
 
     def __init__(self, q_waypoints, velocity_limit, acceleration_limit, blend_radius: float = 0.0, *, tcp_position=None):
-        try:
-            waypoints = np.array(q_waypoints, dtype=float)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"q_waypoints must be an (m + 1, n) array of joint positions: {exc}") from exc
-        if waypoints.ndim != 2 or waypoints.shape[0] < 2 or waypoints.shape[1] < 1:
-            raise ValueError(f"q_waypoints must have shape (m + 1, n) with m >= 1, n >= 1, got shape {waypoints.shape}")
-        if not np.all(np.isfinite(waypoints)):
-            raise ValueError("q_waypoints must be finite")
+        waypoints = _checked_waypoints(q_waypoints)
         n = waypoints.shape[1]
         self.num_joints = n
         self.velocity_limit = positive_vector(velocity_limit, "velocity_limit", n)
         self.acceleration_limit = positive_vector(acceleration_limit, "acceleration_limit", n)
-        try:
-            radius = float(blend_radius)
-        except (TypeError, ValueError) as exc:
-            raise invalid("blend_radius", f"blend_radius must be a number of metres: {exc}") from exc
-        if not np.isfinite(radius) or radius < 0.0:
-            raise invalid("blend_radius", f"blend_radius must be finite and >= 0 [m], got {blend_radius}")
-        self.blend_radius = radius
+        self.blend_radius = radius = blend_radius_value(blend_radius)
         if tcp_position is None:
             if radius > 0.0 and n != UR10E.num_joints:
                 raise ValueError(f"tcp_position is required for blending with n = {n} joints (the default is the UR10e flange)")
@@ -145,38 +153,8 @@ class MovejBlendLaw:
         self.q_goal = waypoints[-1].copy()
         displacements = np.diff(waypoints, axis=0)  # D_k, (m, n)
         m = len(displacements)
-
-        # Per segment: the normalised trapezoid (accel A, ramp time ta, duration T).
-        accels, ramps, durations = [], [], []
-        for d in displacements:
-            size = np.abs(d)
-            moving = size > 0.0
-            vs = np.min(self.velocity_limit[moving] / size[moving])
-            acs = np.min(self.acceleration_limit[moving] / size[moving])
-            if vs * vs / acs < 1.0:  # the cruise speed is reached: trapezoid
-                ta = vs / acs
-                duration = 1.0 / vs + ta
-            else:  # triangle
-                ta = np.sqrt(1.0 / acs)
-                duration = 2.0 * ta
-            accels.append(float(acs))
-            ramps.append(float(ta))
-            durations.append(float(duration))
-
-        overlaps = np.zeros(max(m - 1, 0))
-        if radius > 0.0 and m >= 1:
-            points = np.array([self._tcp(q) for q in waypoints])
-            gaps = np.linalg.norm(np.diff(points, axis=0), axis=1)
-            if np.any(2.0 * radius >= gaps):
-                k = int(np.argmin(gaps))
-                raise ValueError(
-                    f"blend_radius = {radius} m is too large: the TCP positions of waypoints {k} and {k + 1} are "
-                    f"{gaps[k]:.4f} m apart, blend spheres must not overlap (radius < {0.5 * gaps.min():.4f} m)"
-                )
-            for k in range(1, m):
-                tau_in = self._sphere_crossing(k - 1, points[k], last=True, ramps=ramps, accels=accels, durations=durations)
-                tau_out = self._sphere_crossing(k, points[k], last=False, ramps=ramps, accels=accels, durations=durations)
-                overlaps[k - 1] = min(durations[k - 1] - tau_in, tau_out)
+        accels, ramps, durations = self._trapezoids(displacements)
+        overlaps = self._blend_overlaps(ramps, accels, durations)
 
         starts = np.zeros(m)
         for k in range(1, m):
@@ -199,6 +177,47 @@ class MovejBlendLaw:
         self._durations = durations
         self._d = [d.copy() for d in displacements]
         self._zero = np.zeros(n)
+
+    def _trapezoids(self, displacements) -> tuple[list[float], list[float], list[float]]:
+        """Per segment D_k (m, n) [rad], its normalised trapezoid: (accel A [1/s²], ramp time ta
+        [s], duration T [s]), each a list of m (module doc, step 1)."""
+        accels, ramps, durations = [], [], []
+        for d in displacements:
+            size = np.abs(d)
+            moving = size > 0.0
+            vs = np.min(self.velocity_limit[moving] / size[moving])
+            acs = np.min(self.acceleration_limit[moving] / size[moving])
+            if vs * vs / acs < 1.0:  # the cruise speed is reached: trapezoid
+                ta = vs / acs
+                duration = 1.0 / vs + ta
+            else:  # triangle
+                ta = np.sqrt(1.0 / acs)
+                duration = 2.0 * ta
+            accels.append(float(acs))
+            ramps.append(float(ta))
+            durations.append(float(duration))
+        return accels, ramps, durations
+
+    def _blend_overlaps(self, ramps, accels, durations) -> np.ndarray:
+        """delta_k [s] (m - 1,) of every intermediate waypoint (module doc, step 2; 0 without
+        blending); ValueError where the blend spheres of two waypoints overlap."""
+        m = len(durations)
+        overlaps = np.zeros(max(m - 1, 0))
+        radius = self.blend_radius
+        if radius > 0.0 and m >= 1:
+            points = np.array([self._tcp(q) for q in self.q_waypoints])
+            gaps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+            if np.any(2.0 * radius >= gaps):
+                k = int(np.argmin(gaps))
+                raise ValueError(
+                    f"blend_radius = {radius} m is too large: the TCP positions of waypoints {k} and {k + 1} are "
+                    f"{gaps[k]:.4f} m apart, blend spheres must not overlap (radius < {0.5 * gaps.min():.4f} m)"
+                )
+            for k in range(1, m):
+                tau_in = self._sphere_crossing(k - 1, points[k], last=True, ramps=ramps, accels=accels, durations=durations)
+                tau_out = self._sphere_crossing(k, points[k], last=False, ramps=ramps, accels=accels, durations=durations)
+                overlaps[k - 1] = min(durations[k - 1] - tau_in, tau_out)
+        return overlaps
 
     def _sphere_crossing(self, k, centre, *, last, ramps, accels, durations):
         """Local time on segment k where |tcp - centre| = r: the last (entering) or first (leaving)."""
@@ -338,16 +357,21 @@ class MovejConfig:
     velocity_limit: list[float] = field(default_factory=list)
     acceleration_limit: list[float] = field(default_factory=list)
 
+    def validate(self, robot: Robot = UR10E) -> "MovejConfig":
+        """The config, its own fields checked for ``robot`` as :func:`make` checks them first:
+        the goals (rows of n joint positions [rad]), the limits (the robot's where empty), the
+        blend radius; ValueError naming the field (blend spheres that overlap are the law's)."""
+        joint_goals(self.goals, robot.num_joints)
+        joint_move_limits(robot, self.velocity_limit, self.acceleration_limit)
+        blend_radius_value(self.blend_radius)
+        return self
+
 
 def make(config: MovejConfig, robot: Robot, q_initial) -> MovejPlanner:
-    """The baseline of ``config`` on ``robot`` from ``q_initial``."""
-    default_velocity, default_acceleration = robot.joint_move_limits
-    n = robot.num_joints
-    law = MovejBlendLaw(
-        start_and_goals(q_initial, config.goals, n),
-        limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", n),
-        limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit", n),
-        config.blend_radius,
-        tcp_position=robot.tool_position,
-    )
-    return MovejPlanner(law, robot=robot)
+    """The baseline of ``config`` on ``robot`` from ``q_initial`` (the config checked first:
+    :meth:`MovejConfig.validate`)."""
+    config.validate(robot)
+    q = start_and_goals(q_initial, config.goals, robot.num_joints)
+    velocity, acceleration = joint_move_limits(robot, config.velocity_limit, config.acceleration_limit)
+    return MovejPlanner(MovejBlendLaw(q, velocity, acceleration, config.blend_radius, tcp_position=robot.tool_position),
+                        robot=robot)

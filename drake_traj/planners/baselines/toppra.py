@@ -35,16 +35,11 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import RevoluteJoint, SpatialInertia, UnitInertia
 from pydrake.trajectories import PathParameterizedTrajectory, PiecewisePolynomial
 
-from drake_traj.planners.base import TimeLawPlanner, start_and_goals
-from drake_traj.robots import Robot
-from drake_traj.validation import invalid, limit_or_default, positive_vector, real_array, whole_number
+from drake_traj.planners.base import TimeLawPlanner, joint_goals, joint_move_limits, start_and_goals
+from drake_traj.robots import UR10E, Robot
+from drake_traj.validation import invalid, positive_vector, real_array, whole_number
 
-__all__ = [
-    "ToppraLaw",
-    "ToppraPlanner",
-    "geometric_path_from_samples",
-    "time_optimal_along_path",
-]
+__all__ = ["ToppraConfig", "ToppraLaw", "ToppraPlanner", "geometric_path_from_samples", "make", "time_optimal_along_path"]
 
 
 # --------------------------------------------------------------------------------------------
@@ -372,6 +367,15 @@ class ToppraConfig:
     acceleration_limit: list[float] = field(default_factory=list)
     grid_points: int = 0
 
+    def validate(self, robot: Robot = UR10E) -> "ToppraConfig":
+        """The config, its own fields checked for ``robot`` as :func:`make` checks them first: the
+        limits (the robot's where empty), then the path's rows of n joint positions [rad] (named
+        ``goals`` in the message, as the start and goals of every joint task); ValueError naming
+        the field (``grid_points`` is checked with the path)."""
+        joint_move_limits(robot, self.velocity_limit, self.acceleration_limit)
+        joint_goals(self.path, robot.num_joints)
+        return self
+
 
 def _grid_points(value):
     """The config's ``grid_points`` for :func:`time_optimal_along_path`: 0 is None (Drake's
@@ -380,11 +384,10 @@ def _grid_points(value):
 
 
 def make(config: ToppraConfig, robot: Robot, q_initial) -> ToppraPlanner:
-    """The baseline of ``config`` on ``robot``: time-optimal along the path from ``q_initial``."""
-    default_velocity, default_acceleration = robot.joint_move_limits
-    n = robot.num_joints
-    velocity = limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", n)
-    acceleration = limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit", n)
-    path = geometric_path_from_samples(start_and_goals(q_initial, config.path, n))
+    """The baseline of ``config`` on ``robot``: time-optimal along the path from ``q_initial`` (the
+    config checked first: :meth:`ToppraConfig.validate`)."""
+    config.validate(robot)
+    velocity, acceleration = joint_move_limits(robot, config.velocity_limit, config.acceleration_limit)
+    path = geometric_path_from_samples(start_and_goals(q_initial, config.path, robot.num_joints))
     _, trajectory = time_optimal_along_path(path, velocity, acceleration, grid_points=_grid_points(config.grid_points))
     return ToppraPlanner(ToppraLaw(trajectory), velocity, acceleration)

@@ -33,20 +33,20 @@ loop), non-positive or non-finite sizes and speeds, or a radius R and a distance
 together that do not fit the corner (R must equal Delta sin(angle BME / 2)).
 
 Modules: :mod:`.geometry` (section 2.2), :mod:`.path` (the profile and timing, eq. 1-14, and the path
-in time), :mod:`.law` (the joint law on a robot), :mod:`.system` (the Drake system),
-:mod:`.figures`, :mod:`.placements` (the paper's loop in each workspace) and :mod:`.config`
-(:class:`BorygaConfig` and ``make``). The math is plain numpy: tests call it directly and the
+in time), :mod:`.law` (the joint law on a robot), :mod:`.figures`, :mod:`.placements` (the paper's
+loop in each workspace), :mod:`.config` (:class:`BorygaConfig` and its ``validate``) and
+:mod:`.system` (the Drake system and ``make``). The math is plain numpy: tests call it directly and the
 planner system is a thin shell around it. Positions are in the base frame xyz [m]; times in seconds.
 """
 
-from drake_traj.planners.boryga.config import BorygaConfig, make
+from drake_traj.planners.boryga.config import BorygaConfig
 from drake_traj.planners.boryga.figures import loop_path_figure
 from drake_traj.planners.boryga.geometry import LoopGeometry, loop_geometry
 from drake_traj.planners.boryga.law import RobotLoopLaw, joint_speed_cap
 from drake_traj.planners.boryga.path import (PHASES, LoopPath, LoopTiming, loop_timing, plan_loop_path,
                                              poly7_profile, poly7_timing)
 from drake_traj.planners.boryga.placements import PAPER_LOOP, LoopPlacement, paper_loop_placement
-from drake_traj.planners.boryga.system import BorygaLoopPlanner
+from drake_traj.planners.boryga.system import BorygaLoopPlanner, make
 
 __all__ = [
     "PAPER_LOOP", "PHASES", "BorygaConfig", "BorygaLoopPlanner", "LoopGeometry", "LoopPath", "LoopPlacement",

@@ -1,17 +1,11 @@
-"""Boryga's loop planner's scenario entry (``planner: !BorygaConfig``) and its ``make``."""
+"""Boryga's loop planner's scenario entry (``planner: !BorygaConfig``) and its checks."""
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
-import numpy as np
+from drake_traj.robots import UR10E, Robot
+from drake_traj.validation import invalid, real_array
 
-from drake_traj.planners.boryga.law import RobotLoopLaw
-from drake_traj.planners.boryga.path import plan_loop_path
-from drake_traj.planners.boryga.placements import PAPER_LOOP, PLACED_ROBOTS, paper_loop_placement
-from drake_traj.planners.boryga.system import BorygaLoopPlanner
-from drake_traj.robots import Robot
-from drake_traj.validation import at_field, invalid, limit_or_default, real_array
-
-__all__ = ["BorygaConfig", "make"]
+__all__ = ["BorygaConfig"]
 
 
 @dataclass
@@ -39,32 +33,12 @@ class BorygaConfig:
     velocity_limit: list[float] = field(default_factory=list)
     acceleration_limit: list[float] = field(default_factory=list)
 
-
-def make(config: BorygaConfig, robot: Robot, q_initial) -> BorygaLoopPlanner:
-    """The loop of ``config`` on ``robot`` (``q_initial`` gives the tool orientation, the IK
-    branch and, for the default placement on robots other than Boryga's, the point B)."""
-    points = [real_array(getattr(config, name), name, "m") for name in ("B", "M", "E")]
-    if any(point.size for point in points):
-        if not all(point.shape == (3,) for point in points):
+    def validate(self, robot: Robot = UR10E) -> "BorygaConfig":
+        """The config, its own fields checked as ``make`` checks them first: B, M and E real and
+        all 3-vectors [m] or all empty; ValueError naming the field. Returns a copy with B, M and
+        E as arrays. ``robot``: the robot it runs on (the points are checked in its reach, and Δ
+        and v_max with the path, by ``make``)."""
+        points = [real_array(getattr(self, name), name, "m") for name in ("B", "M", "E")]
+        if any(point.size for point in points) and not all(point.shape == (3,) for point in points):
             raise invalid("B", f"B, M and E must all be 3-vectors [m] or all empty, got {[p.tolist() for p in points]}")
-        for name, point in zip(("B", "M", "E"), points):  # named before the path between them is solved
-            try:
-                robot.point_ik(point[None], q_initial)
-            except ValueError as error:
-                raise at_field(error, name) from error
-    elif robot.name in PLACED_ROBOTS:
-        placement = paper_loop_placement(robot.name)
-        points = [placement.B, placement.M, placement.E]
-    else:
-        offset = robot.tool_position(np.asarray(q_initial, dtype=float)) - np.asarray(PAPER_LOOP["B"])
-        points = [np.asarray(PAPER_LOOP[name]) + offset for name in ("B", "M", "E")]
-    law = RobotLoopLaw(plan_loop_path(*points, config.v_max, delta=config.delta), robot, q_initial)
-    n = robot.num_joints
-    # the UR10e's joint-move limits; on Boryga's robots their rated speeds and no acceleration limit
-    default_velocity, default_acceleration = robot.joint_move_limits
-    velocity = limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", n)
-    if np.size(config.acceleration_limit) or np.all(np.isfinite(default_acceleration)):
-        acceleration = limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit", n)
-    else:
-        acceleration = np.full(n, np.inf)
-    return BorygaLoopPlanner(law, velocity, acceleration)
+        return replace(self, B=points[0], M=points[1], E=points[2])

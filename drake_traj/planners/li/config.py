@@ -1,16 +1,13 @@
-"""Li et al. 2019's scenario entry (``planner: !LiConfig``) and its ``make``."""
+"""Li et al. 2019's scenario entry (``planner: !LiConfig``) and its checks."""
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from drake_traj.planners.li.path import li_closed_path
-from drake_traj.planners.li.plan import plan_li_path
-from drake_traj.planners.li.system import LiPathPlanner
-from drake_traj.robots import LI_4DOF, Robot
-from drake_traj.validation import at_field, invalid, limit_or_default, real_array
+from drake_traj.robots import UR10E, Robot
+from drake_traj.validation import invalid, real_array
 
-__all__ = ["CARTESIAN_ACCELERATION_LIMIT", "CARTESIAN_VELOCITY_LIMIT", "LiConfig", "make"]
+__all__ = ["CARTESIAN_ACCELERATION_LIMIT", "CARTESIAN_VELOCITY_LIMIT", "LiConfig"]
 
 # Table 4: Sup |V_m| = 200 mm/s, Sup |a_m| = 100 mm/s^2 (the tool limits of the paper's experiment).
 CARTESIAN_VELOCITY_LIMIT = 0.2  # [m/s]
@@ -38,28 +35,14 @@ class LiConfig:
     velocity_limit: list[float] = field(default_factory=list)
     acceleration_limit: list[float] = field(default_factory=list)
 
-
-def make(config: LiConfig, robot: Robot, q_initial) -> LiPathPlanner:
-    """The planner of ``config`` on ``robot`` (``q_initial``: see :class:`LiConfig`)."""
-    q_initial = np.asarray(q_initial, dtype=float)
-    if np.size(config.points):
-        points = real_array(config.points, "points", "m")
+    def validate(self, robot: Robot = UR10E) -> "LiConfig":
+        """The config, its own fields checked as ``make`` checks them first: the points, where
+        given, real rows of [x, y, z] [m], at least two; ValueError naming the field. Returns a
+        copy with the points as an array (k, 3). ``robot``: the robot it runs on (the points are
+        checked in its reach, the limits with the path, by ``make``)."""
+        if not np.size(self.points):
+            return self
+        points = real_array(self.points, "points", "m")
         if points.ndim != 2 or points.shape[1] != 3 or len(points) < 2:
             raise invalid("points", f"points must be a list of at least two [x, y, z] rows [m], got shape {points.shape}")
-        for index, point in enumerate(points):  # named by its index before the path between them is solved
-            try:
-                robot.point_ik(point[None], q_initial)
-            except ValueError as error:
-                raise at_field(error, "points", index) from error
-    else:
-        points = li_closed_path()
-        if robot.name != LI_4DOF.name:
-            points = points - points[0] + robot.tool_position(q_initial)
-    default_velocity, default_acceleration = robot.joint_move_limits
-    n = robot.num_joints
-    velocity = limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", n)
-    acceleration = limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit", n)
-    tool_limits = (config.tool_velocity_limit, config.tool_acceleration_limit)
-    plan = plan_li_path(points, lambda path: robot.point_ik(path, q_initial), robot.tool_motion, velocity,
-                        acceleration, *tool_limits)
-    return LiPathPlanner(plan, velocity, acceleration, robot.tool_motion, tool_limits)
+        return replace(self, points=points)

@@ -1,15 +1,18 @@
 """Li et al. 2019 under the planner contract: :class:`LiPathPlanner` (the joint spline of
-:func:`~.plan.plan_li_path` on the scaled clock)."""
+:func:`~.plan.plan_li_path` on the scaled clock) and ``make``."""
 
 import numpy as np
 
-from drake_traj.planners.base import TimeLawPlanner
+from drake_traj.planners.base import TimeLawPlanner, joint_move_limits
+from drake_traj.planners.li.config import LiConfig
 from drake_traj.planners.li.figures import tool_speed_figure
-from drake_traj.planners.li.plan import LiPlan
+from drake_traj.planners.li.path import li_closed_path
+from drake_traj.planners.li.plan import LiPlan, plan_li_path
 from drake_traj.planners.li.repair import tool_speed_and_acceleration
-from drake_traj.validation import instance_of
+from drake_traj.robots import LI_4DOF, Robot
+from drake_traj.validation import at_field, instance_of
 
-__all__ = ["LiPathPlanner"]
+__all__ = ["LiPathPlanner", "make"]
 
 
 class LiPathPlanner(TimeLawPlanner):
@@ -46,3 +49,26 @@ class LiPathPlanner(TimeLawPlanner):
 
     def figures(self) -> dict:
         return {"tool_speed": tool_speed_figure(self)}
+
+
+def make(config: LiConfig, robot: Robot, q_initial) -> LiPathPlanner:
+    """The planner of ``config`` on ``robot`` (``q_initial``: see :class:`LiConfig`); the config
+    checked first (:meth:`~.config.LiConfig.validate`)."""
+    q_initial = np.asarray(q_initial, dtype=float)
+    config = config.validate(robot)
+    if np.size(config.points):
+        points = config.points
+        for index, point in enumerate(points):  # named by its index before the path between them is solved
+            try:
+                robot.point_ik(point[None], q_initial)
+            except ValueError as error:
+                raise at_field(error, "points", index) from error
+    else:
+        points = li_closed_path()
+        if robot.name != LI_4DOF.name:
+            points = points - points[0] + robot.tool_position(q_initial)
+    velocity, acceleration = joint_move_limits(robot, config.velocity_limit, config.acceleration_limit)
+    tool_limits = (config.tool_velocity_limit, config.tool_acceleration_limit)
+    plan = plan_li_path(points, lambda path: robot.point_ik(path, q_initial), robot.tool_motion, velocity,
+                        acceleration, *tool_limits)
+    return LiPathPlanner(plan, velocity, acceleration, robot.tool_motion, tool_limits)

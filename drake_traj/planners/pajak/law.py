@@ -38,7 +38,7 @@ from drake_traj.planners.pajak.kernel import (
     Status,
     evaluate_kernel,
 )
-from drake_traj.planners.pajak.parameters import TASK_JOINTS, PajakConfig
+from drake_traj.planners.pajak.config import TASK_JOINTS, PajakConfig
 from drake_traj.planners.pajak.stepping import finished_kernel, update_kernel
 from drake_traj.planners.pajak.terms import ORIENTATION_LENGTH
 from drake_traj.robots import UR10E, Robot

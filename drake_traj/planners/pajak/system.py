@@ -12,7 +12,7 @@ from drake_traj.planners.base import DEFAULT_PREFLIGHT_HORIZON, TimeLawPlanner
 from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coefficients
 from drake_traj.planners.pajak.integration import integrate
 from drake_traj.planners.pajak.law import PajakLaw
-from drake_traj.planners.pajak.parameters import PajakConfig
+from drake_traj.planners.pajak.config import PajakConfig
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import finite_array, invalid, run_duration
 
@@ -287,5 +287,7 @@ class PajakPlanner(TimeLawPlanner):
 
 def make(config: PajakConfig, robot: Robot, q_initial) -> PajakPlanner:
     """The planner of ``config`` on ``robot`` (a 6-axis arm with the task kinematics the compiled
-    law is bound to, :class:`PajakLaw`), starting at rest at ``q_initial`` [rad]."""
+    law is bound to, :class:`PajakLaw`), starting at rest at ``q_initial`` [rad]. The law checks
+    the robot, then calls :meth:`PajakConfig.validate` (so a config on a robot it cannot run on
+    is refused for the robot)."""
     return PajakPlanner(config, q_initial, robot=robot)

@@ -14,12 +14,12 @@ t_fj = max(15|D_j| / (8 K_vj), sqrt(10 |D_j| / (sqrt(3) K_aj))), and D_j is the 
 q^f_j - q^i_j [rad], not a duration.
 
 Modules: :mod:`.profile` (the law r(s) and the timing, eq. 6-9), :mod:`.law` (segments, the
-chained :class:`QuinticLaw` and its planning), :mod:`.system` (the Drake system) and :mod:`.config`
-(:class:`QuinticConfig` and ``make``). The math is plain numpy: tests call it directly and the
-planner system is a thin shell around it.
+chained :class:`QuinticLaw` and its planning), :mod:`.config` (:class:`QuinticConfig` and its
+``validate``) and :mod:`.system` (the Drake system and ``make``). The math is plain numpy: tests
+call it directly and the planner system is a thin shell around it.
 """
 
-from drake_traj.planners.quintic.config import QuinticConfig, make
+from drake_traj.planners.quintic.config import QuinticConfig
 from drake_traj.planners.quintic.law import QuinticLaw, QuinticSegment, plan_synchronized_quintic
 from drake_traj.planners.quintic.profile import (
     joint_minimum_times,
@@ -28,7 +28,7 @@ from drake_traj.planners.quintic.profile import (
     quintic_profile,
     synchronized_duration,
 )
-from drake_traj.planners.quintic.system import QuinticPtpPlanner
+from drake_traj.planners.quintic.system import QuinticPtpPlanner, make
 
 __all__ = [
     "QuinticConfig", "QuinticLaw", "QuinticPtpPlanner", "QuinticSegment", "joint_minimum_times", "make",

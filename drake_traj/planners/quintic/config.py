@@ -1,14 +1,11 @@
-"""The quintic planner's scenario entry (``planner: !QuinticConfig``) and its ``make``."""
+"""The quintic planner's scenario entry (``planner: !QuinticConfig``) and its checks."""
 
 from dataclasses import dataclass, field
 
-from drake_traj.errors import DrakeTrajError
-from drake_traj.planners.quintic.law import plan_synchronized_quintic
-from drake_traj.planners.quintic.system import QuinticPtpPlanner
-from drake_traj.robots import Robot
-from drake_traj.validation import limit_or_default
+from drake_traj.planners.base import joint_move_limits
+from drake_traj.robots import UR10E, Robot
 
-__all__ = ["QuinticConfig", "make"]
+__all__ = ["QuinticConfig"]
 
 
 @dataclass
@@ -26,21 +23,9 @@ class QuinticConfig:
     velocity_limit: list[float] = field(default_factory=list)
     acceleration_limit: list[float] = field(default_factory=list)
 
-
-def make(config: QuinticConfig, robot: Robot, q_initial) -> QuinticPtpPlanner:
-    """The planner of ``config`` on ``robot`` from ``q_initial``, the goals checked against the
-    robot's joint ranges."""
-    default_velocity, default_acceleration = robot.joint_move_limits
-    velocity = limit_or_default(config.velocity_limit, default_velocity, "velocity_limit", robot.num_joints)
-    acceleration = limit_or_default(config.acceleration_limit, default_acceleration, "acceleration_limit",
-                                    robot.num_joints)
-    try:
-        plan = plan_synchronized_quintic(q_initial, config.goals, velocity, acceleration,
-                                         position_lower=robot.lower_limits, position_upper=robot.upper_limits)
-    except DrakeTrajError as error:  # a limit not given is the robot's: say so
-        name = error.field[0] if error.field else None
-        if name in ("velocity_limit", "acceleration_limit") and not len(getattr(config, name)):
-            raise error.relocated(error.field, f"{error} (not given: the {robot.name} robot's joint-move limit; give "
-                                               f"{name})") from None
-        raise
-    return QuinticPtpPlanner(plan, velocity, acceleration, robot=robot)
+    def validate(self, robot: Robot = UR10E) -> "QuinticConfig":
+        """The config, its own fields checked for ``robot`` as ``make`` checks them first: the
+        velocity and acceleration limits (the robot's where empty); ValueError naming the field.
+        The goals are checked with the start, by the plan (and against the joint ranges)."""
+        joint_move_limits(robot, self.velocity_limit, self.acceleration_limit)
+        return self

@@ -1,15 +1,18 @@
 """The synchronised quintic planner system: :class:`QuinticPtpPlanner`, a thin
-:class:`~drake_traj.planners.base.TimeLawPlanner` around a :class:`~.law.QuinticLaw`."""
+:class:`~drake_traj.planners.base.TimeLawPlanner` around a :class:`~.law.QuinticLaw`, and
+``make``."""
 
 import numpy as np
 
-from drake_traj.planners.base import TimeLawPlanner, planner_robot
-from drake_traj.planners.quintic.law import QuinticLaw
+from drake_traj.errors import DrakeTrajError
+from drake_traj.planners.base import TimeLawPlanner, joint_move_limits, planner_robot
+from drake_traj.planners.quintic.config import QuinticConfig
+from drake_traj.planners.quintic.law import QuinticLaw, plan_synchronized_quintic
 from drake_traj.planners.quintic.profile import UNITS
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import instance_of, joint_limit
 
-__all__ = ["QuinticPtpPlanner"]
+__all__ = ["QuinticPtpPlanner", "make"]
 
 
 class QuinticPtpPlanner(TimeLawPlanner):
@@ -39,3 +42,20 @@ class QuinticPtpPlanner(TimeLawPlanner):
     def task_waypoints(self) -> np.ndarray:
         """Tool positions at the joint goals [m]."""
         return self.robot.tool_position(np.array([segment.q_goal for segment in self.law.segments]))
+
+
+def make(config: QuinticConfig, robot: Robot, q_initial) -> QuinticPtpPlanner:
+    """The planner of ``config`` on ``robot`` from ``q_initial`` (the config checked first:
+    :meth:`~.config.QuinticConfig.validate`), the goals checked against the robot's joint ranges."""
+    config.validate(robot)
+    velocity, acceleration = joint_move_limits(robot, config.velocity_limit, config.acceleration_limit)
+    try:
+        plan = plan_synchronized_quintic(q_initial, config.goals, velocity, acceleration,
+                                         position_lower=robot.lower_limits, position_upper=robot.upper_limits)
+    except DrakeTrajError as error:  # a limit not given is the robot's: say so
+        name = error.field[0] if error.field else None
+        if name in ("velocity_limit", "acceleration_limit") and not len(getattr(config, name)):
+            raise error.relocated(error.field, f"{error} (not given: the {robot.name} robot's joint-move limit; give "
+                                               f"{name})") from None
+        raise
+    return QuinticPtpPlanner(plan, velocity, acceleration, robot=robot)

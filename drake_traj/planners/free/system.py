@@ -1,153 +1,36 @@
-"""Free motion: from goals to a motion that avoids the cell (:class:`FreeMotionConfig`).
+"""Free motion as a Drake system: :class:`FreeMotionPlanner` and its ``make``, from goals to a
+motion that avoids the cell (:class:`~drake_traj.planners.free.config.FreeMotionConfig`).
 
 For each goal in turn: OMPL finds a collision-free joint path from the previous one
 (:func:`~.search.search`), our shortcutting shortens it (:func:`~.search.shortcut`), the
 centripetal C2 spline through its vertices (more points along its segments where the spline
 strays into the cell, so the spline hugs the checked segments) is checked with the cell check's
 guarantee, then timed jerk-limited and near time-optimal by
-:func:`~drake_traj.planners.smooth.timing.time_path`; the arm stops at each goal. The timed
+:func:`~drake_traj.planners.timing.time_path`; the arm stops at each goal. The timed
 motion is what the planner runs, and it is checked in the cell like every plan before anything
 moves. The search needs the cell: the planner is made without it and plans when it is given one
 (:meth:`FreeMotionPlanner.plan_in`, which the preflight and the station's check call).
 """
 
-
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
 
 from drake_traj.errors import Cause, DrakeTrajError, PlanningError, joint_label
 from drake_traj.planners.base import TimeLawPlanner
-from drake_traj.planners.baselines.ruckig import jerk_limited_limits
+from drake_traj.planners.free.config import FreeMotionConfig
+from drake_traj.planners.free.law import FreeMotionLaw, Leg
 from drake_traj.planners.free.search import PLANNERS, Scene, search, shortcut
-from drake_traj.planners.laws.hermite import HermiteLaw
-from drake_traj.planners.smooth.planners import waypoint_path
-from drake_traj.planners.smooth.timing import time_path
+from drake_traj.planners.timing import jerk_limited_limits, time_path, waypoint_path
 from drake_traj.robots import Robot
-from drake_traj.validation import finite_array, invalid, positive_scalar, whole_number
+from drake_traj.validation import finite_array
 
-__all__ = ["FreeMotionConfig", "FreeMotionPlanner", "make"]
+__all__ = ["DENSITIES", "FreeMotionPlanner", "make"]
 
-MAX_GOALS = 100  # goals (or poses) of one task at most
-MAX_PLANNING_TIME = 120.0  # [s] the longest search budget
 DENSITIES = (None, 0.3, 0.1, 0.03)
 """[rad] the spline's repair: its points along the found segments at most this far apart (None:
 the vertices only), tried in turn until the spline keeps the clearance."""
-
-
-@dataclass
-class FreeMotionConfig:
-    """Goals reached through the cell on a path found for them: the scenario's
-    ``planner: !FreeMotionConfig`` entry.
-
-    Attributes:
-        goals: joint configurations [rad] reached in order, one row of n each; the arm stops at each.
-        poses: TCP poses [x, y, z, φ_X, φ_Y, φ_Z] [m, rad] instead of goals (Z-Y-X Euler angles as
-            Pająk's waypoints): each reached by the inverse-kinematics solution nearest the
-            previous configuration that is inside the joint ranges, clear of the cell and reached
-            by a path.
-        velocity_limit, acceleration_limit, jerk_limit: per joint (or one value); empty: the
-            robot's joint-move limits, and 10 /s × the acceleration limit.
-        planning_time: the search's budget per goal [s].
-        seed: the random numbers' seed: the same seed finds the same path.
-        planner: the OMPL planner, one of :data:`~.search.PLANNERS` (``rrt_connect``: the first
-            path found, then shortened).
-        shortcut_rounds: random shortcuts tried on each found path.
-        grid_points: nodes of the timing's linear programs.
-    """
-
-    goals: list[list[float]] = field(default_factory=list)
-    poses: list[list[float]] = field(default_factory=list)
-    velocity_limit: list[float] = field(default_factory=list)
-    acceleration_limit: list[float] = field(default_factory=list)
-    jerk_limit: list[float] = field(default_factory=list)
-    planning_time: float = 5.0
-    seed: int = 0
-    planner: str = "rrt_connect"
-    shortcut_rounds: int = 60
-    grid_points: int = 200
-
-    def validate(self, num_joints: int = 6) -> None:
-        """ValueError naming the field for a malformed config (the geometry is the planner's)."""
-        if bool(len(self.goals)) == bool(len(self.poses)):
-            raise invalid("goals", "give either goals (joint configurations) or poses (TCP poses), one of the two")
-        name, width = ("goals", num_joints) if len(self.goals) else ("poses", 6)
-        rows = finite_array(getattr(self, name), name, "rad" if name == "goals" else "m and rad")
-        if rows.ndim != 2 or rows.shape[1] != width:
-            raise invalid(name, f"{name} must be rows of {width} values, got shape {rows.shape}")
-        if len(rows) > MAX_GOALS:
-            raise invalid(name, f"{name} has {len(rows)} rows, at most {MAX_GOALS}")
-        budget = positive_scalar(self.planning_time, "planning_time", "s")
-        if budget > MAX_PLANNING_TIME:
-            raise invalid("planning_time", f"planning_time = {budget:g} s is above {MAX_PLANNING_TIME:g} s")
-        if self.planner not in PLANNERS:
-            raise invalid("planner", f"planner must be one of {sorted(PLANNERS)}, got {self.planner!r}")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed < 2**31:
-            raise invalid("seed", f"seed must be a whole number in [0, 2^31), got {self.seed!r}")
-        whole_number(self.shortcut_rounds, "shortcut_rounds", minimum=0)
-        whole_number(self.grid_points, "grid_points", minimum=20)
-
-
-class FreeMotionLaw:
-    """The found and timed motion as a time law (:class:`~drake_traj.planners.laws.TimeLaw`):
-    each leg's :class:`~drake_traj.planners.smooth.timing.SmoothTiming` in turn, at rest between
-    them, as one :class:`HermiteLaw` on their knots. Until the planner has planned
-    (:meth:`FreeMotionPlanner.plan_in`), asking for it raises a :class:`PlanningError`."""
-
-    acceleration_jumps = np.zeros(0)  # the legs meet at rest, each leg C2
-
-    def __init__(self, q_start: np.ndarray):
-        self.q_start = q_start
-        self._law = None
-
-    def set_legs(self, timings) -> None:
-        """The motion of the timed legs (each a SmoothTiming from the previous leg's end)."""
-        knots, samples, offset = [], [], 0.0
-        for k, timing in enumerate(timings):
-            own = np.asarray(timing.law.knots)
-            own = own if k == 0 else own[1:]  # a leg's first knot is the previous leg's last
-            knots.append(own + offset)
-            samples.append(np.array([np.stack(timing.law.sample(t)) for t in own]))
-            offset += timing.duration
-        samples = np.concatenate(samples)
-        law = HermiteLaw(np.concatenate(knots), samples, samples)
-        self._law = law
-        self.rates_at, self.sample = law.rates_at, law.sample  # the hot path, without this wrapper
-
-    def _planned(self) -> HermiteLaw:
-        if self._law is None:
-            raise PlanningError("the free-motion planner has not planned its path yet: it plans in its cell when the "
-                                "preflight or the station's check gives it one (FreeMotionPlanner.plan_in)",
-                                cause=Cause.PLANNING)
-        return self._law
-
-    @property
-    def duration(self) -> float:
-        return self._planned().duration
-
-    @property
-    def polynomial_breaks(self) -> np.ndarray:
-        return self._planned().polynomial_breaks
-
-    def rates_at(self, tau: float):
-        return self._planned().rates_at(tau)
-
-    def sample(self, tau: float):
-        return self._planned().sample(tau)
-
-
-@dataclass(frozen=True)
-class Leg:
-    """One goal's path: the found vertices, the shortened ones, the timed spline, what it took."""
-
-    found: np.ndarray  # (k, n) [rad] OMPL's path (two rows where the straight segment was free)
-    vertices: np.ndarray  # (k', n) [rad] after shortcutting
-    timing: object  # SmoothTiming
-    check: object  # the cell check's MotionCheck of the timed leg
-    density: float | None  # [rad] the spline's points along the segments (None: the vertices only)
-    search_seconds: float
-    samples: int
 
 
 class FreeMotionPlanner(TimeLawPlanner):
@@ -164,7 +47,7 @@ class FreeMotionPlanner(TimeLawPlanner):
     needs_cell = True  # the preflight and the station's check call plan_in(checker) first
 
     def __init__(self, config: FreeMotionConfig, robot: Robot, q_initial):
-        config.validate(robot.num_joints)
+        config.validate(robot)
         self.config = config
         self.robot = robot
         self.velocity, self.acceleration, self.jerk = jerk_limited_limits(

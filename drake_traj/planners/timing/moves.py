@@ -7,10 +7,10 @@ smooth-waypoints planner takes them where they are faster than the spline's timi
 import numpy as np
 from pydrake.trajectories import PiecewisePolynomial
 
-from drake_traj.planners.baselines.ruckig import RuckigStopLaw
 from drake_traj.planners.laws.hermite import HermiteLaw
-from drake_traj.planners.smooth.timing import (InfeasibleTimingError, SmoothTiming, check_least_durations, joint_limits,
-                                               stretched)
+from drake_traj.planners.timing.limits import check_least_durations, joint_limits
+from drake_traj.planners.timing.motion import InfeasibleTimingError, SmoothTiming, stretched
+from drake_traj.planners.timing.ruckig_law import RuckigStopLaw
 from drake_traj.validation import positive_scalar
 
 __all__ = ["line_timing", "stop_timing"]
