@@ -1,19 +1,102 @@
 """The recipes of docs/design.md ("Adding to drake_traj"), each followed on a toy example: a new
-arm description format, export format and planner are each one class or folder, registered in
-one place. (A new obstacle shape: tests/test_cell.py.)"""
+planner (its config, law, system and maker registered in one place), arm description format and
+export format. (A new obstacle shape, one class: tests/test_cell.py.)"""
 
 import gzip
 import json
+from dataclasses import dataclass, field
 
 import numpy as np
 import pytest
 
-from drake_traj import QuinticConfig, SimulationResult, cli, simulate
+from drake_traj import QuinticConfig, SimulationResult, cli, get_robot, planners, simulate
 from drake_traj.data import data_directory
+from drake_traj.errors import DrakeTrajError
 from drake_traj.planners import make_planner
+from drake_traj.planners.base import TimeLawPlanner, joint_move_limits
 from drake_traj.results import exports
 from drake_traj.robots import model_files
 from drake_traj.robots.chain_arm import ChainArm
+
+
+
+# ---- a planner: config (with validate), law, system and make, registered in planners._MAKERS ----
+
+@dataclass
+class CubicConfig:
+    """The toy planner's scenario entry: one cubic move q_start + (goal - q_start)(3u² - 2u³),
+    u = t / T, to ``goal`` [rad], as short as the joint-move limits allow."""
+
+    goal: list[float] = field(default_factory=list)
+    velocity_limit: list[float] = field(default_factory=list)
+    acceleration_limit: list[float] = field(default_factory=list)
+
+    def validate(self, robot):
+        if len(self.goal) != robot.num_joints:
+            raise DrakeTrajError(f"goal must have {robot.num_joints} joint positions, got {len(self.goal)}",
+                                 field=("goal",))
+        joint_move_limits(robot, self.velocity_limit, self.acceleration_limit)
+        return self
+
+
+class CubicLaw:
+    """The toy law (a :class:`~drake_traj.planners.laws.TimeLaw`): one cubic, q'' jumps at both ends."""
+
+    def __init__(self, q_start, goal, velocity, acceleration):
+        self.q_start, self.delta = np.asarray(q_start, float), np.asarray(goal, float) - q_start
+        # the cubic's peaks: |q'| = 1.5 |Δ| / T at u = 1/2, |q''| = 6 |Δ| / T² at u = 0 and 1
+        self.duration = float(max(np.max(1.5 * np.abs(self.delta) / velocity),
+                                  np.max(np.sqrt(6 * np.abs(self.delta) / acceleration))))
+        self.acceleration_jumps = np.array([0.0, self.duration])
+        self.polynomial_breaks = np.array([0.0, self.duration])
+
+    def sample(self, tau):
+        T, u = self.duration, np.clip(tau / self.duration, 0.0, 1.0)
+        inside = 0.0 < tau < T
+        return (self.q_start + self.delta * (3 * u**2 - 2 * u**3), self.delta * (6 * u - 6 * u**2) / T * inside,
+                self.delta * (6 - 12 * u) / T**2 * inside)
+
+    def rates_at(self, tau):
+        return self.sample(tau)[1:]
+
+
+class CubicPlanner(TimeLawPlanner):
+    """The toy system: a time-law planner around the cubic law."""
+
+    def task_waypoints(self):
+        return self.robot.tool_position((self.law.q_start + self.law.delta)[None, :])
+
+
+def make_cubic(config, robot, q_initial):
+    config.validate(robot)
+    velocity, acceleration = joint_move_limits(robot, config.velocity_limit, config.acceleration_limit)
+    return CubicPlanner(CubicLaw(q_initial, config.goal, velocity, acceleration), velocity, acceleration)
+
+
+def test_a_planner_is_its_config_law_system_and_one_registry_entry(monkeypatch):
+    monkeypatch.setitem(planners._MAKERS, CubicConfig, make_cubic)  # the one line a new planner adds
+    robot = get_robot("ur10e")
+    goal = robot.home_configuration + np.array([0.4, -0.3, 0.2, 0.0, -0.5, 0.6])
+    planner = make_planner(CubicConfig(goal=goal.tolist()), robot, robot.home_configuration)
+    assert planner.robot is robot
+
+    plan = planner.plan()  # the law's pieces, as every time-law planner's plan
+    t = np.linspace(0.0, plan.end_time(), 4001)
+    qd = np.array([plan.EvalDerivative(time, 1).ravel() for time in t])
+    qdd = np.array([plan.EvalDerivative(time, 2).ravel() for time in t])
+    # the limits the move promises, at dense samples, and one joint at each of its limits
+    assert np.all(np.abs(qd) <= robot.velocity_limits * (1 + 1e-9))
+    assert np.all(np.abs(qdd) <= planner.acceleration_limit * (1 + 1e-9))
+    assert np.isclose(max(np.max(np.abs(qd) / planner.velocity_limit), np.max(np.abs(qdd) / planner.acceleration_limit)),
+                      1.0, atol=1e-3)
+
+    result = simulate(planner)  # the preflight, the cell check and the closed loop, as for any planner
+    assert result.succeeded, result.failure
+    np.testing.assert_allclose(result.q_ref[-1], goal, atol=1e-9)
+    np.testing.assert_allclose(result.q_meas[-1], goal, atol=1e-3)
+    with pytest.raises(DrakeTrajError, match="goal must have 6 joint positions"):
+        make_planner(CubicConfig(goal=[0.1]), robot, robot.home_configuration)
+
 
 START = np.array([-np.pi / 2, -np.pi / 2, -3 * np.pi / 4, -np.pi / 4, np.pi / 2, np.pi / 4])  # [rad]
 

@@ -14,7 +14,7 @@ Every planner is a LeafSystem with
 - an optional input port ``speed_override`` (a value in [0, 1]; unconnected means 1).
 
 At the simulator's initialization a planner in a station checks that its plan was accepted by
-the cell check in that station's scene (``guard``, :mod:`drake_traj.guard`): an unchecked plan is
+the cell check in that station's scene (``guard``, :mod:`drake_traj.cell.guard`): an unchecked plan is
 checked there, and refused before the motion where it would collide.
 
 Subclasses implement :meth:`PlannerSystem.evaluate` (qdd and c from the context) and
@@ -81,7 +81,7 @@ class PlannerSystem(LeafSystem):
         self._q_initial = q_initial
         self._plan = None  # the PiecewisePolynomial of plan(), made at the first call
         # fingerprints of the collision scenes in which the cell check accepted plan()
-        # (CellChecker.check_planner), and the station's guard (drake_traj.guard.MotionGuard, set
+        # (CellChecker.check_planner), and the station's guard (drake_traj.cell.guard.MotionGuard, set
         # by add_station): the motion starts only where the guard finds its scene checked
         self.checked_scenes: set[str] = set()
         self.guard = None
@@ -185,7 +185,7 @@ class PlannerSystem(LeafSystem):
     # --- shared ------------------------------------------------------------------------------
     def _before_motion(self, context) -> EventStatus:
         """At the simulator's initialization: the station's guard refuses a plan that was not
-        checked in the station's scene (checking it there first; drake_traj.guard), whatever
+        checked in the station's scene (checking it there first; drake_traj.cell.guard), whatever
         started the simulation (run_station or one's own Simulator)."""
         if self.guard is not None:
             self.guard.ensure_checked(self, DEFAULT_PREFLIGHT_HORIZON)

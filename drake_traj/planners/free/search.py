@@ -1,7 +1,7 @@
 """Collision-free joint paths through a cell: the Open Motion Planning Library's planners (the
 ``ompl`` wheel) search, validity from SceneGraph's signed distances, our shortcutting after.
 
-Validity is the cell check's (:class:`~drake_traj.clearance.CellChecker`, duck-typed here: its
+Validity is the cell check's (:class:`~drake_traj.cell.clearance.CellChecker`, duck-typed here: its
 ``pose_query``, ``reach`` and ``clearance``): a configuration is valid inside the joint ranges with
 no two bodies closer than the clearance c. A straight joint segment is valid by conservative
 advancement: from a configuration where the nearest pair is d apart, no two bodies come more
@@ -44,7 +44,7 @@ class Scene:
     """The cell as the search sees it.
 
     Args:
-        checker: the cell check of the robot in its cell (a :class:`~drake_traj.clearance.CellChecker`).
+        checker: the cell check of the robot in its cell (a :class:`~drake_traj.cell.clearance.CellChecker`).
         lower, upper: the joint ranges [rad], (n,).
     """
 

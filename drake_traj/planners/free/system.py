@@ -61,9 +61,9 @@ class FreeMotionPlanner(TimeLawPlanner):
     # --- planning ---------------------------------------------------------------------------
     def plan_in(self, checker):
         """Find, shorten, smooth, time and check the motion in ``checker``'s cell (a
-        :class:`~drake_traj.clearance.CellChecker`; what its ``check_planner`` calls for this
+        :class:`~drake_traj.cell.clearance.CellChecker`; what its ``check_planner`` calls for this
         planner); nothing to do where it planned there already. Returns the cell check's
-        :class:`~drake_traj.clearance.MotionCheck` of the timed motion.
+        :class:`~drake_traj.cell.clearance.MotionCheck` of the timed motion.
 
         Raises:
             CollisionError: the start or a goal too close to something (naming the bodies).

@@ -8,7 +8,7 @@ for Python callers (the Drake system, tests) and :mod:`.integration` for whole r
 here and in :mod:`.stepping` take flat float vectors whose layouts are the enums below, so that a
 call from Python costs no conversion:
 
-- :class:`Parameter`: the task's settings (from :class:`~.parameters.PajakConfig`), with the
+- :class:`Parameter`: the task's settings (from :class:`~.config.PajakConfig`), with the
   waypoints (w, 6) and the remaining path after each waypoint (w,) as separate arrays;
 - :class:`Discrete`: the discrete state of the law (the Drake system's ``scaling`` group is its
   first three entries, c, t0 and c0);

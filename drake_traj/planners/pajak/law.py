@@ -9,12 +9,12 @@ relaxed back to 1 by eq. 18. Waypoints are passed without stopping by blending t
 ball around each waypoint (eq. 19), or the arm stops at each.
 
 The law itself is compiled (:mod:`.kernel`, one implementation for every caller); this module
-packs a :class:`~.parameters.PajakConfig` into the kernel's vectors and turns its status codes
+packs a :class:`~.config.PajakConfig` into the kernel's vectors and turns its status codes
 into :class:`PlanningError`. A LeafSystem (continuous state [q; q̇], the discrete state of
 :class:`~.kernel.Discrete`) calls :meth:`PajakLaw.acceleration` from its derivatives and
 :meth:`PajakLaw.update` from a periodic update; :func:`~.integration.integrate` runs a whole task.
 
-Corrections, readings and our improvements (each a flag of :class:`~.parameters.PajakConfig`,
+Corrections, readings and our improvements (each a flag of :class:`~.config.PajakConfig`,
 default on; all off gives the paper's method as printed, with the corrections) are listed in
 docs/papers.md (Pająk 2024) and at the functions of :mod:`.kernel` (and :mod:`.terms`,
 :mod:`.limits`) that implement them.
