@@ -473,6 +473,21 @@ def joint_goals(goals, num_joints: int) -> np.ndarray:
     return rows
 
 
+def waypoint_rows(q_waypoints) -> np.ndarray:
+    """A law's ``q_waypoints`` [rad or m], the start then each goal, as a float array (m + 1, n), a
+    copy, with m >= 1, n >= 1 and every value finite; ValueError naming the first bad entry."""
+    try:
+        rows = np.array(q_waypoints, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"q_waypoints must be an (m + 1, n) array of joint positions: {exc}") from exc
+    if rows.ndim != 2 or rows.shape[0] < 2 or rows.shape[1] < 1:
+        raise ValueError(f"q_waypoints must have shape (m + 1, n) with m >= 1, n >= 1, got shape {rows.shape}")
+    if not np.all(np.isfinite(rows)):
+        k, j = np.argwhere(~np.isfinite(rows))[0]
+        raise ValueError(f"q_waypoints[{k}, {j}] must be finite, got {rows[k, j]}")
+    return rows
+
+
 def start_and_goals(q_initial, goals, num_joints: int) -> np.ndarray:
     """The start ``q_initial`` (n,) followed by the rows of ``goals`` (m, n): shape (m + 1, n)."""
     start = finite_array(q_initial, "q_initial", "rad", shape=(num_joints,))

@@ -46,7 +46,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from drake_traj.planners.base import TimeLawPlanner, joint_goals, joint_move_limits, planner_robot, start_and_goals
+from drake_traj.planners.base import (TimeLawPlanner, joint_goals, joint_move_limits, planner_robot, start_and_goals,
+                                     waypoint_rows)
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import instance_of, invalid, positive_vector
 
@@ -87,20 +88,6 @@ def trapezoid_profile(tau, ta: float, duration: float, accel: float):
     return s, sd, sdd
 
 
-def _checked_waypoints(q_waypoints) -> np.ndarray:
-    """``q_waypoints`` as a float array (m + 1, n) [rad], a copy, with m >= 1, n >= 1 and every
-    value finite; ValueError otherwise."""
-    try:
-        waypoints = np.array(q_waypoints, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"q_waypoints must be an (m + 1, n) array of joint positions: {exc}") from exc
-    if waypoints.ndim != 2 or waypoints.shape[0] < 2 or waypoints.shape[1] < 1:
-        raise ValueError(f"q_waypoints must have shape (m + 1, n) with m >= 1, n >= 1, got shape {waypoints.shape}")
-    if not np.all(np.isfinite(waypoints)):
-        raise ValueError("q_waypoints must be finite")
-    return waypoints
-
-
 def blend_radius_value(blend_radius) -> float:
     """``blend_radius`` [m] as a float, finite and >= 0; ValueError naming it otherwise."""
     try:
@@ -134,7 +121,7 @@ class MovejBlendLaw:
     acceleration_jumps = None
 
     def __init__(self, q_waypoints, velocity_limit, acceleration_limit, blend_radius: float = 0.0, *, tcp_position=None):
-        waypoints = _checked_waypoints(q_waypoints)
+        waypoints = waypoint_rows(q_waypoints)
         n = waypoints.shape[1]
         self.num_joints = n
         self.velocity_limit = positive_vector(velocity_limit, "velocity_limit", n)

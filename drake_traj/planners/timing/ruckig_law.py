@@ -26,25 +26,11 @@ import numpy as np
 import ruckig
 
 from drake_traj.errors import Cause, DrakeTrajError, joint_label
+from drake_traj.planners.base import waypoint_rows
 from drake_traj.planners.timing.limits import default_jerk_limit
 from drake_traj.validation import positive_vector
 
 __all__ = ["RuckigStopLaw"]
-
-
-def _checked_waypoints(q_waypoints) -> np.ndarray:
-    """``q_waypoints`` as a float array (m + 1, n) [rad], a copy, with m >= 1 and n >= 1 and every
-    value finite; ValueError otherwise."""
-    try:
-        q = np.array(q_waypoints, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"q_waypoints must be an array of real numbers: {exc}") from exc
-    if q.ndim != 2 or q.shape[0] < 2 or q.shape[1] < 1:
-        raise ValueError(f"q_waypoints must have shape (m + 1, n) with m >= 1, n >= 1, got shape {q.shape}")
-    if not np.all(np.isfinite(q)):
-        k, j = np.argwhere(~np.isfinite(q))[0]
-        raise ValueError(f"q_waypoints[{k}, {j}] must be finite, got {q[k, j]}")
-    return q
 
 
 class RuckigStopLaw:
@@ -75,7 +61,7 @@ class RuckigStopLaw:
     acceleration_jumps = np.empty(0)
 
     def __init__(self, q_waypoints, velocity_limit, acceleration_limit, jerk_limit=None):
-        q = _checked_waypoints(q_waypoints)
+        q = waypoint_rows(q_waypoints)
         n = q.shape[1]
         self.num_joints = n
         self.velocity_limit = positive_vector(velocity_limit, "velocity_limit", n)
