@@ -31,6 +31,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import Trajectory
 
 from drake_traj.cell.cell import Cell, add_cell
+from drake_traj.cell.compiled_model import CompiledCollisionModel
 from drake_traj.cell.directives import refuse_free_bodies
 from drake_traj.cell.shapes import shape_radius
 from drake_traj.errors import Cause, DrakeTrajError, Field, PlanningError, joint_label
@@ -293,6 +294,15 @@ class CellChecker:
     def link_reach(self) -> tuple[np.ndarray, dict]:
         """:func:`link_reach` of the robot in this checker's plant (per-link travel bounds)."""
         return link_reach(self.plant, self.scene_graph, self.instance, self.robot.joint_names)
+
+    def compiled_model(self) -> CompiledCollisionModel:
+        """The compiled collision model of this checker's scene (the robot, its tool and the cell at
+        this clearance: :class:`~drake_traj.cell.compiled_model.CompiledCollisionModel`), built at
+        the first call and kept: batches of configurations checked 100 times faster and more than
+        by SceneGraph, each distance a certified lower bound of SceneGraph's."""
+        if getattr(self, "_compiled_model", None) is None:
+            self._compiled_model = CompiledCollisionModel(self)
+        return self._compiled_model
 
     def owner(self, geometry) -> tuple[str, str]:
         """(body, geometry) names of a geometry id, as messages give them (:func:`geometry_owner`)."""
