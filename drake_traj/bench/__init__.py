@@ -2,7 +2,9 @@
 tasks through the same closed loop, on Dask distributed: the tasks (:mod:`.task_sets`), T_opt
 along a planner's path (:mod:`.optimum`), the planner configs and the work unit of one run
 (:mod:`.units`), where the units run and their progress (:mod:`.engine`), the CSV, Markdown and
-figure (:mod:`.report`) and the entry point :func:`bench` (:mod:`.run`)."""
+figure (:mod:`.report`) and the entry point :func:`bench` (:mod:`.run`); the free-motion suite
+(``--suite free``): its seeded scenes (:mod:`.free_scenes`) and its runner :func:`free_bench`
+(:mod:`.free_suite`)."""
 
 from drake_traj.bench.task_sets import (Task, joint_waypoints, pajak_walk_tasks, paper_task, random_tasks, tasks)
 from drake_traj.bench.optimum import (converged_optimum, optimal_duration)
@@ -10,5 +12,7 @@ from drake_traj.bench.units import (COLUMNS, CONFIG_BUILDERS, PLANNERS, run_plan
 from drake_traj.bench.engine import (BenchSetupError)
 from drake_traj.bench.report import (bench_figure, medians)
 from drake_traj.bench.run import (bench)
+from drake_traj.bench.free_scenes import (FreeQuery, FreeScene, SCENE_KINDS, generate)
+from drake_traj.bench.free_suite import (ClearanceProbe, free_bench, run_free_query)
 
-__all__ = ['BenchSetupError', 'COLUMNS', 'CONFIG_BUILDERS', 'PLANNERS', 'Task', 'bench', 'bench_figure', 'converged_optimum', 'joint_waypoints', 'medians', 'optimal_duration', 'pajak_walk_tasks', 'paper_task', 'random_tasks', 'run_planner', 'run_toppra', 'tasks']
+__all__ = ['BenchSetupError', 'ClearanceProbe', 'FreeQuery', 'FreeScene', 'SCENE_KINDS', 'COLUMNS', 'CONFIG_BUILDERS', 'PLANNERS', 'Task', 'bench', 'bench_figure', 'converged_optimum', 'free_bench', 'generate', 'joint_waypoints', 'medians', 'optimal_duration', 'pajak_walk_tasks', 'paper_task', 'random_tasks', 'run_free_query', 'run_planner', 'run_toppra', 'tasks']

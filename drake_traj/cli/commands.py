@@ -19,7 +19,7 @@ from tqdm import tqdm
 
 from drake_traj.version import __version__
 from drake_traj.cli.exit_codes import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, EXIT_TERMINATED
-from drake_traj.bench import bench
+from drake_traj.bench import bench, free_bench
 from drake_traj.cell import CollisionError, refusal_figure
 from drake_traj.errors import Cause, DrakeTrajError, Failure, PlanningError
 from drake_traj.results.exports import FORMATS, UR_CYCLE, ExportError
@@ -313,9 +313,14 @@ def _exports() -> list[str]:
 
 
 def run_bench(args) -> int:
-    """``drake-traj bench``; bad arguments, ``--out`` or ``--scheduler`` are refused before any run."""
-    bench(args.out, count=args.count, seed=args.seed, repeats=args.repeats, workers=args.workers,
-          scheduler=args.scheduler, overwrite=args.overwrite, command=args.command_line)
+    """``drake-traj bench``; bad arguments, ``--out`` or ``--scheduler`` are refused before any run.
+    ``--suite free``: the free-motion suite (:func:`drake_traj.bench.free_bench`) instead."""
+    if args.suite == "free":
+        free_bench(args.out or "out/free", count=5 if args.count is None else args.count, seed=args.seed,
+                   workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite, command=args.command_line)
+        return EXIT_OK
+    bench(args.out or "out/bench", count=20 if args.count is None else args.count, seed=args.seed, repeats=args.repeats,
+          workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite, command=args.command_line)
     return EXIT_OK
 
 
@@ -388,11 +393,16 @@ def _export_options(parser) -> None:
 
 def _bench_options(parser) -> None:
     parser.set_defaults(handler=run_bench)
-    parser.add_argument("--out", default="out/bench", help="output directory (default: out/bench)")
+    parser.add_argument("--suite", choices=("planners", "free"), default="planners",
+                        help="planners: every planner and baseline on UR10e tasks (default); free: the free-motion "
+                             "planner on seeded scenes of every kind")
+    parser.add_argument("--out", default=None, help="output directory (default: out/bench; --suite free: out/free)")
     parser.add_argument("--overwrite", action="store_true", help="replace an earlier bench in the output directory")
-    parser.add_argument("--count", type=int, default=20, help="seeded random tasks besides the paper's")
+    parser.add_argument("--count", type=int, default=None,
+                        help="seeded random tasks besides the paper's (default 20); --suite free: queries per scene "
+                             "kind (default 5)")
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--repeats", type=int, default=5, help="planning-time repeats on the paper task")
+    parser.add_argument("--repeats", type=int, default=5, help="planning-time repeats on the paper task (--suite planners)")
     parser.add_argument("--workers", type=int, default=None,
                         help="processes of the local Dask cluster (default: one per core; 1: no Dask, in order)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
