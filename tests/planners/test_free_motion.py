@@ -9,7 +9,9 @@ from drake_traj import FreeMotionConfig, get_robot, load_scenario, make_station,
 from drake_traj.cell import Box, Cell, CellChecker, CollisionError, add_cell
 from drake_traj.errors import Cause, DrakeTrajError, PlanningError
 from drake_traj.planners import make_planner
-from drake_traj.planners.free import Scene, search
+from drake_traj.bench.free_scenes import generate
+from drake_traj.planners.free import Scene, SearchResult, search
+from drake_traj.planners.free import system as free_system
 from drake_traj.scenario import make_planner as scenario_planner
 from pydrake.systems.analysis import Simulator
 
@@ -129,19 +131,40 @@ def test_an_unreachable_pose_is_refused():
     assert refused.value.cause is Cause.UNREACHABLE
 
 
-def test_no_path_within_the_budget_says_what_was_tried():
-    planner = make_planner(FreeMotionConfig(poses=SHELF.planner.poses, planning_time=1e-3), UR10E, SHELF.q_initial)
-    with pytest.raises(PlanningError, match=r"no collision-free path to pose 0 found within planning_time = 0.001 s "
-                                            r"\(RRTConnect, \d+ configurations? tried, \d+ states sampled") as refused:
-        shelf_checker().check_planner(planner)
-    assert refused.value.cause is Cause.PLANNING and refused.value.field == ("poses", 0)
+def slot_query(kind: str, seed: int):
+    """A seeded query of the free-motion bench (drake_traj.bench.free_scenes): its scene's checker and query."""
+    scene = generate(kind, seed)
+    return CellChecker(scene.robot, cell=scene.cell), scene.robot, scene.queries[0]
 
 
-def test_a_scenario_refusal_is_at_the_goals_line(tmp_path):
-    text = SHELF.source.path.read_text().replace("planning_time: 5.0", "planning_time: 0.001")
+def test_no_path_within_the_budget_says_what_was_tried_and_what_would_help():
+    checker, robot, query = slot_query("slot_40", 1)  # 40 mm taller than the forearm: not found in 4 s of search
+    planner = make_planner(query.config(planning_time=0.2), robot, query.start)
+    with pytest.raises(PlanningError, match=r"no collision-free path to goal 0 found within planning_time = 0.2 s "
+                                            r"\(RRTConnect, 1 configuration tried, \d+ states sampled in 0.1\d s of "
+                                            r"search\); a path may need more time: give planning_time = 0.8") as refused:
+        checker.check_planner(planner)
+    assert refused.value.cause is Cause.PLANNING and refused.value.field == ("goals", 0)
+    assert "Approximate" not in str(refused.value) and "Timeout" not in str(refused.value)  # not OMPL's words
+
+
+def test_a_narrow_passage_is_found_and_the_budget_covers_all_of_planning():
+    checker, robot, query = slot_query("slot_60", 4)  # a slot 60 mm taller than the forearm
+    planner = make_planner(query.config(planning_time=2.0), robot, query.start)
+    checker.check_planner(planner)  # found, timed and checked in the cell
+    np.testing.assert_allclose(planner.plan().value(planner.plan().end_time()).ravel(), query.goal, atol=1e-9)
+    # search, shortening, smoothing, timing and the check together: within the budget (0.2 s of slack
+    # for a busy machine's timing and check, which cannot be cut short)
+    assert 0.0 < planner.planning_time_s < 2.0 + 0.2
+
+
+def test_a_scenario_refusal_is_at_the_goals_line(tmp_path, monkeypatch):
+    text = SHELF.source.path.read_text()
     path = tmp_path / "tight.yaml"
     path.write_text(text)
     line = 1 + text.splitlines().index(next(row for row in text.splitlines() if row.strip().startswith("- [0.70")))
+    # a search that finds nothing (the shelf's own is found within milliseconds)
+    monkeypatch.setattr(free_system, "search", lambda *args, **kwargs: SearchResult(None, "rrt_connect", 0.01, 7, 7, ""))
     with pytest.raises(PlanningError, match=rf"tight.yaml, line {line}, column 7: no collision-free path to pose 0"):
         simulate(load_scenario(path))
 

@@ -4,7 +4,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from drake_traj.planners.free.search import PLANNERS
+from drake_traj.planners.free.search import COLLISION_CHECKS, DEFAULT_MAX_STEP, PLANNERS
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import finite_array, invalid, positive_scalar, whole_number
 
@@ -27,12 +27,18 @@ class FreeMotionConfig:
             by a path.
         velocity_limit, acceleration_limit, jerk_limit: per joint (or one value); empty: the
             robot's joint-move limits, and 10 /s × the acceleration limit.
-        planning_time: the search's budget per goal [s].
+        planning_time: the whole planning budget of the task [s]: the search, shortening,
+            smoothing, timing and check of every goal's leg (each leg a share of what is left; the
+            search of a leg stops where the rest of it would not fit).
         seed: the random numbers' seed: the same seed finds the same path.
         planner: the OMPL planner, one of :data:`~drake_traj.planners.free.search.PLANNERS` (``rrt_connect``: the first
             path found, then shortened).
         shortcut_rounds: random shortcuts tried on each found path.
         grid_points: nodes of the timing's linear programs.
+        max_step: the longest edge the search adds [rad] (OMPL's range: :data:`~drake_traj.planners.free.search.DEFAULT_MAX_STEP`).
+        collision_check: ``compiled`` (the compiled collision model) or ``scenegraph`` (SceneGraph
+            from Python: the slower reference) for the search's configurations and segments; the
+            timed motion is checked by the cell check either way.
     """
 
     goals: list[list[float]] = field(default_factory=list)
@@ -45,6 +51,8 @@ class FreeMotionConfig:
     planner: str = "rrt_connect"
     shortcut_rounds: int = 60
     grid_points: int = 200
+    max_step: float = DEFAULT_MAX_STEP
+    collision_check: str = "compiled"
 
     def validate(self, robot: Robot = UR10E) -> "FreeMotionConfig":
         """The config, its own fields checked for ``robot`` (its number of joints n): ValueError
@@ -67,4 +75,8 @@ class FreeMotionConfig:
             raise invalid("seed", f"seed must be a whole number in [0, 2^31), got {self.seed!r}")
         whole_number(self.shortcut_rounds, "shortcut_rounds", minimum=0)
         whole_number(self.grid_points, "grid_points", minimum=20)
+        positive_scalar(self.max_step, "max_step", "rad")
+        if self.collision_check not in COLLISION_CHECKS:
+            raise invalid("collision_check", f"collision_check must be one of {list(COLLISION_CHECKS)}, got "
+                                             f"{self.collision_check!r}")
         return self

@@ -1,9 +1,12 @@
 """Collision-free joint paths through a cell: the Open Motion Planning Library's planners (the
-``ompl`` wheel) search, validity from SceneGraph's signed distances, our shortcutting after.
+``ompl`` wheel) search, validity from the cell check's compiled collision model (or SceneGraph's
+signed distances, the reference), our shortcutting after.
 
 Validity is the cell check's (:class:`~drake_traj.cell.clearance.CellChecker`, duck-typed here: its
-``pose_query``, ``reach`` and ``clearance``): a configuration is valid inside the joint ranges with
-no two bodies closer than the clearance c. A straight joint segment is valid by conservative
+``compiled_model``, ``pose_query``, ``link_reach`` and ``clearance``): a configuration is valid
+inside the joint ranges with no two bodies closer than the clearance c. The compiled model
+(:class:`~drake_traj.cell.compiled_model.CompiledCollisionModel`) gives each pair's distance as a
+certified lower bound of the true one, about 100 times faster than a SceneGraph query from Python. A straight joint segment is valid by conservative
 advancement: from a configuration where the nearest pair is d apart, no two bodies come more
 than 2.2 Σ_j R_j |Δq_j| closer (R_j the joint reach bounds, both bodies moving, the check's 1.1
 margin), so the next configuration checked is max(d - c, c/2) of that travel further: at least c
@@ -25,11 +28,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["PLANNERS", "SearchResult", "Scene", "search", "shortcut"]
+__all__ = ["COLLISION_CHECKS", "DEFAULT_MAX_STEP", "PLANNERS", "SearchResult", "Scene", "search", "shortcut"]
 
 PLANNERS = {"rrt_connect": "RRTConnect", "aorrtc": "AORRTC", "bit_star": "BITstar", "rrt_star": "RRTstar"}
 """The OMPL planners a config may name: RRT-Connect finds a path and stops (our default); the
 others are asymptotically optimal and use the whole budget."""
+
+COLLISION_CHECKS = ("compiled", "scenegraph")
+"""How the search checks configurations and segments: the compiled collision model (default), or
+SceneGraph's signed distances from Python (the reference the compiled model is measured against)."""
+
+DEFAULT_MAX_STEP = 1.0
+"""[rad] the longest edge the tree-growing planners add (OMPL's "range"). OMPL's default is 0.2 of
+the space's extent, 6.16 rad for joints of ±2π: edges across the whole cell that narrow passages
+refuse. Measured on the free-motion bench (docs/free-motion.md)."""
 
 GIVE_UP = 15
 """Shortcutting stops after this many shortcuts in a row were refused."""
@@ -48,10 +60,14 @@ class Scene:
         lower, upper: the joint ranges [rad], (n,).
     """
 
-    def __init__(self, checker, lower, upper):
+    def __init__(self, checker, lower, upper, *, collision_check: str = "compiled"):
+        if collision_check not in COLLISION_CHECKS:
+            raise ValueError(f"collision_check must be one of {COLLISION_CHECKS}, got {collision_check!r}")
         self.checker = checker
+        self.collision_check = collision_check
         self.clearance = float(checker.clearance)
         self.lower, self.upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+        self.model = checker.compiled_model() if collision_check == "compiled" else None
         reach, self._links = checker.link_reach()
         n = reach.shape[1]
         # [m/rad] (n + 1, n + 1, n): the relative travel of a pair of links per |Δq| (1.1 margin): the
@@ -74,13 +90,20 @@ class Scene:
         return rows[:, 0], rows[:, 1].astype(int), rows[:, 2].astype(int)
 
     def distance(self, q) -> float:
-        """The smallest distance [m] between two bodies at ``q``, at most :data:`LOOK_AHEAD`."""
+        """The smallest distance [m] between two bodies at ``q``, at most :data:`LOOK_AHEAD` (the
+        compiled model's: at most its own look-ahead)."""
+        if self.model is not None:
+            self.queries += 1
+            return self.model.distances(q)
         distances = self._pairs(q)[0]
         return float(distances.min()) if len(distances) else LOOK_AHEAD
 
     def valid(self, q) -> bool:
         """Inside the joint ranges and no two bodies closer than the clearance."""
         q = np.asarray(q, dtype=float)
+        if self.model is not None:
+            self.queries += 1
+            return self.model.valid(q)
         return bool(np.all(q >= self.lower) and np.all(q <= self.upper)) and self.distance(q) >= self.clearance
 
     def segment_valid(self, a, b) -> bool:
@@ -88,7 +111,11 @@ class Scene:
         configuration checked and c/2 between them; ``a`` is taken as checked. Conservative
         advancement per pair of bodies: from a configuration where a pair is d apart, the next
         one checked is max(d - c, c/2) of that pair's travel bound further (the joints between
-        its two links only), the least over the pairs (module docstring)."""
+        its two links only), the least over the pairs (module docstring); compiled where the scene
+        checks with the compiled model."""
+        if self.model is not None:
+            self.queries += 1
+            return self.model.segment_valid(a, b)
         a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
         step = b - a
         if not np.any(step):
@@ -124,20 +151,24 @@ class SearchResult:
     status: str  # OMPL's word for the outcome
 
 
-def search(scene: Scene, start, goal, *, planning_time: float, seed: int, planner: str = "rrt_connect") -> SearchResult:
-    """A collision-free joint path from ``start`` to ``goal`` by OMPL's ``planner`` within
-    ``planning_time`` [s], random numbers seeded with ``seed`` (a forked child process: module
-    docstring). Both ends must be valid (:meth:`Scene.valid`); the straight segment is tried first."""
-    start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
-    if scene.segment_valid(start, goal):
-        return SearchResult(np.array([start, goal]), "straight", 0.0, 0, scene.queries, "straight segment")
+def search(scene: Scene, start, goals, *, planning_time: float, seed: int, planner: str = "rrt_connect",
+           max_step: float = DEFAULT_MAX_STEP) -> SearchResult:
+    """A collision-free joint path from ``start`` to any of ``goals`` ((k, n), or one goal (n,))
+    by OMPL's ``planner`` within ``planning_time`` [s], random numbers seeded with ``seed`` (a
+    forked child process: module docstring), edges at most ``max_step`` [rad] long. Every end must
+    be valid (:meth:`Scene.valid`); the straight segment to each goal, in order, is tried first.
+    The path ends at the goal it reached."""
+    start, goals = np.asarray(start, dtype=float), np.atleast_2d(np.asarray(goals, dtype=float))
+    for goal in goals:
+        if scene.segment_valid(start, goal):
+            return SearchResult(np.array([start, goal]), "straight", 0.0, 0, scene.queries, "straight segment")
     read, write = os.pipe()
     child = os.fork()
     if child == 0:  # the child: search, write the result, leave without Python's exit handlers
         code = 0
         try:
             os.close(read)
-            outcome = _search_here(scene, start, goal, planning_time, seed, planner)
+            outcome = _search_here(scene, start, goals, planning_time, seed, planner, max_step)
             with os.fdopen(write, "wb") as pipe:
                 pickle.dump(outcome, pipe)
         except BaseException:  # noqa: BLE001 - anything at all: the parent reports no result
@@ -154,8 +185,10 @@ def search(scene: Scene, start, goal, *, planning_time: float, seed: int, planne
     return pickle.loads(data)
 
 
-def _search_here(scene: Scene, start, goal, planning_time: float, seed: int, planner: str) -> SearchResult:
-    """The search itself, in this process (the forked child)."""
+def _search_here(scene: Scene, start, goals, planning_time: float, seed: int, planner: str,
+                 max_step: float) -> SearchResult:
+    """The search itself, in this process (the forked child): the goals as one goal region of
+    states (OMPL's GoalStates), so every candidate shares one search."""
     from ompl import base as ob, geometric as og, util as ou  # the child's own OMPL: a fresh seed
 
     signal.signal(signal.SIGINT, signal.SIG_DFL)  # Ctrl-C ends the child; the parent handles it
@@ -187,14 +220,22 @@ def _search_here(scene: Scene, start, goal, planning_time: float, seed: int, pla
     information.setMotionValidator(validator)
     information.setup()
     setup = og.SimpleSetup(information)
-    ends = []
-    for values in (start, goal):
+
+    def state_of(values):
         state = information.allocState()
         for j in range(n):
             state[j] = float(values[j])
-        ends.append(state)
-    setup.setStartAndGoalStates(ends[0], ends[1])
-    setup.setPlanner(getattr(og, PLANNERS[planner])(information))
+        return state
+
+    setup.setStartState(state_of(start))
+    region = ob.GoalStates(information)
+    for goal in goals:
+        region.addState(state_of(goal))
+    setup.setGoal(region)
+    search_planner = getattr(og, PLANNERS[planner])(information)
+    if hasattr(search_planner, "setRange"):
+        search_planner.setRange(float(max_step))
+    setup.setPlanner(search_planner)
     began = time.perf_counter()
     status = setup.solve(float(planning_time))
     seconds = time.perf_counter() - began
@@ -205,15 +246,17 @@ def _search_here(scene: Scene, start, goal, planning_time: float, seed: int, pla
     return SearchResult(vertices, planner, seconds, samples[0], scene.queries, str(status))
 
 
-def shortcut(scene: Scene, vertices, rng: np.random.Generator, *, rounds: int = 60) -> np.ndarray:
+def shortcut(scene: Scene, vertices, rng: np.random.Generator, *, rounds: int = 60,
+             deadline: float = float("inf")) -> np.ndarray:
     """The path ``vertices`` (k, n) [rad] shortened: up to ``rounds`` random shortcuts between two
-    points of the path (by length; :data:`GIVE_UP` refused in a row end them), each kept where
-    its segment is valid (:meth:`Scene.segment_valid`),
-    then every vertex the segment from its predecessor to its successor makes unnecessary."""
+    points of the path (by length; :data:`GIVE_UP` refused in a row end them, and so does the
+    ``deadline``, a ``time.perf_counter()`` value), each kept where its segment is valid
+    (:meth:`Scene.segment_valid`), then every vertex the segment from its predecessor to its
+    successor makes unnecessary."""
     path = [np.asarray(v, dtype=float) for v in vertices]
     failures = 0
     for _ in range(rounds):
-        if len(path) < 3 or failures >= GIVE_UP:
+        if len(path) < 3 or failures >= GIVE_UP or time.perf_counter() > deadline:
             break
         lengths = np.linalg.norm(np.diff(path, axis=0), axis=1)
         ends = np.concatenate([[0.0], np.cumsum(lengths)])

@@ -19,14 +19,18 @@ import numpy as np
 
 from drake_traj.errors import Cause, DrakeTrajError, PlanningError, joint_label
 from drake_traj.planners.base import TimeLawPlanner
-from drake_traj.planners.free.config import FreeMotionConfig
+from drake_traj.planners.free.config import MAX_PLANNING_TIME, FreeMotionConfig
 from drake_traj.planners.free.law import FreeMotionLaw, Leg
 from drake_traj.planners.free.search import PLANNERS, Scene, search, shortcut
 from drake_traj.planners.timing import jerk_limited_limits, time_path, waypoint_path
 from drake_traj.robots import Robot
 from drake_traj.validation import finite_array
 
-__all__ = ["DENSITIES", "FreeMotionPlanner", "make"]
+__all__ = ["DENSITIES", "SEARCH_SHARE", "FreeMotionPlanner", "make"]
+
+SEARCH_SHARE = 0.8
+"""The share of a leg's budget its search may take; the rest is for shortening, smoothing, timing
+and checking the path found (on the free-motion bench these take 0.1-0.3 s together)."""
 
 DENSITIES = (None, 0.3, 0.1, 0.03)
 """[rad] the spline's repair: its points along the found segments at most this far apart (None:
@@ -74,12 +78,17 @@ class FreeMotionPlanner(TimeLawPlanner):
         if self._planned_in is not None and self._planned_in[0] == checker.fingerprint:
             return self._planned_in[1]
         began = time.perf_counter()
-        scene = Scene(checker, self.robot.lower_limits, self.robot.upper_limits)
+        deadline = began + self.config.planning_time  # the whole budget: every leg, all of planning
+        scene = Scene(checker, self.robot.lower_limits, self.robot.upper_limits,
+                      collision_check=self.config.collision_check)
         rng = np.random.default_rng(self.config.seed)
         checker.check_configuration(self.initial_positions())
+        goals = list(self._goal_candidates(checker))  # every goal checked before any search
         legs, current = [], self.initial_positions()
-        for k, candidates in enumerate(self._goal_candidates(checker)):
-            leg, current = self._leg(scene, checker, rng, k, current, candidates)
+        for k, candidates in enumerate(goals):
+            now = time.perf_counter()
+            leg_deadline = now + max(deadline - now, 0.0) / (len(goals) - k)  # a share of what is left
+            leg, current = self._leg(scene, checker, rng, k, current, candidates, leg_deadline)
             legs.append(leg)
         self.law.set_legs([leg.timing for leg in legs])
         self._plan = None  # plan() is made again from the new law
@@ -133,35 +142,37 @@ class FreeMotionPlanner(TimeLawPlanner):
                 goals.append(shifted)
         return sorted(goals, key=lambda q: float(np.linalg.norm(q - previous)))
 
-    def _leg(self, scene: Scene, checker, rng, k: int, start, candidates) -> "tuple[Leg, np.ndarray]":
-        """The timed leg from ``start`` to the first of ``candidates`` a path reaches."""
+    def _leg(self, scene: Scene, checker, rng, k: int, start, candidates, deadline: float) -> "tuple[Leg, np.ndarray]":
+        """The timed leg from ``start`` to whichever of ``candidates`` one search reaches first,
+        planned by ``deadline`` (a ``time.perf_counter()`` value) where it can be."""
         word, field_ = ("goal", ("goals", k)) if len(self.config.goals) else ("pose", ("poses", k))
         goals = candidates if len(self.config.goals) else self._pose_goals(scene, candidates, start)
         if not goals:
             raise PlanningError(f"{word} {k}: none of its {len(candidates)} inverse-kinematics solutions is inside the "
                                 "joint ranges and clear of the cell", field=field_, cause=Cause.COLLISION)
-        tried = []
-        for goal in goals:
-            budget = self.config.planning_time / len(goals)
-            found = search(scene, start, goal, planning_time=budget, seed=int(rng.integers(2**31 - 1)),
-                           planner=self.config.planner)
-            tried.append(found)
-            if found.vertices is None:
-                continue
-            vertices = shortcut(scene, found.vertices, rng, rounds=self.config.shortcut_rounds)
-            for density in DENSITIES:
-                timed = self._smooth_and_time(checker, vertices, density)
-                if timed is not None:
-                    return Leg(found.vertices, vertices, *timed, density, found.seconds, found.samples), goal
-            raise PlanningError(f"{word} {k}: a path was found ({len(vertices)} vertices) but no smooth motion along it "
-                                f"kept the clearance (points along it down to {DENSITIES[-1]} rad apart)",
-                                field=field_, cause=Cause.PLANNING)
-        samples = sum(result.samples for result in tried)
-        statuses = "; ".join(sorted({result.status for result in tried}))
-        raise PlanningError(f"no collision-free path to {word} {k} found within planning_time = "
-                            f"{self.config.planning_time:g} s ({PLANNERS[self.config.planner]}, {len(tried)} "
-                            f"configuration{'s' * (len(tried) > 1)} tried, {samples} states sampled: {statuses}); raise "
-                            f"planning_time, or move the {word} away from the obstacles", field=field_, cause=Cause.PLANNING)
+        budget = SEARCH_SHARE * max(deadline - time.perf_counter(), 0.0)
+        found = search(scene, start, np.array(goals), planning_time=max(budget, 1e-3),
+                       seed=int(rng.integers(2**31 - 1)), planner=self.config.planner, max_step=self.config.max_step)
+        if found.vertices is None:
+            raise PlanningError(self._not_found(word, k, len(goals), found), field=field_, cause=Cause.PLANNING)
+        vertices = shortcut(scene, found.vertices, rng, rounds=self.config.shortcut_rounds, deadline=deadline)
+        for density in DENSITIES:
+            timed = self._smooth_and_time(checker, vertices, density)
+            if timed is not None:
+                return Leg(found.vertices, vertices, *timed, density, found.seconds, found.samples), vertices[-1]
+        raise PlanningError(f"{word} {k}: a path was found ({len(vertices)} vertices) but no smooth motion along it "
+                            f"kept the clearance (points along it down to {DENSITIES[-1]} rad apart)",
+                            field=field_, cause=Cause.PLANNING)
+
+    def _not_found(self, word: str, k: int, goals: int, found) -> str:
+        """The refusal of a search that found no path in its budget: what it tried, and what to change."""
+        budget = self.config.planning_time
+        if found.vertices is None and np.isnan(found.seconds):  # the child process ended without a result
+            return f"the search for {word} {k} failed: {found.status}"
+        return (f"no collision-free path to {word} {k} found within planning_time = {budget:g} s "
+                f"({PLANNERS[self.config.planner]}, {goals} configuration{'s' * (goals > 1)} tried, {found.samples} "
+                f"states sampled in {found.seconds:.2f} s of search); a path may need more time: give planning_time = "
+                f"{min(4 * budget, MAX_PLANNING_TIME):g} (or another seed), or move the {word} further from the obstacles")
 
     def _smooth_and_time(self, checker, vertices, density):
         """(the timed spline through ``vertices`` (points ``density`` [rad] apart along the
