@@ -16,12 +16,16 @@ import pytest
 from pydrake.geometry import Ellipsoid, HalfSpace, ProximityProperties
 from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.tree import BodyIndex
+from pydrake.trajectories import PiecewisePolynomial
+from scipy.spatial import cKDTree
 
 from drake_traj import get_robot
-from drake_traj.cell import Box, Cell, CellChecker, Cylinder, Sphere, Tool, UnsupportedShapeError
+from drake_traj.cell import Box, Cell, CellChecker, CollisionError, Cylinder, Sphere, Tool, UnsupportedShapeError
 from drake_traj.cell.convex_distance import segment_distance
 from drake_traj.data import data_directory
 from drake_traj.robots.chain_arm import ChainArm
+
+UR10E = get_robot("ur10e")
 
 LOOK_AHEAD = 0.07  # [m] the free-motion search's look-ahead (the model's default)
 CONSERVATIVE = 1e-6  # [m] the most a compiled distance may be above SceneGraph's
@@ -239,3 +243,42 @@ def test_accepted_segments_keep_half_the_clearance(name):
             pairs = checker.pose_query(a + u * (b - a)).ComputeSignedDistancePairwiseClosestPoints(0.5 * c)
             assert not [pair.distance for pair in pairs if pair.distance < 0.5 * c], (a, b, u)
     assert accepted == needed
+
+
+def _cylinder_surface(query, geometry, spacing: float = 5e-4) -> np.ndarray:
+    """Points on a cylinder geometry's surface (side and both caps) about ``spacing`` [m] apart, in the world."""
+    shape = query.inspector().GetShape(geometry)
+    r, h = shape.radius(), shape.length() / 2
+    angles = np.linspace(0.0, 2 * np.pi, int(2 * np.pi * r / spacing), endpoint=False)
+    heights = np.linspace(-h, h, int(2 * h / spacing) + 1)
+    side = [(r * np.cos(a), r * np.sin(a), z) for a in angles for z in heights]
+    caps = [(rho * np.cos(a), rho * np.sin(a), z) for z in (-h, h) for rho in np.linspace(0.0, r, int(r / spacing) + 1)
+            for a in angles]
+    X = query.GetPoseInWorld(geometry)
+    return (X.rotation().matrix() @ np.array(side + caps).T).T + X.translation()
+
+
+def test_the_cell_check_takes_the_smaller_of_scenegraph_and_the_certified_distance():
+    """SceneGraph's signed distance between two of the UR10e's cylinders (the forearm's joint 4
+    housing and the wrist 2 link's joint 6 housing) is 2.3 mm above the true one in this
+    configuration: with a clearance between the two, the check refuses what SceneGraph alone let through."""
+    q = np.array([0.38625543, -2.28754037, -1.34318407, 2.33710291, 0.47260968, -1.52009363])
+    probe = CellChecker(UR10E)
+    query = probe.pose_query(q)
+    inspector = query.inspector()
+    (reported,) = [pair for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.1)
+                   if {inspector.GetName(pair.id_A), inspector.GetName(pair.id_B)}
+                   == {"ur10e::joint4_housing", "ur10e::joint6_housing"}]
+    # an upper bound of the true distance, independently: two points of the two surfaces
+    tree = cKDTree(_cylinder_surface(query, reported.id_B))
+    witness = float(tree.query(_cylinder_surface(query, reported.id_A))[0].min())
+    nearest = min(pair.distance for pair in query.ComputeSignedDistancePairwiseClosestPoints(0.1))
+    assert nearest == reported.distance and reported.distance - witness > 2e-3  # SceneGraph: 2 mm further
+    clearance = 0.5 * (reported.distance + witness)
+    checker = CellChecker(UR10E, cell=Cell(clearance=clearance))
+    assert not checker.contacts(q)  # SceneGraph alone would let it through
+    with pytest.raises(CollisionError, match="forearm_link") as refused:
+        checker.check_configuration(q)
+    assert refused.value.distance <= witness
+    with pytest.raises(CollisionError, match="wrist_2_link"):
+        checker.check(PiecewisePolynomial.ZeroOrderHold([0.0, 1.0], np.column_stack([q, q])))

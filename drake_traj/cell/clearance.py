@@ -31,7 +31,7 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import Trajectory
 
 from drake_traj.cell.cell import Cell, add_cell
-from drake_traj.cell.compiled_model import CompiledCollisionModel
+from drake_traj.cell.compiled_model import CompiledCollisionModel, UnsupportedShapeError
 from drake_traj.cell.directives import refuse_free_bodies
 from drake_traj.cell.shapes import shape_radius
 from drake_traj.errors import Cause, DrakeTrajError, Field, PlanningError, joint_label
@@ -285,6 +285,8 @@ class CellChecker:
         self._inspector = self.scene_graph.model_inspector()
         self.reach = joint_reach(self.plant, self.scene_graph, self._plant_context, self.instance, robot.joint_names)
         self.fingerprint = scene_fingerprint(self.plant, self._inspector)
+        self._compiled_model = None  # built on first use (compiled_model)
+        self.compiled_unavailable: str | None = None  # why the compiled model cannot take this scene
 
     @property
     def clearance(self) -> float:
@@ -300,7 +302,7 @@ class CellChecker:
         this clearance: :class:`~drake_traj.cell.compiled_model.CompiledCollisionModel`), built at
         the first call and kept: batches of configurations checked 100 times faster and more than
         by SceneGraph, each distance a certified lower bound of SceneGraph's."""
-        if getattr(self, "_compiled_model", None) is None:
+        if self._compiled_model is None:
             self._compiled_model = CompiledCollisionModel(self)
         return self._compiled_model
 
@@ -327,6 +329,46 @@ class CellChecker:
                 nearest[key] = Contact(pair.distance, (body_a, body_b), (geometry_a, geometry_b), points,
                                        (self._on_arm(pair.id_A), self._on_arm(pair.id_B)))
         return sorted(nearest.values(), key=lambda contact: contact.distance)
+
+    def _second_opinion(self) -> CompiledCollisionModel | None:
+        """The compiled model for the checks' second opinion, or None where the scene has a shape
+        it does not take (:class:`~drake_traj.cell.compiled_model.UnsupportedShapeError`; then
+        SceneGraph alone checks, and :attr:`compiled_unavailable` says why)."""
+        if self.compiled_unavailable is not None:
+            return None
+        try:
+            return self.compiled_model()
+        except UnsupportedShapeError as error:
+            self.compiled_unavailable = str(error)
+            return None
+
+    def _missed_contacts(self, q) -> list[Contact]:
+        """The nearest pair closer than the clearance at ``q`` by the compiled model's certified
+        lower bound where SceneGraph's signed distance put it further (SceneGraph's distance of a
+        cylinder or box pair can be above the true one by millimetres:
+        :mod:`~drake_traj.cell.compiled_model`), as a one-entry list (its points SceneGraph's
+        closest points of the pair); empty where the model finds none."""
+        model = self._second_opinion()
+        if model is None:
+            return []
+        bounds = model.pair_bounds(q)
+        p = int(np.argmin(bounds[:, 0])) if len(bounds) else -1
+        if p < 0 or bounds[p, 0] >= self.clearance:
+            return []
+        pair_ids = {model.geometries[model.pairs[p, 0]], model.geometries[model.pairs[p, 1]]}
+        query = self.pose_query(q)
+        points = np.full((2, 3), np.nan)
+        for pair in query.ComputeSignedDistancePairwiseClosestPoints(self.clearance + 0.1):
+            if {pair.id_A, pair.id_B} == pair_ids:
+                points = np.array([query.GetPoseInWorld(pair.id_A) @ pair.p_ACa,
+                                   query.GetPoseInWorld(pair.id_B) @ pair.p_BCb])
+                ids = (pair.id_A, pair.id_B)
+                break
+        else:
+            ids = tuple(pair_ids)
+        (body_a, geometry_a), (body_b, geometry_b) = self.owner(ids[0]), self.owner(ids[1])
+        return [Contact(float(bounds[p, 0]), (body_a, body_b), (geometry_a, geometry_b), points,
+                        (self._on_arm(ids[0]), self._on_arm(ids[1])))]
 
     def _on_arm(self, geometry) -> bool:
         """Whether the geometry's body moves with the arm: a body of the robot's model (its
@@ -373,7 +415,8 @@ class CellChecker:
               target_word: str = "waypoint") -> MotionCheck:
         """Check the joint reference ``trajectory`` (a Drake Trajectory of q(t), e.g.
         ``planner.plan()``): every joint inside its range on a 1 ms grid, then no two bodies
-        closer than the clearance at :meth:`sample_times`.
+        closer than the clearance at :meth:`sample_times`, by SceneGraph's signed distances and by
+        the compiled model's certified lower bounds (:meth:`compiled_model`), whichever is smaller.
 
         ``waypoints`` (m, 3) [m], the task's tool points in order, name the segment of a
         collision ("on the way to waypoint k", ``target_word`` the planner's word for them:
@@ -397,8 +440,12 @@ class CellChecker:
         spacing = self.default_spacing() if spacing is None else float(spacing)
         times = self.sample_times(trajectory, spacing, grid=grid, q=q)
         samples = trajectory.vector_values(times).T
+        model = self._second_opinion()
+        compiled = model.distances(samples) if model is not None else np.full(len(samples), np.inf)
         for k, (t, q_t) in enumerate(zip(times, samples)):
             contacts = self.contacts(q_t)
+            if not contacts and compiled[k] < self.clearance:
+                contacts = self._missed_contacts(q_t)
             if contacts:
                 through = self._through(contacts[0], times[k:], samples[k:])
                 raise self._collision(contacts[0], t, q_t, trajectory, waypoints, target_word, through)
@@ -438,7 +485,7 @@ class CellChecker:
         if not getattr(self, "_free_bodies_refused", False):
             refuse_free_bodies(self.plant, self.instance, self.cell_fields)
             self._free_bodies_refused = True
-        contacts = self.contacts(q)
+        contacts = self.contacts(q) or self._missed_contacts(q)
         if contacts:
             contact = contacts[0]
             if contact.distance < 0 and all(contact.on_arm):
