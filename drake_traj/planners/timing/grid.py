@@ -12,11 +12,12 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["initial_grid", "node_samples", "node_times", "path_derivatives", "refined_grid"]
+__all__ = ["initial_grid", "node_samples", "node_times", "refined_grid"]
 
 
-def initial_grid(path, velocity, acceleration, points: int) -> np.ndarray:
-    """Grid nodes s: ``points`` evenly spaced in the time of an estimate of the bang-bang optimum,
+def initial_grid(values, velocity, acceleration, points: int):
+    """(grid nodes s, the estimate's x and p = x' there [rad²/s², rad/s²]): ``points`` nodes evenly
+    spaced in the time of an estimate of the bang-bang optimum,
     so the nodes crowd where the path is slow and near the ends, plus the path's breaks (on a path
     through hundreds of dense goals the breaks alone left a hairpin turn two nodes, where the
     program stopped the path: "the path speed falls to 0"). The estimate, on 4001 samples: the
@@ -24,10 +25,12 @@ def initial_grid(path, velocity, acceleration, points: int) -> np.ndarray:
     accelerations at constant ṡ), reached from rest and brought to rest at the path acceleration
     min_j a_j / |q'_j| (x' = 2 s̈), each a running minimum; t from ds / ṡ with ṡ linear in t
     between samples. Drake's Toppra gave the same T within 0.2 % on seeded tasks at 5 times the
-    time, and fails on some paths with tight turns."""
+    time, and fails on some paths with tight turns. ``values``: the path's
+    :class:`~drake_traj.planners.timing.paths.PathValues`. The estimate's (x, p) at the nodes picks
+    the rows the bang-bang program starts with (:mod:`.program`)."""
+    path = values.path
     s = np.linspace(path.start_time(), path.end_time(), 4001)
-    d1 = np.abs(path.MakeDerivative(1).vector_values(s))
-    d2 = np.abs(path.MakeDerivative(2).vector_values(s))
+    d1, d2 = (np.abs(value).T for value in values(s, 1, 2))
     with np.errstate(divide="ignore"):
         cap = np.min(np.minimum(velocity[:, None] ** 2 / d1**2, acceleration[:, None] / d2), axis=0)
         path_acceleration = np.min(acceleration[:, None] / d1, axis=0)
@@ -36,9 +39,12 @@ def initial_grid(path, velocity, acceleration, points: int) -> np.ndarray:
     # x(s) <= x(s') + 2 (A(s) - A(s')) for every s' before s, and the same towards the end
     forward = 2 * ramp + np.minimum.accumulate(cap - 2 * ramp)
     backward = 2 * (ramp[-1] - ramp) + np.minimum.accumulate((cap - 2 * (ramp[-1] - ramp))[::-1])[::-1]
-    rate = np.sqrt(np.maximum(np.minimum(forward, backward), 0.0))
+    estimate = np.maximum(np.minimum(forward, backward), 0.0)
+    rate = np.sqrt(estimate)
     times = np.concatenate([[0.0], np.cumsum(2 * np.diff(s) / np.maximum(rate[1:] + rate[:-1], 1e-300))])
-    return _with_breaks(path, np.interp(np.linspace(0.0, times[-1], points), times, s))
+    nodes = _with_breaks(path, np.interp(np.linspace(0.0, times[-1], points), times, s))
+    x = np.interp(nodes, s, estimate)
+    return nodes, x, np.gradient(x, nodes)
 
 
 def refined_grid(path, coarse: np.ndarray, x: np.ndarray, p: np.ndarray, points: int):
@@ -70,12 +76,6 @@ def _with_breaks(path, s: np.ndarray) -> np.ndarray:
     s = s[keep]
     s[-1] = path.end_time()
     return s
-
-
-def path_derivatives(derivatives, s):
-    """First, second and third derivatives of q(s) at ``s``, each (N, n), from ``derivatives``:
-    the trajectories of those derivatives (a program's ``derivatives``, :mod:`.program`)."""
-    return [derivative.vector_values(s).T for derivative in derivatives]
 
 
 _GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(8)
@@ -113,10 +113,10 @@ def _midpoints(s: np.ndarray, x: np.ndarray, p: np.ndarray):
     return s[:-1] + half, x_mid, p_mid, dt
 
 
-def node_samples(path, program, x: np.ndarray, p: np.ndarray):
+def node_samples(program, x: np.ndarray, p: np.ndarray):
     """(t, [q, q̇, q̈] (K, 3, n), [s, ṡ, s̈] (K, 3)) of the solution (x, p) of ``program`` (its grid
-    ``s`` and the path's ``derivatives``) at the nodes and the middle of every interval (the knots
-    of the pieces), at rest at both ends."""
+    ``s`` and the path's ``values``) at the nodes and the middle of every interval (the knots of
+    the pieces), at rest at both ends."""
     nodes = node_times(program.s, x, p)
     s_mid, x_mid, p_mid, dt_mid = _midpoints(program.s, x, p)
     order = np.argsort(np.concatenate([program.s, s_mid]), kind="stable")
@@ -124,9 +124,8 @@ def node_samples(path, program, x: np.ndarray, p: np.ndarray):
     x = np.concatenate([x, x_mid])[order]
     p = np.concatenate([p, p_mid])[order]
     t = np.concatenate([nodes, nodes[:-1] + dt_mid])[order]
-    d1, d2 = path_derivatives(program.derivatives[:2], s)
+    q, d1, d2 = program.values(s, 0, 1, 2)
     rate = np.sqrt(np.maximum(x, 0.0))
-    q = path.vector_values(s).T
     qd = d1 * rate[:, None]
     qdd = d1 * (0.5 * p)[:, None] + d2 * x[:, None]
     return t, np.stack([q, qd, qdd], axis=1), np.stack([s, rate, 0.5 * p], axis=1)

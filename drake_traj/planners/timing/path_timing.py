@@ -31,10 +31,10 @@ import numpy as np
 
 from drake_traj.errors import joint_label
 from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coefficients
-from drake_traj.planners.timing.grid import initial_grid, node_samples, refined_grid
+from drake_traj.planners.timing.grid import initial_grid, node_samples, node_times, refined_grid
 from drake_traj.planners.timing.limits import check_least_durations, joint_limits
 from drake_traj.planners.timing.motion import InfeasibleTimingError, SmoothTiming, stretched
-from drake_traj.planners.timing.paths import PATH_TOLERANCE, check_path
+from drake_traj.planners.timing.paths import PATH_TOLERANCE, PathValues, check_path
 from drake_traj.planners.timing.program import solve_on_grid
 from drake_traj.validation import positive_scalar, whole_number
 
@@ -52,15 +52,16 @@ MAX_GRID_POINTS = 4000
 4nN constraints; 4000 nodes take seconds, a million would not finish)."""
 
 
-def _deviation(path, knots, joint_coefficients, path_samples) -> float:
+def _deviation(values, knots, joint_coefficients, path_samples) -> float:
     """Upper bound [rad] of the distance of the pieces from the path: at 4 points inside every
     piece, |q_piece(t) - q(s_piece(t))|, s_piece the quintic Hermite of (s, ṡ, s̈)."""
     s_coefficients = quintic_hermite_coefficients(knots, path_samples[:, :, None], path_samples[:, :, None])
     tau = np.array([0.2, 0.4, 0.6, 0.8])[None, :] * np.diff(knots)[:, None]  # (K, 4)
     powers = tau[:, :, None] ** np.arange(6)  # (K, 4, 6)
     q = np.einsum("kfp,kpn->kfn", powers, joint_coefficients).reshape(-1, joint_coefficients.shape[2])
+    path = values.path
     s = np.clip(np.einsum("kfp,kp->kf", powers, s_coefficients[:, :, 0]).ravel(), path.start_time(), path.end_time())
-    return float(np.abs(q - path.vector_values(s).T).max())
+    return float(np.abs(q - values(s, 0)[0]).max())
 
 
 class _Pieces(NamedTuple):
@@ -75,24 +76,33 @@ class _Pieces(NamedTuple):
     deviation: float  # [rad] from the path (without the spline's fit)
 
 
-def _better(coarse: _Pieces, fine: _Pieces, tolerance: float) -> _Pieces:
-    """The finer grid's motion where it keeps to the path within ``tolerance`` [rad] and is no
-    longer, or where the coarse one strays; else the coarse grid's."""
-    if coarse.deviation > tolerance or (fine.deviation <= tolerance and fine.t[-1] <= coarse.t[-1]):
-        return fine
-    return coarse
+def _shortest(solutions, limits: np.ndarray, tolerance: float) -> _Pieces:
+    """The shortest motion of the grids' ``solutions`` (program, x, p), coarse to fine, that keeps to
+    the path within ``tolerance`` [rad] (of equal ones the finer grid's), or where none does the
+    finest grid's. The pieces (their exact check, repair and deviation: the cost) are made in the
+    order of the solutions' times at the nodes, which the repair only stretches, until that time
+    exceeds the shortest motion found: most often once or twice, not once per grid."""
+    bounds = [node_times(program.s, x, p)[-1] for program, x, p in solutions]
+    made, best = {}, None  # best: (T, -k) of the shortest motion that keeps to the path so far
+    for k in sorted(range(len(solutions)), key=lambda k: (bounds[k], -k)):
+        if best is not None and bounds[k] > best[0]:
+            break
+        made[k] = _pieces(*solutions[k], limits)
+        if made[k].deviation <= tolerance and (best is None or (made[k].t[-1], -k) < best):
+            best = (made[k].t[-1], -k)
+    return made[len(solutions) - 1 if best is None else -best[1]]
 
 
-def _pieces(path, program, x: np.ndarray, p: np.ndarray, limits: np.ndarray) -> _Pieces:
-    """The motion of the solution (x, p) of ``program`` (its grid and the path's derivatives) as
+def _pieces(program, x: np.ndarray, p: np.ndarray, limits: np.ndarray) -> _Pieces:
+    """The motion of the solution (x, p) of ``program`` (its grid and the path's values) as
     quintic Hermite pieces through the nodes and the middle of every interval, with the repair
     (:func:`stretched`)."""
-    t, joint_samples, path_samples = node_samples(path, program, x, p)
+    t, joint_samples, path_samples = node_samples(program, x, p)
     coefficients = quintic_hermite_coefficients(t, joint_samples, joint_samples)
     t, joint_samples, coefficients, ratio, stretch = stretched(t, joint_samples, coefficients, limits, 1e-6)
     path_samples = path_samples / stretch ** np.arange(3)[None, :]
     return _Pieces(t, joint_samples, path_samples, coefficients, ratio, stretch,
-                   _deviation(path, t, coefficients, path_samples))
+                   _deviation(program.values, t, coefficients, path_samples))
 
 
 def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid_points: int = 200,
@@ -105,8 +115,9 @@ def time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, grid
         velocity_limit, acceleration_limit: per joint [rad/s, rad/s²], > 0 (scalar or (n,)).
         jerk_limit: per joint [rad/s³], > 0; None: 10 /s × the acceleration limit.
         grid_points: nodes of the linear programs evenly in time, besides the path's breaks (more:
-            never longer, slower; 100 is within 0.05 % of 4000 on seeded waypoint paths, and 2.3
-            times Toppra's CPU against 3.9 at 200, but 200 times dense goals up to 8 % faster).
+            never longer, slower; 100 is within 0.05 % of 4000 on seeded waypoint paths and takes
+            0.54 times Drake's Toppra's CPU in the median against 0.9 at 200 (docs/smooth_timing.md,
+            "Planning time"), but 200 times dense goals up to 8 % faster).
         iterations: the most linear programs with the jerk on each grid (they stop once T
             shortens by < 0.2 %).
         max_duration: the longest motion accepted [s]: limits so small that the motion would
@@ -140,43 +151,45 @@ def _time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, gri
     path, fit = check_path(path)
     velocity, acceleration, jerk = joint_limits(path.rows(), velocity_limit, acceleration_limit, jerk_limit)
     max_duration = positive_scalar(max_duration, "max_duration", "s")
+    values = PathValues(path)
     s_all = np.linspace(path.start_time(), path.end_time(), 2001)
-    travel = np.trapezoid(np.abs(path.MakeDerivative(1).vector_values(s_all)), s_all, axis=1)  # per joint [rad]
+    travel = np.trapezoid(np.abs(values(s_all, 1)[0]), s_all, axis=0)  # per joint [rad]
     # A joint's travel D is made of rest-to-rest pieces (it stops where it turns back), and the sums
     # of their least durations are at least those of D (the roots are concave). Checked before any
     # array is made.
     check_least_durations(travel, (velocity, acceleration, jerk), max_duration, "travels")
     limits = np.stack([velocity, acceleration, jerk])
-    pieces, solved, previous = None, 0, None
+    solutions, solved, previous = [], 0, None
     breaks = len(path.get_segment_times()) - 2  # nodes of every grid: levels they dwarf are skipped
     levels = [points for points in GRID_LEVELS if breaks <= 4 * points and points < grid_points] + [grid_points]
     for points in levels:
         # each grid started from the last one's solution (s, x, p), the first (or one after a grid
         # whose path speed fell to 0: too few nodes at a tight turn) from the bang-bang profile
         if previous is None:
-            s, initial = initial_grid(path, velocity, acceleration, points), None
+            (s, *guess), initial = initial_grid(values, velocity, acceleration, points), None
         else:
-            s, *initial = refined_grid(path, *previous, points)
+            (s, *initial), guess = refined_grid(path, *previous, points), None
         try:
-            program, x, p, more = solve_on_grid(path, s, (velocity, acceleration, jerk), iterations, start=initial)
+            program, x, p, more = solve_on_grid(values, s, (velocity, acceleration, jerk), iterations, start=initial,
+                                                guess=guess)
         except InfeasibleTimingError:
-            if pieces is None and points == grid_points:
+            if not solutions and points == grid_points:
                 raise
             continue  # the coarser grids' motion stands
         solved += more
         if not np.all(x[1:-1] > 0):
             previous = None
-            if pieces is None and points == levels[-1] and 2 * points <= min(4 * grid_points, MAX_GRID_POINTS):
+            if not solutions and points == levels[-1] and 2 * points <= min(4 * grid_points, MAX_GRID_POINTS):
                 levels.append(2 * points)  # no motion yet: twice the nodes in time (a hairpin two nodes wide)
             continue
         previous = (s, x, p)
-        finer = _pieces(path, program, x, p, limits)
-        pieces = finer if pieces is None else _better(pieces, finer, PATH_TOLERANCE - fit)
-    if pieces is None:
+        solutions.append((program, x, p))
+    if not solutions:
         k = int(np.argmin(x[1:-1])) + 1
         raise InfeasibleTimingError(
             f"the limits are too small for the path: the path speed falls to 0 at s = {s[k]:.6g} (velocity_limit, "
             "acceleration_limit or jerk_limit)", field=("path",))
+    pieces = _shortest(solutions, limits, PATH_TOLERANCE - fit)
     t, joint_samples, coefficients, ratio, stretch = (pieces.t, pieces.joint_samples, pieces.coefficients,
                                                       pieces.ratio, pieces.stretch)
     if not t[-1] <= max_duration:

