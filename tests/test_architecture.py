@@ -20,7 +20,17 @@ def module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-MODULES = {module_name(path): path for path in PACKAGE.rglob("*.py")}
+# an installed package holds the shipped models/ and diagrams/ (pyproject's package-dir): data and
+# example scripts, not code of the package's layers
+SHIPPED_DATA = ("models", "diagrams")
+
+
+def package_files(pattern: str) -> list[Path]:
+    """The package's files matching ``pattern``, without the shipped data folders."""
+    return [path for path in PACKAGE.rglob(pattern) if path.relative_to(PACKAGE).parts[0] not in SHIPPED_DATA]
+
+
+MODULES = {module_name(path): path for path in package_files("*.py")}
 
 
 def imports_of(name: str) -> list[tuple[str, bool]]:
@@ -98,7 +108,7 @@ def layer(name: str) -> str:
 
 
 def test_every_folder_is_a_layer():
-    folders = {path.name for path in PACKAGE.iterdir() if (path / "__init__.py").exists()}
+    folders = {path.name for path in PACKAGE.iterdir() if (path / "__init__.py").exists()} - set(SHIPPED_DATA)
     assert folders == set(LAYERS) - {"core"}, "a package of drake_traj missing from LAYERS, or a layer with no folder"
 
 
@@ -149,7 +159,7 @@ def test_house_limits_on_module_and_function_length():
 def test_design_doc_lists_every_module_of_the_package():
     """docs/design.md's "Where each part lives" names every folder and module of drake_traj, and
     nothing that is not there: the picture matches the folders one to one."""
-    design = (PACKAGE.parent / "docs" / "design.md").read_text()
+    design = (Path(__file__).resolve().parents[1] / "docs" / "design.md").read_text()
     tree = design.split("## Where each part lives", 1)[1].split("```", 2)[1]
     listed, folders = set(), []
     for line in tree.splitlines():
@@ -162,8 +172,8 @@ def test_design_doc_lists_every_module_of_the_package():
         if token.endswith("/"):
             folders.append(token.rstrip("/"))
         listed.add(path)
-    actual = {path.relative_to(PACKAGE.parent).as_posix() for path in PACKAGE.rglob("*.py")}
-    actual |= {path.relative_to(PACKAGE.parent).as_posix() for path in PACKAGE.rglob("*")
+    actual = {path.relative_to(PACKAGE.parent).as_posix() for path in package_files("*.py")}
+    actual |= {path.relative_to(PACKAGE.parent).as_posix() for path in package_files("*")
                if path.is_dir() and (path / "__init__.py").exists()}
     actual -= {path for path in actual if path.endswith(("__init__.py", "__main__.py"))}
     actual.add(PACKAGE.name)
