@@ -23,6 +23,7 @@ from drake_traj import get_robot
 from drake_traj.cell import Box, Cell, CellChecker, CollisionError, Cylinder, Sphere, Tool, UnsupportedShapeError
 from drake_traj.cell.convex_distance import segment_distance
 from drake_traj.data import data_directory
+from drake_traj.planners.free import Scene
 from drake_traj.robots.chain_arm import ChainArm
 
 UR10E = get_robot("ur10e")
@@ -219,10 +220,12 @@ def _cartesian_cell() -> CellChecker:
 
 @pytest.mark.parametrize("name", ["ur5e_cell", "cartesian"])
 def test_accepted_segments_keep_half_the_clearance(name):
-    # the Cartesian robot's travel is |Δq| per prismatic joint (link_reach reads it as a turn: the
-    # search's Scene accepts segments there that come closer than c/2)
+    # the Cartesian robot's travel is |Δq| per prismatic joint (link_reach had read it as a turn: the
+    # search's Scene accepted segments there that come closer than c/2); both the compiled segment
+    # check and the SceneGraph one of the search's Scene
     checker = _ur5e_cell() if name == "ur5e_cell" else _cartesian_cell()
     model = checker.compiled_model()
+    reference = Scene(checker, checker.robot.lower_limits, checker.robot.upper_limits, collision_check="scenegraph")
     robot = checker.robot
     rng = np.random.default_rng(4)
     c = checker.clearance
@@ -234,7 +237,7 @@ def test_accepted_segments_keep_half_the_clearance(name):
         b = np.clip(a + rng.normal(0.0, 0.25 if name == "ur5e_cell" else 1.0, len(a)) * (robot.upper_limits
                                                                                     - robot.lower_limits) / 4,
                     robot.lower_limits, robot.upper_limits)
-        if not (model.valid(a) and model.segment_valid(a, b)):
+        if not (model.valid(a) and (model.segment_valid(a, b) if accepted % 2 else reference.segment_valid(a, b))):
             continue
         accepted += 1
         travel = 1.1 * np.abs(b - a) @ checker.reach  # [m] any point's travel bound over the segment

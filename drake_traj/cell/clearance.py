@@ -31,14 +31,14 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import Trajectory
 
 from drake_traj.cell.cell import Cell, add_cell
-from drake_traj.cell.compiled_model import CompiledCollisionModel, UnsupportedShapeError
+from drake_traj.cell.compiled_model import CompiledCollisionModel, UnsupportedShapeError, pair_travel
 from drake_traj.cell.directives import refuse_free_bodies
-from drake_traj.cell.shapes import shape_radius
+from drake_traj.cell.reach import joint_reach, link_reach
 from drake_traj.errors import Cause, DrakeTrajError, Field, PlanningError, joint_label
 from drake_traj.robots import Robot
 from drake_traj.validation import MAX_RUN_DURATION
 
-__all__ = ["CellChecker", "CollisionError", "Contact", "JointRangeError", "MotionCheck", "geometry_owner", "joint_reach",
+__all__ = ["CellChecker", "CollisionError", "Contact", "JointRangeError", "MotionCheck", "geometry_owner",
            "planner_target_word"]
 
 RANGE_GRID = 1e-3  # [s] joint ranges are checked at the log's period
@@ -131,67 +131,6 @@ def refuse_unprotected_links(robot, missing: list[str]) -> None:
             "them, and a motion through the table would pass. Give them collision geometry (a mesh is checked as its "
             f"convex hull), or say that they run unprotected: robot.unchecked_links: [{listed}] (or [all]; the run's "
             "metrics then name them)", field=("robot", "unchecked_links"), cause=Cause.COLLISION)
-
-
-def joint_reach(plant, scene_graph, plant_context, instance, joint_names) -> np.ndarray:
-    """R_j [m] per joint of a serial chain: a bound on the distance of any collision geometry
-    outboard of joint j (on its child link or on bodies welded to it, such as the tool) from
-    joint j's origin, which lies on its axis; 1 for a prismatic joint (a point moves at |q̇_j|).
-    Poses are fixed in each link, so any ``plant_context`` gives them."""
-    inspector = scene_graph.model_inspector()
-    joints = [plant.GetJointByName(name, instance) for name in joint_names]
-    reach = np.zeros(len(joints))
-    outboard = 0.0  # R_{j+1}, added to the offset from joint j to joint j+1
-    for j in reversed(range(len(joints))):
-        joint = joints[j]
-        origin = joint.frame_on_child().CalcPoseInWorld(plant_context)
-        link = joint.child_body()
-        bound = 0.0
-        for body in plant.GetBodiesWeldedTo(link):
-            X_OB = origin.InvertAndCompose(body.body_frame().CalcPoseInWorld(plant_context))
-            for geometry in plant.GetCollisionGeometriesForBody(body):
-                X_OG = X_OB @ inspector.GetPoseInFrame(geometry)
-                bound = max(bound, float(np.linalg.norm(X_OG.translation())) + shape_radius(inspector.GetShape(geometry)))
-        if j + 1 < len(joints):
-            following = joints[j + 1]
-            offset = origin.InvertAndCompose(following.frame_on_parent().CalcPoseInWorld(plant_context)).translation()
-            stroke = (max(abs(following.position_lower_limits()[0]), abs(following.position_upper_limits()[0]))
-                      if following.type_name() == "prismatic" else 0.0)
-            bound = max(bound, float(np.linalg.norm(offset)) + stroke + outboard)
-        reach[j] = 1.0 if joint.type_name() == "prismatic" else bound
-        outboard = bound
-    return reach
-
-
-def link_reach(plant, scene_graph, instance, joint_names) -> tuple[np.ndarray, dict]:
-    """Per-link travel bounds of a serial arm: (R [m/rad] (n + 1, n), the link of every
-    collision geometry: {GeometryId: link}, 0 for the base and everything fixed in the world).
-
-    R[i, j] bounds the distance of link i's collision geometry (the bodies welded to it, the tool
-    on the last link, included) from joint j's origin on its axis, for every joint j that moves
-    link i (j < i; joints from 0, link 0 the base): a turn Δq_j moves each of its points at most
-    R[i, j] |Δq_j|. From the link's own geometry about its joint and the joint-to-joint offsets
-    (the triangle inequality, as :func:`joint_reach`, which is the most of these over the links)."""
-    inspector = scene_graph.model_inspector()
-    context = plant.CreateDefaultContext()
-    joints = [plant.GetJointByName(name, instance) for name in joint_names]
-    n = len(joints)
-    origins = [joint.frame_on_child().CalcPoseInWorld(context) for joint in joints]
-    reach = np.zeros((n + 1, n))
-    links = {}
-    for j, joint in enumerate(joints):
-        bound = 0.0
-        for body in plant.GetBodiesWeldedTo(joint.child_body()):
-            X_OB = origins[j].InvertAndCompose(body.body_frame().CalcPoseInWorld(context))
-            for geometry in plant.GetCollisionGeometriesForBody(body):
-                links[geometry] = j + 1
-                X_OG = X_OB @ inspector.GetPoseInFrame(geometry)
-                bound = max(bound, float(np.linalg.norm(X_OG.translation())) + shape_radius(inspector.GetShape(geometry)))
-        reach[j + 1, j] = bound
-        for k in reversed(range(j)):  # the joints before it: its origin's offset to the next joint's, and on
-            offset = origins[k].InvertAndCompose(joints[k + 1].frame_on_parent().CalcPoseInWorld(context)).translation()
-            reach[j + 1, k] = float(np.linalg.norm(offset)) + reach[j + 1, k + 1]
-    return reach, links
 
 
 def geometry_owner(plant, inspector, geometry, robot_instance) -> tuple[str, str]:
@@ -296,6 +235,12 @@ class CellChecker:
     def link_reach(self) -> tuple[np.ndarray, dict]:
         """:func:`link_reach` of the robot in this checker's plant (per-link travel bounds)."""
         return link_reach(self.plant, self.scene_graph, self.instance, self.robot.joint_names)
+
+    def pair_travel(self) -> tuple[np.ndarray, dict]:
+        """(T [m/rad or m/m] (n + 1, n + 1, n), {GeometryId: link}): how far link b moves relative
+        to link a per |Δq_j| (:func:`~drake_traj.cell.compiled_model.pair_travel`), for the
+        free-motion search's conservative advancement."""
+        return pair_travel(self)
 
     def compiled_model(self) -> CompiledCollisionModel:
         """The compiled collision model of this checker's scene (the robot, its tool and the cell at

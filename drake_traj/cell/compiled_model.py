@@ -206,24 +206,12 @@ def _z_onto(axis) -> RotationMatrix:
 
 def pair_travel(checker) -> tuple[np.ndarray, dict]:
     """(T [m/rad or m/m] (n + 1, n + 1, n), {GeometryId: link}): T[a, b, j] bounds how far link b
-    moves relative to link a per |Δq_j|, from :func:`~drake_traj.cell.clearance.link_reach` with
-    the cell check's 1.1 margin, as :class:`~drake_traj.planners.free.search.Scene` builds it: the
-    joints between the two links turn the outer one about the inner one; the joints before both,
-    neither. A prismatic joint j (which link_reach measures as a turn at the default position)
-    moves every point outboard by |Δq_j| (its column set to 1), and lengthens the reach of the
-    revolute joints before it by its stroke (max |limit|, as
-    :func:`~drake_traj.cell.clearance.joint_reach`): both are corrected here."""
+    moves relative to link a per |Δq_j| (a turn; a prismatic joint's shift moves points by itself),
+    from :func:`~drake_traj.cell.clearance.link_reach` with the cell check's 1.1 margin: the joints
+    between the two links move the outer one about the inner one; the joints before both, neither."""
     reach, links = checker.link_reach()
     reach = np.array(reach, dtype=float)
-    plant, instance = checker.plant, checker.instance
-    joints = [plant.GetJointByName(name, instance) for name in checker.robot.joint_names]
     n = reach.shape[1]
-    prismatic = [m for m, joint in enumerate(joints) if isinstance(joint, PrismaticJoint)]
-    for m in prismatic:  # its link and those beyond, about the (revolute) joints before it
-        joint = joints[m]
-        reach[m + 1:, :m] += max(abs(joint.position_lower_limits()[0]), abs(joint.position_upper_limits()[0]))
-    for m in prismatic:  # a shift moves every point outboard by itself
-        reach[m + 1:, m] = 1.0
     travel = np.zeros((n + 1, n + 1, n))
     for a in range(n + 1):
         for b in range(n + 1):

@@ -3,7 +3,7 @@
 signed distances, the reference), our shortcutting after.
 
 Validity is the cell check's (:class:`~drake_traj.cell.clearance.CellChecker`, duck-typed here: its
-``compiled_model``, ``pose_query``, ``link_reach`` and ``clearance``): a configuration is valid
+``compiled_model``, ``pose_query``, ``pair_travel`` and ``clearance``): a configuration is valid
 inside the joint ranges with no two bodies closer than the clearance c. The compiled model
 (:class:`~drake_traj.cell.compiled_model.CompiledCollisionModel`) gives each pair's distance as a
 certified lower bound of the true one, about 100 times faster than a SceneGraph query from Python. A straight joint segment is valid by conservative
@@ -73,15 +73,9 @@ class Scene:
         if self.model is not None:  # its kernels compiled (or read from numba's cache) now, not in a search's budget
             middle = 0.5 * (self.lower + self.upper)
             self.model.valid(middle), self.model.distances(middle), self.model.segment_valid(middle, middle + 1e-3)
-        reach, self._links = checker.link_reach()
-        n = reach.shape[1]
         # [m/rad] (n + 1, n + 1, n): the relative travel of a pair of links per |Δq| (1.1 margin): the
-        # joints between them turn the outer one about the inner one; the joints before both, neither
-        self._pair_travel = np.zeros((n + 1, n + 1, n))
-        for a in range(n + 1):
-            for b in range(n + 1):
-                inner, outer = sorted((a, b))
-                self._pair_travel[a, b, inner:] = 1.1 * reach[outer, inner:] if outer > inner else 0.0
+        # joints between them move the outer one about the inner one; the joints before both, neither
+        self._pair_travel, self._links = checker.pair_travel()
         self._any_pair = self._pair_travel.max(axis=(0, 1))  # a pair beyond the look-ahead
         self.queries = 0
 
