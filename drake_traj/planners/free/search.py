@@ -73,10 +73,10 @@ class Scene:
         if self.model is not None:  # its kernels compiled (or read from numba's cache) now, not in a search's budget
             middle = 0.5 * (self.lower + self.upper)
             self.model.valid(middle), self.model.distances(middle), self.model.segment_valid(middle, middle + 1e-3)
-        # [m/rad] (n + 1, n + 1, n): the relative travel of a pair of links per |Δq| (1.1 margin): the
-        # joints between them move the outer one about the inner one; the joints before both, neither
-        self._pair_travel, self._links = checker.pair_travel()
-        self._any_pair = self._pair_travel.max(axis=(0, 1))  # a pair beyond the look-ahead
+        else:  # SceneGraph's advancement: [m/rad] (n + 1, n + 1, n) the relative travel of a pair of links
+            # per |Δq| (1.1 margin): the joints between them move the outer one about the inner one
+            self._pair_travel, self._links = checker.pair_travel()
+            self._any_pair = self._pair_travel.max(axis=(0, 1))  # a pair beyond the look-ahead
         self.queries = 0
 
     def _pairs(self, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
