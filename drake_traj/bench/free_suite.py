@@ -45,7 +45,7 @@ FREE_COLUMNS = (
     "kind", "scene_seed", "goal", "solved", "planning_s", "wall_s", "cpu_s", "T_s", "T_toppra_s", "T_over_toppra",
     "min_distance_m", "clearance_m", "keeps_clearance", "witness_min_m", "generation_s", "failure",
 )
-PLANNING_TIME = 5.0  # [s] the search's budget per goal: FreeMotionConfig's default, as users run it
+PLANNING_TIME = 5.0  # [s] the whole planning budget of a query: FreeMotionConfig's default, as users run it
 SAMPLE_PERIOD = 1e-3  # [s] of the timed motion between two samples of the independent check
 WITHIN = 0.05  # [m] distances are looked at up to this (a larger one reads as 0.05)
 PROBE_REACH = 2.0  # [m/rad] a bound on any body's travel per radian of any joint (UR10e and tool: 1.81)
@@ -242,7 +242,7 @@ def free_bench(out_dir, *, count: int = 5, seed: int = 0, workers: int | None = 
         workers, scheduler: where the queries run (:func:`~drake_traj.bench.bench`'s; default a
             local Dask cluster of one process per core, 1: in this process, in order).
         kinds: the scene kinds (:data:`~drake_traj.bench.free_scenes.SCENE_KINDS`).
-        planning_time: the planner's search budget per goal [s].
+        planning_time: the planner's whole planning budget of a query [s].
         progress: stream of the progress (None: none); prints free.md and the files written.
         overwrite, command: as :func:`~drake_traj.bench.bench`'s.
 

@@ -294,7 +294,7 @@ class CellChecker:
         :mod:`~drake_traj.cell.compiled_model`), as a one-entry list (its points SceneGraph's
         closest points of the pair); empty where the model finds none."""
         model = self._second_opinion()
-        if model is None:
+        if model is None or model.distances(q) >= self.clearance:  # the broad phase first: most are clear
             return []
         bounds = model.pair_bounds(q)
         p = int(np.argmin(bounds[:, 0])) if len(bounds) else -1

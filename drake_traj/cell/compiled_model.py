@@ -231,8 +231,7 @@ class CompiledCollisionModel:
 
     Attributes: ``clearance`` [m] (the checker's), ``lower``, ``upper`` (n,) the joint ranges,
     ``bodies`` the BodyIndex of each moving link row (:meth:`body_poses`), ``geometries`` the
-    GeometryId of each geometry row, ``pairs`` (P, 4) [geometry a, geometry b, link a, link b] rows,
-    ``pair_names`` the (body/geometry, body/geometry) names of each pair.
+    GeometryId of each geometry row, ``pairs`` (P, 4) [geometry a, geometry b, link a, link b] rows.
     """
 
     def __init__(self, checker, *, look_ahead: float = DEFAULT_LOOK_AHEAD, tolerance: float = TOLERANCE):
@@ -256,7 +255,6 @@ class CompiledCollisionModel:
         self.bodies = list(tree.order)
         self.geo_i, self.geo_f, self.vertices = self._geometry_tables(plant, inspector, tree, body_of)
         self.pairs = np.zeros((len(candidates), 4), dtype=np.int64)
-        self.pair_names = []
         for p, (a, b) in enumerate(sorted(candidates, key=lambda pair: (rows[pair[0]], rows[pair[1]]))):
             for g in (a, b):
                 if tree.moving(body_of[g]) and g not in links:
@@ -264,8 +262,6 @@ class CompiledCollisionModel:
                                          "chain (a joint of its own): the travel bounds do not cover it",
                                          field=("cell",), cause=Cause.INVALID)
             self.pairs[p] = [rows[a], rows[b], links.get(a, 0), links.get(b, 0)]
-            self.pair_names.append(tuple(checker.owner(g)[0] + "/" + inspector.GetName(g).split("::")[-1]
-                                         for g in (a, b)))
         self.model = (self.links_i, self.links_f, self.geo_i, self.geo_f, self.vertices, self.pairs)
 
     def _geometry_tables(self, plant, inspector, tree, body_of) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -176,7 +176,7 @@ def _closest_triangle(w, a, b, c):
         s = (d4 - d3) / ((d4 - d3) + (d5 - d6))
         return 0.0, 1.0 - s, s, 6
     total = va + vb + vc
-    if total == 0.0:  # a degenerate triangle not caught above: its longest edge's closest point
+    if total == 0.0:  # a degenerate triangle not caught above: vertex a (a point of the set: a safe upper bound)
         return 1.0, 0.0, 0.0, 1
     return va / total, vb / total, vc / total, 7
 

@@ -33,8 +33,7 @@ __all__ = ["FOLDER_KINDS", "LOCK", "Claim", "OutputError", "WriteError", "check_
 LOCK = ".drake-traj.lock"
 _OWN_PREFIX = ".drake-traj-"  # staging folders, set-aside content and temporary files
 # The files that mark a folder as a run's or a bench's (a run's manifest first).
-FOLDER_KINDS = {"run": ("run.json", "result.npz", "metrics.json"),
-                "bench": ("bench.csv", "bench.md", "bench.png", "free.csv", "free.md")}
+FOLDER_KINDS = {"run": ("run.json", "result.npz", "metrics.json"), "bench": ("bench.csv", "bench.md", "bench.png")}
 MiB = 2**20
 
 

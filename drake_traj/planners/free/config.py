@@ -11,7 +11,7 @@ from drake_traj.validation import finite_array, invalid, positive_scalar, whole_
 __all__ = ["FreeMotionConfig", "MAX_GOALS", "MAX_PLANNING_TIME"]
 
 MAX_GOALS = 100  # goals (or poses) of one task at most
-MAX_PLANNING_TIME = 120.0  # [s] the longest search budget
+MAX_PLANNING_TIME = 120.0  # [s] the largest planning budget of a task
 
 
 @dataclass

@@ -83,7 +83,7 @@ class FreeMotionPlanner(TimeLawPlanner):
         deadline = began + self.config.planning_time  # the whole budget: every leg, all of planning
         rng = np.random.default_rng(self.config.seed)
         checker.check_configuration(self.initial_positions())
-        goals = list(self._goal_candidates(checker))  # every goal checked before any search
+        goals = list(self._goal_candidates(checker))  # joint goals checked, poses solved, before any search
         legs, current = [], self.initial_positions()
         for k, candidates in enumerate(goals):
             now = time.perf_counter()
@@ -167,12 +167,14 @@ class FreeMotionPlanner(TimeLawPlanner):
     def _not_found(self, word: str, k: int, goals: int, found) -> str:
         """The refusal of a search that found no path in its budget: what it tried, and what to change."""
         budget = self.config.planning_time
-        if found.vertices is None and np.isnan(found.seconds):  # the child process ended without a result
+        if np.isnan(found.seconds):  # the child process ended without a result
             return f"the search for {word} {k} failed: {found.status}"
         return (f"no collision-free path to {word} {k} found within planning_time = {budget:g} s "
                 f"({PLANNERS[self.config.planner]}, {goals} configuration{'s' * (goals > 1)} tried, {found.samples} "
-                f"states sampled in {found.seconds:.2f} s of search); a path may need more time: give planning_time = "
-                f"{min(4 * budget, MAX_PLANNING_TIME):g} (or another seed), or move the {word} further from the obstacles")
+                f"states sampled in {found.seconds:.2f} s of search); " + (
+                    f"a path may need more time: give planning_time = {min(4 * budget, MAX_PLANNING_TIME):g} (or another "
+                    "seed), or " if budget < MAX_PLANNING_TIME else "try another seed, or ") +
+                f"move the {word} further from the obstacles")
 
     def _smooth_and_time(self, checker, vertices, density):
         """(the timed spline through ``vertices`` (points ``density`` [rad] apart along the

@@ -123,7 +123,7 @@ class _Program:
         after, before = (values(side, 3)[0] for side in (np.minimum(s + offset, s[-1]), np.maximum(s - offset, s[0])))
         m1, m2 = values(0.5 * (s[1:-2] + s[2:-1]), 1, 2)  # interior intervals 1..N-3
         jerk_rows = _jerk_rows(N, h, d1, d2, after, before)
-        self.num_accel_rows = num_accel = n * (2 * N - 5)
+        num_accel = n * (2 * N - 5)
         self.num_fixed_rows = num_accel + 3 * (N - 3) + 2
         num_jerk = 2 * (N - 2) * n
         self.matrix = _matrix([_acceleration_rows(N, h, d1, d2, m1, m2), _path_speed_rows(N, h), jerk_rows], 2 * N)
