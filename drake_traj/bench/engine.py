@@ -70,14 +70,23 @@ def run_on(client, work, builders, toppra, bar) -> dict:
                 reference = future
         if toppra:
             runs[client.submit(run_toppra, task, reference, pure=False)] = (task, "toppra")
+    rows = _collect(runs, bar, lambda output: output["row"],
+                    lambda unit, reason: failed_row(unit[0].label, unit[1], reason))
+    return {(task.label, name): row for (task, name), row in rows.items()}
+
+
+def _collect(runs: dict, bar, row_of, failed) -> dict:
+    """{unit: row} of the Dask futures ``runs`` ({future: unit}) as they complete: ``row_of`` of
+    each one's output, counted by the progress ``bar``; a unit whose worker died or could not load
+    it is ``failed(unit, reason)``."""
     rows = {}
     for future in as_completed(runs):
-        task, name = runs.pop(future)
+        unit = runs.pop(future)
         try:
-            row = future.result()["row"]
+            row = row_of(future.result())
         except Exception as error:  # the worker died, or could not load the unit
-            row = failed_row(task.label, name, failure_reason(error))
-        rows[task.label, name] = bar.done(row)
+            row = failed(unit, failure_reason(error))
+        rows[unit] = bar.done(row)
         future.release()
     return rows
 

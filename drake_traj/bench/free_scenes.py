@@ -25,6 +25,7 @@ from the base (the arm's outward direction, −x at q1 = 0), ``lateral`` [m] alo
 axis, ``z`` [m] up. Joint positions in rad.
 """
 
+import functools
 import zlib
 from dataclasses import dataclass, field, replace
 
@@ -83,9 +84,10 @@ class FreeScene:
     queries: tuple = field(default_factory=tuple)
 
 
+@functools.cache
 def forearm_radius(robot=UR10E) -> float:
     """The radius [m] of the forearm's tube in ``robot``'s model: the longest capsule or cylinder
-    of its ``forearm_link`` (the UR10e's: 0.063 m)."""
+    of its ``forearm_link`` (the UR10e's: 0.063 m); read once per robot (a plant of its own)."""
     checker = CellChecker(robot, Cell(mounting=NoMounting()))
     inspector = checker.scene_graph.model_inspector()
     body = checker.plant.GetBodyByName("forearm_link", checker.instance)

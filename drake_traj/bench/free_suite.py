@@ -6,12 +6,13 @@ One work unit is one query (:func:`run_free_query`): its scene drawn from its se
 (``make_planner(FreeMotionConfig(...), robot, start)``) and planned in the scene's cell as the
 preflight does (``CellChecker.check_planner``, which calls ``plan_in``). A row records whether it
 was solved (or the refusal's message), the planning time (the planner's ``planning_time_s``, and
-the wall and process CPU time round the call, the OMPL search's forked child included), the
-motion's duration T, T over Drake's Toppra's time-optimal duration on the same found path
-(:func:`~drake_traj.bench.optimum.converged_optimum`, the planner's velocity and acceleration
-limits, no jerk limit), and the least distance between any two bodies at every 1 ms sample of
-the timed motion by a SceneGraph query of this module's own (:class:`ClearanceProbe`: a plant of
-the robot and the cell, not the planner's checker), and the same of the query's witness.
+the wall and process CPU time round the call), the motion's duration T, T over Drake's Toppra's
+time-optimal duration on the same found path (:func:`~drake_traj.bench.optimum.converged_optimum`,
+the planner's velocity and acceleration limits, no jerk limit), and the least distance between
+any two bodies at every 1 ms sample of the timed motion by a SceneGraph query of this module's own
+(:class:`ClearanceProbe`: a cell check of its own, a second plant of the robot and the cell, asked
+for signed distances directly: not the planner's checker, its samples or its compiled model). The
+query's witness was checked when its scene was made (:mod:`~drake_traj.bench.free_scenes`).
 
 ``free.csv`` has every row, ``free.md`` the summary per kind (:func:`summary`), written whole by
 the bench's writer (:mod:`drake_traj.results.output`).
@@ -19,23 +20,19 @@ the bench's writer (:mod:`drake_traj.results.output`).
 
 import csv
 import functools
-import resource
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-from pydrake.systems.framework import DiagramBuilder
-from distributed import as_completed
 
-from drake_traj.bench.engine import BenchSetupError, _default_workers, _engine, _Progress, where
-from drake_traj.bench.free_scenes import SCENE_KINDS, WITNESS_SPACING, generate
+from drake_traj.bench.engine import BenchSetupError, _collect, _default_workers, _engine, _Progress, where
+from drake_traj.bench.free_scenes import SCENE_KINDS, generate
 from drake_traj.bench.optimum import converged_optimum
 from drake_traj.bench.report import _format
-from drake_traj.bench.run import _claim_output_directory
+from drake_traj.bench.run import _check_where, _claim_output_directory, _whole_number
 from drake_traj.bench.units import failure_reason
-from drake_traj.cell import CellChecker, add_cell
+from drake_traj.cell import CellChecker
 from drake_traj.planners import make_planner
 
 __all__ = ["ClearanceProbe", "FREE_COLUMNS", "FREE_FILES", "free_bench", "run_free_query", "summary"]
@@ -43,57 +40,31 @@ __all__ = ["ClearanceProbe", "FREE_COLUMNS", "FREE_FILES", "free_bench", "run_fr
 FREE_FILES = ("free.csv", "free.md")
 FREE_COLUMNS = (
     "kind", "scene_seed", "goal", "solved", "planning_s", "wall_s", "cpu_s", "T_s", "T_toppra_s", "T_over_toppra",
-    "min_distance_m", "clearance_m", "keeps_clearance", "witness_min_m", "generation_s", "failure",
+    "min_distance_m", "clearance_m", "keeps_clearance", "generation_s", "failure",
 )
 PLANNING_TIME = 5.0  # [s] the whole planning budget of a query: FreeMotionConfig's default, as users run it
 SAMPLE_PERIOD = 1e-3  # [s] of the timed motion between two samples of the independent check
 WITHIN = 0.05  # [m] distances are looked at up to this (a larger one reads as 0.05)
-PROBE_REACH = 2.0  # [m/rad] a bound on any body's travel per radian of any joint (UR10e and tool: 1.81)
 MAX_COUNT = 1000  # queries per kind
 
 
 class ClearanceProbe:
     """The least signed distance [m] between any two bodies that may collide (the arm's links, its
-    tool, the cell's geometry) from a MultibodyPlant and SceneGraph of its own: ``robot``'s model
-    and ``cell`` (:func:`~drake_traj.cell.add_cell`), queried with
-    ``ComputeSignedDistancePairwiseClosestPoints``. Joint positions in rad, world = base frame."""
+    tool, the cell's geometry): ``robot`` in ``cell`` in a cell check of its own
+    (:class:`~drake_traj.cell.CellChecker`: its plant and SceneGraph, the pairs it checks), asked
+    ``ComputeSignedDistancePairwiseClosestPoints`` directly. Joint positions in rad, world = base frame."""
 
     def __init__(self, robot, cell):
-        builder = DiagramBuilder()
-        plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
-        self._instance = robot.add_to_plant(plant)
-        add_cell(plant, cell, self._instance, robot=robot)
-        plant.Finalize()
-        self._diagram = builder.Build()
-        context = self._diagram.CreateDefaultContext()
-        self._plant, self._plant_context = plant, plant.GetMyMutableContextFromRoot(context)
-        self._port, self._scene_context = scene_graph.get_query_output_port(), scene_graph.GetMyContextFromRoot(context)
+        self._checker = CellChecker(robot, cell)
 
     def distance(self, q, within: float = WITHIN) -> float:
         """The least distance at ``q``; ``within`` [m] where every pair is further apart."""
-        self._plant.SetPositions(self._plant_context, self._instance, np.asarray(q, dtype=float))
-        pairs = self._port.Eval(self._scene_context).ComputeSignedDistancePairwiseClosestPoints(within)
+        pairs = self._checker.pose_query(q).ComputeSignedDistancePairwiseClosestPoints(within)
         return min((pair.distance for pair in pairs), default=within)
 
     def along(self, configurations, within: float = WITHIN) -> float:
         """The least :meth:`distance` over ``configurations`` (k, n)."""
         return min((self.distance(q, within) for q in configurations), default=within)
-
-    def along_path(self, vertices, spacing: float = WITNESS_SPACING, within: float = WITHIN) -> float:
-        """The least distance at samples of the joint path ``vertices`` (straight segments) no
-        more than ``spacing`` [m] of travel apart, bounded by :data:`PROBE_REACH` per radian of
-        every joint (independent of the cell check's bounds)."""
-        samples = [np.asarray(vertices[:1], dtype=float)]
-        for a, b in zip(np.asarray(vertices, dtype=float), np.asarray(vertices, dtype=float)[1:]):
-            pieces = max(1, int(np.ceil(PROBE_REACH * np.abs(b - a).sum() / spacing)))
-            samples.append(a + (b - a) * (np.arange(1, pieces + 1) / pieces)[:, None])
-        return self.along(np.concatenate(samples), within)
-
-
-def _cpu() -> float:
-    """CPU time [s] of this process and its ended children (the planner's forked searches)."""
-    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
 
 
 def _failed(kind: str, scene_seed: int, reason: str, **known) -> dict:
@@ -114,16 +85,16 @@ def run_free_query(kind: str, scene_seed: int, planning_time: float = PLANNING_T
     query = scene.queries[0]
     probe = ClearanceProbe(scene.robot, scene.cell)
     known = {"goal": "pose" if query.pose is not None else "joints", "clearance_m": scene.cell.clearance,
-             "generation_s": time.perf_counter() - began, "witness_min_m": probe.along_path(query.witness)}
+             "generation_s": time.perf_counter() - began}
     checker = CellChecker(scene.robot, scene.cell)
-    wall, cpu = time.perf_counter(), _cpu()
+    wall, cpu = time.perf_counter(), time.process_time()
     try:
         planner = make_planner(query.config(planning_time=planning_time), scene.robot, query.start)
         checker.check_planner(planner)  # what the preflight's cell check calls: plan_in(checker)
     except Exception as error:  # refused: the planner's message
-        return _failed(kind, scene_seed, failure_reason(error), wall_s=time.perf_counter() - wall, cpu_s=_cpu() - cpu,
-                       **known)
-    known |= {"wall_s": time.perf_counter() - wall, "cpu_s": _cpu() - cpu}
+        return _failed(kind, scene_seed, failure_reason(error), wall_s=time.perf_counter() - wall,
+                       cpu_s=time.process_time() - cpu, **known)
+    known |= {"wall_s": time.perf_counter() - wall, "cpu_s": time.process_time() - cpu}
     return _solved_row(kind, scene_seed, planner, probe, known)
 
 
@@ -162,8 +133,8 @@ def _reason(failure: str) -> str:
 def summary(rows) -> list[dict]:
     """Per kind (in :data:`SCENE_KINDS`'s order), then over all: queries, solved, planning time
     [s] (the planner's, of the solved queries; CPU and wall round the call, of all) median / p90 /
-    worst, T / T_toppra median, the least distance [mm] seen in the solved motions and in the
-    witnesses, and the failures by their kind (:data:`REASONS`)."""
+    worst, T / T_toppra median, the least distance [mm] seen in the solved motions, and the
+    failures by their kind (:data:`REASONS`)."""
     table = []
     kinds = [kind for kind in SCENE_KINDS if any(row["kind"] == kind for row in rows)]
     for kind in kinds + ["all"]:
@@ -181,15 +152,13 @@ def summary(rows) -> list[dict]:
             "cpu_s": _percentiles(row["cpu_s"] for row in mine), "wall_s": _percentiles(row["wall_s"] for row in mine),
             "T_over_toppra": f"{np.median(ratios):.3f}" if ratios else "-",
             "min_distance_mm": min((1e3 * row["min_distance_m"] for row in solved), default=float("nan")),
-            "witness_min_mm": min((1e3 * row["witness_min_m"] for row in mine if np.isfinite(row["witness_min_m"])),
-                                  default=float("nan")),
             "failures": ", ".join(f"{count} {reason}" for reason, count in reasons.items())})
     return table
 
 
 SUMMARY_HEADER = ("kind", "queries", "solved", "solved [%]", "planning [s] median / p90 / worst (solved)",
                   "CPU [s] median / p90 / worst", "wall [s] median / p90 / worst", "T / T_toppra median",
-                  "least distance [mm], motions", "least distance [mm], witnesses", "failures")
+                  "least distance [mm]", "failures")
 
 
 def markdown(rows, count: int, seed: int, planning_time: float) -> str:
@@ -213,15 +182,9 @@ def _write_csv(rows, path) -> None:
 
 def _check(count, seed, workers, scheduler, kinds, planning_time) -> None:
     """BenchSetupError naming the first argument of :func:`free_bench` that cannot work."""
-    for value, name, least, most in ((count, "--count", 1, MAX_COUNT), (seed, "--seed", 0, 2**31 - MAX_COUNT)):
-        if isinstance(value, bool) or not isinstance(value, int) or not least <= value <= most:
-            raise BenchSetupError(f"{name} must be a whole number from {least} to {most}, got {value!r}")
-    if workers is not None:
-        if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= _default_workers():
-            raise BenchSetupError(f"--workers must be a whole number from 1 to {_default_workers()} (this machine's "
-                                  f"cores), got {workers!r}")
-        if scheduler is not None:
-            raise BenchSetupError("give --workers (a local cluster) or --scheduler (an existing one), not both")
+    _whole_number(count, "count", "--count", 1, MAX_COUNT)
+    _whole_number(seed, "seed", "--seed", 0, 2**31 - MAX_COUNT)
+    _check_where(workers, scheduler)
     unknown = [kind for kind in kinds if kind not in SCENE_KINDS]
     if unknown or not kinds:
         raise BenchSetupError(f"kinds must be some of {list(SCENE_KINDS)}, got {list(kinds)}")
@@ -272,23 +235,21 @@ def free_bench(out_dir, *, count: int = 5, seed: int = 0, workers: int | None = 
 
 
 def _run(client, work, planning_time, bar) -> dict:
-    """{(kind, scene seed): row} of every unit of ``work``: in this process (``client`` None) or on Dask."""
+    """{(kind, scene seed): row} of every unit of ``work``: in this process (``client`` None) or on
+    Dask; a query not solved counts as failed on the progress ``bar``."""
+    counted = _Solved(bar)
     if client is None:
-        return {unit: _done(bar, run_free_query(*unit, planning_time)) for unit in work}
+        return {unit: counted.done(run_free_query(*unit, planning_time)) for unit in work}
     futures = {client.submit(run_free_query, *unit, planning_time, pure=False): unit for unit in work}
-    rows = {}
-    for future in as_completed(futures):
-        unit = futures.pop(future)
-        try:
-            row = future.result()
-        except Exception as error:  # the worker died, or could not load the unit
-            row = _failed(*unit, failure_reason(error))
-        rows[unit] = _done(bar, row)
-        future.release()
-    return rows
+    return _collect(futures, counted, lambda row: row, lambda unit, reason: _failed(*unit, reason))
 
 
-def _done(bar, row) -> dict:
-    """Count ``row`` on the progress ``bar`` (a query not solved counts as failed); returns it."""
-    bar.done({"succeeded": row["solved"]})
-    return row
+class _Solved:
+    """The progress ``bar`` of the queries: a row counts as failed where it was not solved."""
+
+    def __init__(self, bar):
+        self._bar = bar
+
+    def done(self, row) -> dict:
+        self._bar.done({"succeeded": row["solved"]})
+        return row

@@ -17,24 +17,32 @@ __all__ = ["bench"]
 MAX_COUNT = 10_000  # seeded tasks per bench: each costs about 10 s of one core here (all planners)
 
 
-def _check_arguments(count, seed, repeats, workers, scheduler, planners, extra_planners) -> None:
-    """BenchSetupError naming the option of the first of :func:`bench`'s arguments that cannot work."""
-    def whole(value, name, option, least, most=2**32 - 1, why=""):
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not least <= value <= most:
-            raise BenchSetupError(f"{name} ({option}) must be a whole number from {least} to {most}{why}, got {value!r}")
+def _whole_number(value, name, option, least, most=2**32 - 1, why="") -> None:
+    """BenchSetupError unless ``value`` (the argument ``name``, option ``option``) is a whole number
+    from ``least`` to ``most`` (``why``: what bounds it)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not least <= value <= most:
+        raise BenchSetupError(f"{name} ({option}) must be a whole number from {least} to {most}{why}, got {value!r}")
 
-    whole(count, "count", "--count", 0, MAX_COUNT)
-    whole(seed, "seed", "--seed", 0)
-    whole(repeats, "repeats", "--repeats", 1, 1000)
+
+def _check_where(workers, scheduler) -> None:
+    """BenchSetupError for ``workers`` or ``scheduler`` (where the runs go) that cannot work."""
     if workers is not None:
-        whole(workers, "workers", "--workers", 1, _default_workers(),
-              " (this machine's cores, a process each; for more, a Dask cluster: --scheduler)")
+        _whole_number(workers, "workers", "--workers", 1, _default_workers(),
+                     " (this machine's cores, a process each; for more, a Dask cluster: --scheduler)")
         if scheduler is not None:
             raise BenchSetupError(
                 f"workers (--workers {workers}) sizes the local cluster; with --scheduler {scheduler} the runs go "
                 "to that cluster's workers: give one of the two")
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
         raise BenchSetupError(f"scheduler (--scheduler) must be an address such as tcp://host:8786, got {scheduler!r}")
+
+
+def _check_arguments(count, seed, repeats, workers, scheduler, planners, extra_planners) -> None:
+    """BenchSetupError naming the option of the first of :func:`bench`'s arguments that cannot work."""
+    _whole_number(count, "count", "--count", 0, MAX_COUNT)
+    _whole_number(seed, "seed", "--seed", 0)
+    _whole_number(repeats, "repeats", "--repeats", 1, 1000)
+    _check_where(workers, scheduler)
     unknown = [name for name in planners if name not in PLANNERS]
     if unknown or not planners:
         raise BenchSetupError(f"planners must be some of {list(PLANNERS)}, got {list(planners)}")

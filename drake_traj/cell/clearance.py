@@ -8,16 +8,15 @@ pair of collision geometries that Drake does not filter: the arm's non-adjacent 
 and the cell (bodies joined by a joint, and everything welded to the world, are filtered by the
 plant; the robot model may declare more, with its reasons, in its URDF).
 
-Sampling (:meth:`CellChecker.sample_times`). No point of the arm moves faster than
-``Σ_j |q̇_j| R_j``, where ``R_j`` bounds the distance of any collision geometry outboard of joint
-j from that joint's axis (:func:`joint_reach`, from the plant's fixed joint and geometry poses:
-for a serial chain R_j = max(geometry of link j, |offset to joint j+1| + R_{j+1})). The samples
-are spaced so that this bound integrates to at most ``spacing`` between neighbours; between two
-samples every point is then within ``spacing / 2`` of where it was at the nearer one, and a
-signed distance (1-Lipschitz in each body's displacement) is at least the sampled one minus
-``spacing`` (both bodies moving) or minus ``spacing / 2`` (arm against the cell). With the
-default ``spacing = clearance / 2``, a motion accepted at ``clearance`` keeps at least
-``clearance / 2`` everywhere between the samples.
+Sampling (:meth:`CellChecker.check`): conservative advancement on the arm's travel bounds
+(:mod:`~drake_traj.cell.reach`, where the argument is): from a sample where two links are d apart,
+the next sample is at most ``d - clearance + spacing`` of their travel bound further, so no
+distance falls below ``clearance - spacing`` between two samples; with the default ``spacing =
+clearance / 2``, a motion accepted at ``clearance`` keeps at least ``clearance / 2`` everywhere
+between the samples, and where the arm is far from everything the samples are far apart. d is the
+smaller of SceneGraph's signed distance and the compiled model's certified lower bound
+(:class:`~drake_traj.cell.compiled_model.CompiledCollisionModel`), SceneGraph asked for every pair
+within the distance that covers the step: SceneGraph's own distances prove every step.
 """
 
 import hashlib
@@ -31,11 +30,11 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.trajectories import Trajectory
 
 from drake_traj.cell.cell import Cell, add_cell
-from drake_traj.cell.compiled_model import CompiledCollisionModel, UnsupportedShapeError, pair_travel
+from drake_traj.cell.compiled_model import DEFAULT_LOOK_AHEAD, CompiledCollisionModel, UnsupportedShapeError
 from drake_traj.cell.directives import refuse_free_bodies
-from drake_traj.cell.reach import joint_reach, link_reach
+from drake_traj.cell.reach import Advancement, joint_reach, link_reach, pair_travel
 from drake_traj.errors import Cause, DrakeTrajError, Field, PlanningError, joint_label
-from drake_traj.robots import Robot
+from drake_traj.robots import Robot, exclude_self_contact, srdf_hint, touching_shapes
 from drake_traj.validation import MAX_RUN_DURATION
 
 __all__ = ["CellChecker", "CollisionError", "Contact", "JointRangeError", "MotionCheck", "geometry_owner",
@@ -179,11 +178,13 @@ def scene_fingerprint(plant, inspector) -> str:
 
 @dataclass(frozen=True)
 class MotionCheck:
-    """An accepted motion: the configurations checked at its sample times [s], and the bound
-    [m] on any point's travel between two of them."""
+    """An accepted motion: the configurations checked at its sample times [s], the least distance
+    [m] the check took at each (at most the look-ahead) and ``spacing`` [m]: no distance falls more
+    than ``spacing`` below the clearance between two samples (module docstring)."""
 
     times: np.ndarray
     spacing: float
+    distances: np.ndarray
 
 
 class CellChecker:
@@ -214,6 +215,7 @@ class CellChecker:
         if before_finalize is not None:  # a station's own bodies (add_station's before_finalize)
             before_finalize(self.plant, self.scene_graph)
         self.plant.Finalize()
+        self.unchecked_pairs = exclude_self_contact(self.plant, self.scene_graph, self.instance, robot)  # before contexts
         self.unprotected_links = unprotected_links(self.plant, self.instance, robot.joint_names)
         refuse_unprotected_links(robot, self.unprotected_links)
         self._diagram = builder.Build()
@@ -238,9 +240,12 @@ class CellChecker:
 
     def pair_travel(self) -> tuple[np.ndarray, dict]:
         """(T [m/rad or m/m] (n + 1, n + 1, n), {GeometryId: link}): how far link b moves relative
-        to link a per |Δq_j| (:func:`~drake_traj.cell.compiled_model.pair_travel`), for the
-        free-motion search's conservative advancement."""
-        return pair_travel(self)
+        to link a per |Δq_j| (:func:`~drake_traj.cell.reach.pair_travel` of :meth:`link_reach`),
+        for the conservative advancement of the check and of the free-motion search; made once."""
+        if getattr(self, "_pair_travel", None) is None:
+            reach, links = self.link_reach()
+            self._pair_travel = (pair_travel(reach), links)
+        return self._pair_travel
 
     def compiled_model(self) -> CompiledCollisionModel:
         """The compiled collision model of this checker's scene (the robot, its tool and the cell at
@@ -330,28 +335,31 @@ class CellChecker:
             self._arm_bodies = arm = frozenset(arm)
         return int(self.plant.GetBodyFromFrameId(self._inspector.GetFrameId(geometry)).index()) in arm
 
-    def sample_times(self, trajectory: Trajectory, spacing: float | None = None, *, grid=None, q=None) -> np.ndarray:
-        """Times [s] at which to check ``trajectory`` (q(t)) so that no point of the arm moves
-        more than ``spacing`` [m] (default half the clearance, at least 1 mm) between two
-        samples (module docstring). The speed bound is integrated on a 1 ms grid, each step's
-        |Δq_j| standing for ∫|q̇_j| dt (exact where no joint turns back inside the millisecond;
-        a 10 % margin covers the rest). ``grid`` and ``q`` (the trajectory on it) when known.
-
-        A motion that needs more than :data:`MAX_SAMPLES` samples (an arm of absurd reach, a
+    def _advancement(self, grid, q, spacing: float) -> Advancement:
+        """The travel bounds along ``q`` (the trajectory on its ``grid``); a motion whose travel
+        takes more than :data:`MAX_SAMPLES` samples ``spacing`` [m] apart (an arm of absurd reach, a
         long motion at a small clearance) is refused before any is taken: DrakeTrajError at
         ``cell.clearance`` (cause INFEASIBLE) naming the travel and the clearance."""
-        spacing = self.default_spacing() if spacing is None else float(spacing)
-        grid = _grid(trajectory) if grid is None else grid
-        q = trajectory.vector_values(grid).T if q is None else q
-        travel = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(q, axis=0)) @ self.reach)]) * 1.1
-        if not travel[-1] / spacing <= MAX_SAMPLES:  # NaN too
+        advancement = Advancement(grid, q, self.reach, self.pair_travel()[0])
+        travel = float(advancement.travel[-1])
+        if not travel / spacing <= MAX_SAMPLES:  # NaN too
             raise DrakeTrajError(
-                f"the motion is too long to check in the cell: its points travel up to {travel[-1]:.4g} m (the joints' "
+                f"the motion is too long to check in the cell: its points travel up to {travel:.4g} m (the joints' "
                 f"turns times the arm's reach outboard of each, {float(np.max(self.reach)):.4g} m at most), which at "
                 f"cell.clearance = {self.clearance * 1e3:g} mm (samples {spacing * 1e3:g} mm of travel apart) takes "
-                f"{travel[-1] / spacing:.3g} samples, more than the {MAX_SAMPLES} the check takes: split the motion, "
+                f"{travel / spacing:.3g} samples, more than the {MAX_SAMPLES} the check takes: split the motion, "
                 "raise cell.clearance, or check the arm's lengths", field=("cell", "clearance"),
                 cause=Cause.INFEASIBLE)
+        return advancement
+
+    def sample_times(self, trajectory: Trajectory, spacing: float | None = None, *, grid=None, q=None) -> np.ndarray:
+        """Times [s] of ``trajectory`` (q(t)) every ``spacing`` [m] (default half the clearance, at
+        least 1 mm) of the arm's travel bound, its ends included (module docstring): the samples of
+        :meth:`check` where every pair is at the clearance, the most it takes (too many refused:
+        :meth:`_advancement`). ``grid`` (the trajectory's 1 ms grid) and ``q`` (on it) when known."""
+        spacing = self.default_spacing() if spacing is None else float(spacing)
+        grid = _grid(trajectory) if grid is None else grid
+        travel = self._advancement(grid, trajectory.vector_values(grid).T if q is None else q, spacing).travel
         count = int(np.ceil(travel[-1] / spacing))
         times = np.interp(np.linspace(0.0, travel[-1], count + 1), travel, grid) if count else grid[:1]
         return np.unique(np.concatenate([times, grid[[0, -1]]]))
@@ -360,18 +368,78 @@ class CellChecker:
               target_word: str = "waypoint") -> MotionCheck:
         """Check the joint reference ``trajectory`` (a Drake Trajectory of q(t), e.g.
         ``planner.plan()``): every joint inside its range on a 1 ms grid, then no two bodies
-        closer than the clearance at :meth:`sample_times`, by SceneGraph's signed distances and by
-        the compiled model's certified lower bounds (:meth:`compiled_model`), whichever is smaller.
+        closer than the clearance at samples placed by conservative advancement (module
+        docstring: none ``spacing`` [m] closer between two, default half the clearance, at least
+        1 mm), by SceneGraph's signed distances and the compiled model's certified lower bounds
+        (:meth:`compiled_model`), whichever is smaller.
 
         ``waypoints`` (m, 3) [m], the task's tool points in order, name the segment of a
         collision ("on the way to waypoint k", ``target_word`` the planner's word for them:
         :func:`planner_target_word`). Raises :class:`JointRangeError` or
         :class:`CollisionError` (time, bodies, distance, segment, configuration) for the first
         sample that is too close: a motion that goes on into the same body (or the arm into
-        itself) is said to go through it, how deep and when (the samples after it are
-        scanned); returns a :class:`MotionCheck`."""
+        itself) is said to go through it, how deep and when (the samples after it, every
+        ``spacing`` of travel, are scanned); returns a :class:`MotionCheck`."""
         grid = _grid(trajectory)
         q = trajectory.vector_values(grid).T
+        self._check_ranges(trajectory, grid, q, waypoints, target_word)
+        spacing = self.default_spacing() if spacing is None else float(spacing)
+        advancement = self._advancement(grid, q, spacing)
+        model = self._second_opinion()
+        pair_rows = None if model is None else advancement.row(*np.sort(model.pairs[:, 2:4], axis=1).T)
+        times, distances, t = [], [], float(grid[0])
+        while True:
+            q_t = trajectory.value(t).ravel()
+            distance, after = self._advance(advancement, t, q_t, model, pair_rows, spacing)
+            if distance < self.clearance:
+                contacts = self.contacts(q_t) or self._missed_contacts(q_t)
+                if contacts:
+                    later = self.sample_times(trajectory, spacing, grid=grid, q=q)
+                    later = np.concatenate([[t], later[later > t]])
+                    through = self._through(contacts[0], later, trajectory.vector_values(later).T)
+                    raise self._collision(contacts[0], t, q_t, trajectory, waypoints, target_word, through)
+                # the model's bound, run pair by pair to its tolerance, is not below the clearance: every pair at it
+                distance, after = self.clearance, advancement.after(t, [advancement.ANY], [spacing])
+            times.append(t)
+            distances.append(distance)
+            if t >= grid[-1]:
+                return MotionCheck(np.array(times), spacing, np.array(distances))
+            t = after
+
+    def _advance(self, advancement: Advancement, t: float, q, model, pair_rows, spacing: float) -> tuple[float, float]:
+        """:meth:`~drake_traj.cell.reach.Advancement.step` at ``q`` (time ``t`` [s]): the compiled
+        ``model``'s bounds (None: none; ``pair_rows`` its pairs' rows) first, then SceneGraph's."""
+        if model is None:
+            rows, bounds, look_ahead = np.zeros(0, dtype=np.int64), np.zeros(0), DEFAULT_LOOK_AHEAD
+        else:
+            bounds, chosen = model.near_pairs(q)
+            rows, look_ahead = pair_rows[chosen], model.look_ahead
+        links = self._geometry_links()
+
+        def scenegraph(within: float):
+            rows, distances = [], []
+            for found in self.pose_query(q).ComputeSignedDistancePairwiseClosestPoints(within):
+                a, b = links[found.id_A], links[found.id_B]
+                rows.append(advancement.ANY if a is None or b is None else advancement.row(min(a, b), max(a, b)))
+                distances.append(found.distance)
+            return rows, distances
+
+        return advancement.step(t, rows, bounds, scenegraph, self.clearance, spacing, look_ahead)
+
+    def _geometry_links(self) -> dict:
+        """{GeometryId: link} of every proximity geometry for the check's travel bounds: the arm's
+        (:meth:`pair_travel`'s), 0 fixed in the world or apart from the arm, None moving with it on
+        no link of its chain (any pair's bound then)."""
+        if getattr(self, "_links", None) is None:
+            links, plant = self.pair_travel()[1], self.plant
+            fixed = {body.index() for body in plant.GetBodiesWeldedTo(plant.world_body())}
+            self._links = {geometry: links.get(geometry, 0 if plant.GetBodyFromFrameId(self._inspector.GetFrameId(
+                geometry)).index() in fixed or not self._on_arm(geometry) else None)
+                for geometry in self._inspector.GetAllGeometryIds(Role.kProximity)}
+        return self._links
+
+    def _check_ranges(self, trajectory: Trajectory, grid, q, waypoints, target_word: str) -> None:
+        """:class:`JointRangeError` at the first time of ``grid`` where ``q`` leaves a joint's range."""
         lower, upper = self.robot.lower_limits, self.robot.upper_limits
         outside = (q < lower) | (q > upper)
         if outside.any():
@@ -382,19 +450,6 @@ class CellChecker:
                 f"the planned motion takes {joint_label(j, self.robot.joint_names)} to {q[k, j]:.4f} {unit}, past its "
                 f"range [{lower[j]:.4f}, {upper[j]:.4f}] {unit}{self._segment_text(trajectory, grid[k], waypoints, target_word)}",
                 joint=j, value=q[k, j], limit=limit, time=grid[k], configuration=q[k], cause=Cause.JOINT_RANGE)
-        spacing = self.default_spacing() if spacing is None else float(spacing)
-        times = self.sample_times(trajectory, spacing, grid=grid, q=q)
-        samples = trajectory.vector_values(times).T
-        model = self._second_opinion()
-        compiled = model.distances(samples) if model is not None else np.full(len(samples), np.inf)
-        for k, (t, q_t) in enumerate(zip(times, samples)):
-            contacts = self.contacts(q_t)
-            if not contacts and compiled[k] < self.clearance:
-                contacts = self._missed_contacts(q_t)
-            if contacts:
-                through = self._through(contacts[0], times[k:], samples[k:])
-                raise self._collision(contacts[0], t, q_t, trajectory, waypoints, target_word, through)
-        return MotionCheck(times, spacing)
 
     def _through(self, contact: Contact, times, samples) -> tuple[Contact, float] | None:
         """(the deepest contact, its time [s]) of the same kind as ``contact`` (the arm in the
@@ -434,11 +489,13 @@ class CellChecker:
         if contacts:
             contact = contacts[0]
             if contact.distance < 0 and all(contact.on_arm):
-                text = f"in {what} the arm would hit itself ({' and '.join(contact.bodies)}, {self._mm(contact)} deep)"
+                text = (f"in {what} the arm would hit itself ({' and '.join(contact.bodies)}, {self._mm(contact)} deep"
+                        f"{touching_shapes(self, contact)})")
             elif contact.distance < 0:
                 text = f"{what} puts {' into '.join(self._arm_first(contact))} ({self._mm(contact)} deep)"
             else:
                 text = f"{what} {self._near_miss(contact)}"
+            text += srdf_hint(self, contact) if all(contact.on_arm) else ""  # a pair that is so in most poses
             raise CollisionError(text, bodies=contact.bodies, distance=contact.distance, clearance=self.clearance,
                                  time=0.0, configuration=q, field=field, cause=Cause.COLLISION)
 
@@ -470,7 +527,8 @@ class CellChecker:
         (cell.clearance)", or "brings the arm within d mm of itself (A and B), ..."."""
         closer = f"closer than the clearance of {self.clearance * 1000:g} mm (cell.clearance)"
         if all(contact.on_arm):
-            return f"brings the arm within {self._mm(contact)} of itself ({' and '.join(contact.bodies)}), {closer}"
+            return (f"brings the arm within {self._mm(contact)} of itself ({' and '.join(contact.bodies)}"
+                    f"{touching_shapes(self, contact)}), {closer}")
         return f"brings {' and '.join(self._arm_first(contact))} within {self._mm(contact)} of each other, {closer}"
 
     def _collision(self, contact: Contact, t: float, q, trajectory, waypoints, target_word: str = "waypoint",
@@ -487,7 +545,7 @@ class CellChecker:
             when = f" at t = {deepest_t:.3f} s" if deepest_t != t else ""
             if all(deepest.on_arm):
                 text = (f"in the planned motion the arm would hit itself ({' and '.join(deepest.bodies)}, "
-                        f"{self._mm(deepest)} deep{when})")
+                        f"{self._mm(deepest)} deep{when}{touching_shapes(self, deepest)})")
             elif any(deepest.on_arm):
                 arm, other = self._arm_first(deepest)
                 text = f"the planned motion goes through {other} ({arm} {self._mm(deepest)} deep{when})"

@@ -3,7 +3,7 @@ faster than SceneGraph's, with SceneGraph kept as the proof.
 
 :class:`CompiledCollisionModel` reads a :class:`~drake_traj.cell.clearance.CellChecker`'s plant
 and SceneGraph once (duck-typed: its ``plant``, ``scene_graph``, ``instance``, ``robot``,
-``clearance`` and ``link_reach()``):
+``clearance`` and ``pair_travel()``):
 
 - the kinematic tree of the bodies that carry collision geometry, as data for the compiled
   forward kinematics (:func:`~drake_traj.cell.collision_kernels.link_poses`): each moving body's
@@ -42,8 +42,6 @@ TOLERANCE = 1e-6
 """[m] GJK stops once its upper and lower bounds of a distance are this close: the lower bound
 returned is at most this below the true distance where GJK converges (every polytope pair,
 and the curved ones within :data:`~drake_traj.cell.convex_distance.MAX_ITERATIONS` steps)."""
-
-TRAVEL_MARGIN = 1.1  # the cell check's margin on the travel bounds (drake_traj.cell.clearance)
 
 
 class UnsupportedShapeError(DrakeTrajError):
@@ -204,23 +202,6 @@ def _z_onto(axis) -> RotationMatrix:
     return RotationMatrix(np.column_stack([x, np.cross(axis, x), axis]))
 
 
-def pair_travel(checker) -> tuple[np.ndarray, dict]:
-    """(T [m/rad or m/m] (n + 1, n + 1, n), {GeometryId: link}): T[a, b, j] bounds how far link b
-    moves relative to link a per |Δq_j| (a turn; a prismatic joint's shift moves points by itself),
-    from :func:`~drake_traj.cell.clearance.link_reach` with the cell check's 1.1 margin: the joints
-    between the two links move the outer one about the inner one; the joints before both, neither."""
-    reach, links = checker.link_reach()
-    reach = np.array(reach, dtype=float)
-    n = reach.shape[1]
-    travel = np.zeros((n + 1, n + 1, n))
-    for a in range(n + 1):
-        for b in range(n + 1):
-            inner, outer = sorted((a, b))
-            if outer > inner:
-                travel[a, b, inner:] = TRAVEL_MARGIN * reach[outer, inner:]
-    return travel, links
-
-
 class CompiledCollisionModel:
     """The robot, its tool and its cell as compiled collision data (module docstring).
 
@@ -241,7 +222,7 @@ class CompiledCollisionModel:
         self.upper = np.ascontiguousarray(robot.upper_limits, dtype=float)
         plant, inspector = checker.plant, checker.scene_graph.model_inspector()
         self.n = plant.num_positions(checker.instance)
-        self.pair_travel, links = pair_travel(checker)
+        self.pair_travel, links = checker.pair_travel()
         tree = _Tree(plant, checker.instance)
         candidates = [(a, b) for a, b in inspector.GetCollisionCandidates()]
         body_of = {g: int(plant.GetBodyFromFrameId(inspector.GetFrameId(g)).index()) for pair in candidates for g in pair}
@@ -321,17 +302,23 @@ class CompiledCollisionModel:
         kernels.distances_many(configurations, self.model, self.look_ahead, self.tolerance, out)
         return float(out[0]) if single else out
 
-    def pair_distances(self, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(distances [m], link a, link b) of the pairs closer than :attr:`look_ahead` at one
-        configuration ``q`` (n,) [rad]; the links are :func:`~drake_traj.cell.clearance.link_reach`'s
-        (0 the base and the world), as the free-motion search's conservative advancement needs them."""
+    def near_pairs(self, q) -> tuple[np.ndarray, np.ndarray]:
+        """(distances [m], rows of :attr:`pairs`) of the pairs closer than :attr:`look_ahead` at one
+        configuration ``q`` (n,) [rad]."""
         configuration, _ = self._configurations(q)
         distances = np.empty(len(self.pairs))
         indices = np.empty(len(self.pairs), dtype=np.int64)
         count = kernels.pair_distances_into(configuration[0], self.model, self.look_ahead, self.tolerance, distances,
                                             indices)
-        chosen = indices[:count]
-        return distances[:count], self.pairs[chosen, 2].copy(), self.pairs[chosen, 3].copy()
+        return distances[:count], indices[:count]
+
+    def pair_distances(self, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(distances [m], link a, link b) of the pairs closer than :attr:`look_ahead` at one
+        configuration ``q`` (n,) [rad] (:meth:`near_pairs`); the links are
+        :func:`~drake_traj.cell.clearance.link_reach`'s (0 the base and the world), as the
+        conservative advancements need them."""
+        distances, chosen = self.near_pairs(q)
+        return distances, self.pairs[chosen, 2], self.pairs[chosen, 3]
 
     def valid(self, q):
         """Per configuration of ``q`` (m, n) [rad] (a bool for one (n,)): inside the joint ranges

@@ -1,6 +1,9 @@
 """The free-motion planner: goals reached on a path found through the cell (OMPL), shortened,
 smoothed, timed, checked; its refusals; its reproducibility; its motion checked independently."""
 
+import re
+import sys
+
 import numpy as np
 import pytest
 from pydrake.planning import RobotDiagramBuilder, SceneGraphCollisionChecker
@@ -90,9 +93,34 @@ def test_the_search_alone_is_reproducible_in_one_process():
     scene = Scene(checker, UR10E.lower_limits, UR10E.upper_limits)
     goal = np.atleast_2d(UR10E.task_kinematics().inverse_kinematics_all(SHELF.planner.poses[0]))
     goal = next(q for q in goal if scene.valid(q) and not scene.segment_valid(SHELF.q_initial, q))
-    results = [search(scene, SHELF.q_initial, goal, planning_time=5.0, seed=11) for _ in range(2)]
-    assert results[0].vertices is not None
-    np.testing.assert_array_equal(results[0].vertices, results[1].vertices)
+    first = search(scene, SHELF.q_initial, goal, planning_time=5.0, seed=11)
+    other = search(scene, SHELF.q_initial, goal, planning_time=5.0, seed=12)  # OMPL seeded again in between
+    again = search(scene, SHELF.q_initial, goal, planning_time=5.0, seed=11)
+    assert first.vertices is not None and first.runs >= 1
+    np.testing.assert_array_equal(first.vertices, again.vertices)
+    assert other.vertices.shape != first.vertices.shape or not np.array_equal(other.vertices, first.vertices)
+
+
+def test_rrt_connect_starts_over_and_its_runs_end_by_states_not_the_clock(monkeypatch):
+    """Runs of 40, 48, 58, ... states: the search starts over until one finds the path; each run
+    ends by the states it sampled, so the path is the same within any budget that reaches it; a
+    path's every segment keeps the clearance; an error in a validity callback reaches the caller."""
+    checker, robot, query = slot_query("slot_60", 4)
+    scene = Scene(checker, robot.lower_limits, robot.upper_limits)
+    monkeypatch.setattr(sys.modules[Scene.__module__], "RESTART", 40)  # the search module (shadowed by its function)
+    found = search(scene, query.start, query.goal, planning_time=20.0, seed=5)
+    assert found.vertices is not None and found.runs > 1 and found.samples > 40
+    again = search(scene, query.start, query.goal, planning_time=60.0, seed=5)
+    np.testing.assert_array_equal(found.vertices, again.vertices)
+    assert again.runs == found.runs and again.samples == found.samples
+    assert all(scene.segment_valid(a, b) for a, b in zip(found.vertices, found.vertices[1:]))
+
+    def refuse(q):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(scene, "valid", refuse)
+    with pytest.raises(KeyboardInterrupt):
+        search(scene, query.start, query.goal, planning_time=5.0, seed=5)
 
 
 def test_a_start_in_collision_is_refused_naming_the_bodies():
@@ -119,16 +147,28 @@ def test_a_goal_inside_an_obstacle_is_refused_at_the_goal():
 def test_a_goal_outside_the_joint_ranges_is_refused():
     planner = make_planner(FreeMotionConfig(goals=[[0.0, -1.57, 0.0, -1.57, 0.0, 7.0]]), UR10E,
                            UR10E.home_configuration)
-    with pytest.raises(DrakeTrajError, match=r"goals\[0\].*outside its range") as refused:
+    with pytest.raises(DrakeTrajError, match=r"^goal 0: joint 6 \(wrist_3_joint\) = 7 rad is outside its range") as refused:
         CellChecker(UR10E).check_planner(planner)
     assert refused.value.cause is Cause.JOINT_RANGE and refused.value.field == ("goals", 0)
 
 
 def test_an_unreachable_pose_is_refused():
     planner = make_planner(FreeMotionConfig(poses=[[2.5, 0.0, 0.5, 0.0, 1.57, 0.0]]), UR10E, UR10E.home_configuration)
-    with pytest.raises(DrakeTrajError, match=r"poses\[0\] cannot be reached") as refused:
+    with pytest.raises(DrakeTrajError, match=r"^pose 0 cannot be reached: .* is out of reach") as refused:
         CellChecker(UR10E).check_planner(planner)
-    assert refused.value.cause is Cause.UNREACHABLE
+    assert refused.value.cause is Cause.UNREACHABLE and refused.value.field == ("poses", 0)
+    # the IK's reason once, the wrist-1 joint's distances over its branches as one range
+    assert str(refused.value).count("the wrist-1 joint would be") == 1
+
+
+def test_a_pose_inside_an_obstacle_names_the_obstacle():
+    pose = [0.9, 0.0, 0.5, 0.0, 1.5707963267948966, 0.0]  # the TCP, tool level, in the middle of the crate
+    crate = Box(name="crate", size=[0.3, 0.3, 0.3], xyz=pose[:3])
+    planner = make_planner(FreeMotionConfig(poses=[pose]), UR10E, UR10E.home_configuration)
+    with pytest.raises(PlanningError, match=r"^pose 0: none of its 8 inverse-kinematics solutions is inside the joint "
+                                            r"ranges and clear of the cell \(.*closer than cell.clearance: \d+ to crate") as refused:
+        CellChecker(UR10E, Cell(obstacles=[crate])).check_planner(planner)
+    assert refused.value.cause is Cause.COLLISION and refused.value.field == ("poses", 0)
 
 
 def slot_query(kind: str, seed: int):
@@ -149,6 +189,30 @@ def test_no_path_within_the_budget_says_what_was_tried_and_what_would_help():
     assert "Approximate" not in str(refused.value) and "Timeout" not in str(refused.value)  # not OMPL's words
 
 
+def test_a_path_no_smooth_motion_keeps_clear_is_searched_again_while_the_budget_lasts(monkeypatch):
+    """The first path's spline refused at every density: the planner searches again (the next
+    seed) and times that one; refused every time, it says how many paths it found, by the budget."""
+    checker, robot, query = slot_query("slot_60", 4)
+    real = free_system.FreeMotionPlanner._smooth_and_time
+    tried = []
+
+    def first_refused(self, scene, checker, vertices, density):
+        tried.append(len(vertices))
+        return None if len(tried) <= len(free_system.DENSITIES) else real(self, scene, checker, vertices, density)
+
+    monkeypatch.setattr(free_system.FreeMotionPlanner, "_smooth_and_time", first_refused)
+    planner = make_planner(query.config(planning_time=5.0), robot, query.start)
+    checker.check_planner(planner)
+    assert len(tried) > len(free_system.DENSITIES) and planner.planning_time_s < 5.0 + 0.2
+    np.testing.assert_allclose(planner.plan().value(planner.plan().end_time()).ravel(), query.goal, atol=1e-9)
+    monkeypatch.setattr(free_system.FreeMotionPlanner, "_smooth_and_time", lambda *args: None)
+    planner = make_planner(query.config(planning_time=2.0), robot, query.start)
+    with pytest.raises(PlanningError, match=r"^goal 0: (\d+) paths were found \(\d+(, \d+)* vertices\) but no smooth "
+                                            r"motion along any kept the clearance") as refused:
+        checker.check_planner(planner)
+    assert int(re.match(r"goal 0: (\d+)", str(refused.value))[1]) >= 2 and refused.value.cause is Cause.PLANNING
+
+
 def test_a_narrow_passage_is_found_and_the_budget_covers_all_of_planning():
     checker, robot, query = slot_query("slot_60", 4)  # a slot 60 mm taller than the forearm
     planner = make_planner(query.config(planning_time=2.0), robot, query.start)
@@ -166,8 +230,21 @@ def test_a_scenario_refusal_is_at_the_goals_line(tmp_path, monkeypatch):
     line = 1 + text.splitlines().index(next(row for row in text.splitlines() if row.strip().startswith("- [0.70")))
     # a search that finds nothing (the shelf's own is found within milliseconds)
     monkeypatch.setattr(free_system, "search", lambda *args, **kwargs: SearchResult(None, "rrt_connect", 0.01, 7, 7, ""))
-    with pytest.raises(PlanningError, match=rf"tight.yaml, line {line}, column 7: no collision-free path to pose 0"):
+    with pytest.raises(PlanningError, match=rf"tight.yaml, line {line}, column 7: planner.poses\[0\]: no collision-free "
+                                            "path to pose 0"):
         simulate(load_scenario(path))
+
+
+def test_a_scenario_pose_out_of_reach_is_at_its_planner_field(tmp_path):
+    text = SHELF.source.path.read_text()
+    row = next(row for row in text.splitlines() if row.strip().startswith("- [0.70"))
+    path = tmp_path / "far.yaml"
+    path.write_text(text.replace(row, "    - [2.70, -0.305, 0.40, 0.0, 1.5707963267948966, 0.0]"))
+    line = 1 + text.splitlines().index(row)
+    with pytest.raises(DrakeTrajError, match=rf"far.yaml, line {line}, column 7: planner.poses\[0\]: pose 0 cannot be "
+                                             r"reached: .* the wrist-1 joint would be [\d.]+ to [\d.]+ m \(by IK branch\)") as refused:
+        simulate(load_scenario(path))
+    assert refused.value.field == ("planner", "poses", 0)
 
 
 def test_several_goals_stop_at_each_and_a_station_of_ones_own_plans_in_its_cell():
@@ -183,6 +260,10 @@ def test_several_goals_stop_at_each_and_a_station_of_ones_own_plans_in_its_cell(
     middle = planner.legs[0].timing.duration
     np.testing.assert_allclose(plan.value(middle).ravel(), goals[0], atol=1e-9)
     np.testing.assert_allclose(plan.derivative(1).value(middle).ravel(), 0.0, atol=1e-9)  # at rest at the goal
+    for leg, offset in zip(planner.legs, (0.0, middle)):  # the joined law is each leg's own, knot by knot
+        for knot in leg.timing.law.knots[::7]:
+            np.testing.assert_allclose(np.stack(planner.law.sample(offset + knot)), np.stack(leg.timing.law.sample(knot)),
+                                       rtol=0.0, atol=1e-12)
 
 
 @pytest.mark.parametrize("config, field", [

@@ -29,10 +29,10 @@ class FreeMotionLaw:
         """The motion of the timed legs (each a SmoothTiming from the previous leg's end)."""
         knots, samples, offset = [], [], 0.0
         for k, timing in enumerate(timings):
-            own = np.asarray(timing.law.knots)
-            own = own if k == 0 else own[1:]  # a leg's first knot is the previous leg's last
-            knots.append(own + offset)
-            samples.append(np.array([np.stack(timing.law.sample(t)) for t in own]))
+            own, table = np.asarray(timing.law.knots), _knot_samples(timing)
+            first = 0 if k == 0 else 1  # a leg's first knot is the previous leg's last
+            knots.append(own[first:] + offset)
+            samples.append(table[first:])
             offset += timing.duration
         samples = np.concatenate(samples)
         law = HermiteLaw(np.concatenate(knots), samples, samples)
@@ -72,3 +72,12 @@ class Leg:
     density: float | None  # [rad] the spline's points along the segments (None: the vertices only)
     search_seconds: float
     samples: int
+
+
+def _knot_samples(timing) -> np.ndarray:
+    """(q, q̇, q̈) [rad, rad/s, rad/s²] at every knot of a timed leg (a SmoothTiming), (K, 3, n), as
+    its own law gives them: each quintic piece's start (its monomial coefficients c0, c1, 2 c2),
+    and the leg's end, at rest."""
+    c = timing.coefficients
+    end = np.stack(timing.law.sample(timing.duration))[None]
+    return np.concatenate([np.stack([c[:, 0], c[:, 1], 2.0 * c[:, 2]], axis=1), end])

@@ -13,16 +13,18 @@ margin), so the next configuration checked is max(d - c, c/2) of that travel fur
 at every configuration checked and c/2 between them, the cell check's own guarantee, with long
 steps where the arm is far from everything.
 
-The search runs in a forked child process: OMPL's random numbers are seeded once per process
-(a second seed is refused), so a child per search makes a seed reproduce its path in any process,
-and nothing OMPL does can end the caller's interpreter. Joint positions in rad.
+The search runs in this process, its random numbers seeded at its start: OMPL's ``RNG.setSeed``
+seeds the generator of the seeds of every sampler made after it (OMPL logs an error where some were
+made before, which says only that those earlier ones are not reseeded), and each search makes its
+own, so a seed reproduces its path in any process, after any other search. It ran in a forked
+child process before: 54 ms a search on the free-motion bench's clutter (the child's fork, its
+import of OMPL and its exit), 0.3 ms in this process. An exception in a validity callback
+(Ctrl-C's KeyboardInterrupt too) ends the search and reaches the caller. Joint positions in rad.
 """
 
 from __future__ import annotations
 
-import os
-import pickle
-import signal
+import itertools
 import time
 from dataclasses import dataclass
 
@@ -45,13 +47,25 @@ refuse. Measured on the free-motion bench's seven kinds of scene, 10 seeded quer
 budget (docs/free-motion.md): 0.15 rad 69/70 solved, 0.25 and 0.4 rad 70/70, 1 rad 31/35 (the slot
 40 mm taller than the forearm 1/5), 2 rad the slot 3/5."""
 
+RESTART, RESTART_GROWTH = 2000, 1.2
+"""RRT-Connect starts over (its trees cleared, its random numbers going on) after RESTART states
+sampled, each run RESTART_GROWTH times as long as the one before: the states it needs to a path
+through a narrow passage are heavy-tailed. Measured on the free-motion bench's 40 mm slots (scene
+seeds 0-29, 4 search seeds each, in states sampled, at most 150,000): without restarts 115 of 120
+found, mean 19,831; with these 120 of 120, median 3,318, p90 12,010, worst 37,382, mean 5,755
+(80 of 80 on scene seeds 100-119, mean 6,327). Runs of a constant 2,000 needed 12 % fewer in the
+mean, but would never find a path that needs a larger tree; growth 1.5 (mean 5,969, worst 69,994)
+and Luby's sequence of 1,000 or 2,000 (worst 89,839) did worse. The runs end by states sampled, not
+by the clock: a seed finds its path on any machine that finds it within the budget."""
+
 GIVE_UP = 15
 """Shortcutting stops after this many shortcuts in a row were refused."""
 
 LOOK_AHEAD = 0.07
 """[m] how far a distance query looks: a pair further away takes at most this less c of travel per
-step. Measured on examples/bench_free_motion.py (24 queries): 0.07 m 0.42 s median planning, 0.1 m
-0.45 s, 0.25 m 0.54 s (more pairs per query cost more than the longer steps save)."""
+step. Measured on 24 seeded queries round a shelf, a gate and bins with SceneGraph in the search:
+0.07 m 0.42 s median planning, 0.1 m 0.45 s, 0.25 m 0.54 s (more pairs per query cost more than the
+longer steps save)."""
 
 
 class Scene:
@@ -77,6 +91,7 @@ class Scene:
             # per |Δq| (1.1 margin): the joints between them move the outer one about the inner one
             self._pair_travel, self._links = checker.pair_travel()
             self._any_pair = self._pair_travel.max(axis=(0, 1))  # a pair beyond the look-ahead
+        _ompl()  # imported now, not in a search's budget
         self.queries = 0
 
     def _pairs(self, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -144,55 +159,41 @@ class SearchResult:
 
     vertices: np.ndarray | None
     planner: str
-    seconds: float  # [s] the search's own time, in the child
+    seconds: float  # [s] OMPL's solve
     samples: int  # states OMPL sampled and checked
     queries: int  # distance queries of the search (states and segments)
     status: str  # OMPL's word for the outcome
+    runs: int = 1  # OMPL's runs (RRT-Connect's restarts: RESTART); 0 for the straight segment
 
 
 def search(scene: Scene, start, goals, *, planning_time: float, seed: int, planner: str = "rrt_connect",
            max_step: float = DEFAULT_MAX_STEP) -> SearchResult:
     """A collision-free joint path from ``start`` to any of ``goals`` ((k, n), or one goal (n,))
-    by OMPL's ``planner`` within ``planning_time`` [s], random numbers seeded with ``seed`` (a
-    forked child process: module docstring), edges at most ``max_step`` [rad] long. Every end must
+    by OMPL's ``planner`` within ``planning_time`` [s], random numbers seeded with ``seed`` (the
+    same seed, the same path: module docstring), edges at most ``max_step`` [rad] long. Every end must
     be valid (:meth:`Scene.valid`); the straight segment to each goal, in order, is tried first.
     The path ends at the goal it reached."""
     start, goals = np.asarray(start, dtype=float), np.atleast_2d(np.asarray(goals, dtype=float))
     for goal in goals:
         if scene.segment_valid(start, goal):
-            return SearchResult(np.array([start, goal]), "straight", 0.0, 0, scene.queries, "straight segment")
-    read, write = os.pipe()
-    child = os.fork()
-    if child == 0:  # the child: search, write the result, leave without Python's exit handlers
-        code = 0
-        try:
-            os.close(read)
-            outcome = _search_here(scene, start, goals, planning_time, seed, planner, max_step)
-            with os.fdopen(write, "wb") as pipe:
-                pickle.dump(outcome, pipe)
-        except BaseException:  # noqa: BLE001 - anything at all: the parent reports no result
-            code = 1
-        finally:
-            os._exit(code)
-    os.close(write)
-    with os.fdopen(read, "rb") as pipe:
-        data = pipe.read()
-    _, status = os.waitpid(child, 0)
-    if not data:
-        reason = f"signal {os.WTERMSIG(status)}" if os.WIFSIGNALED(status) else f"exit code {os.WEXITSTATUS(status)}"
-        return SearchResult(None, planner, float("nan"), 0, 0, f"the search process ended without a result ({reason})")
-    return pickle.loads(data)
+            return SearchResult(np.array([start, goal]), "straight", 0.0, 0, scene.queries, "straight segment", 0)
+    return _ompl_search(scene, start, goals, planning_time, seed, planner, max_step)
 
 
-def _search_here(scene: Scene, start, goals, planning_time: float, seed: int, planner: str,
+def _ompl():
+    """OMPL's modules (base, geometric, util), imported at the first call (12 ms, measured)."""
+    from ompl import base, geometric, util
+
+    return base, geometric, util
+
+
+def _ompl_search(scene: Scene, start, goals, planning_time: float, seed: int, planner: str,
                  max_step: float) -> SearchResult:
-    """The search itself, in this process (the forked child): the goals as one goal region of
-    states (OMPL's GoalStates), so every candidate shares one search."""
-    from ompl import base as ob, geometric as og, util as ou  # the child's own OMPL: a fresh seed
-
-    signal.signal(signal.SIGINT, signal.SIG_DFL)  # Ctrl-C ends the child; the parent handles it
-    ou.setLogLevel(ou.LogLevel.LOG_NONE)
-    ou.RNG.setSeed(int(seed) + 1)  # OMPL refuses 0 ("use the time")
+    """OMPL's search: the goals as one goal region of states (OMPL's GoalStates), so every
+    candidate shares one search."""
+    ob, og, ou = _ompl()
+    ou.setLogLevel(ou.LogLevel.LOG_NONE)  # a second setSeed's error among them (module docstring)
+    ou.RNG.setSeed(int(seed) + 1)  # before the planner and its samplers are made; OMPL ignores a seed of 0
     n = len(start)
     space = ob.RealVectorStateSpace(n)
     bounds = ob.RealVectorBounds(n)
@@ -236,13 +237,20 @@ def _search_here(scene: Scene, start, goals, planning_time: float, seed: int, pl
         search_planner.setRange(float(max_step))
     setup.setPlanner(search_planner)
     began = time.perf_counter()
-    status = setup.solve(float(planning_time))
+    deadline, limit = began + float(planning_time), RESTART if planner == "rrt_connect" else np.inf
+    for run in itertools.count(1):  # RRT-Connect starts over after RESTART states, each run longer
+        status = setup.solve(ob.PlannerTerminationCondition(
+            lambda: samples[0] >= limit or time.perf_counter() >= deadline))
+        if setup.haveExactSolutionPath() or time.perf_counter() >= deadline:
+            break
+        setup.clear()  # the trees; the samplers made for the next run take the next seeds
+        limit = samples[0] + RESTART * RESTART_GROWTH ** run
     seconds = time.perf_counter() - began
     vertices = None
     if setup.haveExactSolutionPath():
         path = setup.getSolutionPath()
         vertices = np.array([as_array(path.getState(k)) for k in range(path.getStateCount())])
-    return SearchResult(vertices, planner, seconds, samples[0], scene.queries, str(status))
+    return SearchResult(vertices, planner, seconds, samples[0], scene.queries, str(status), run)
 
 
 def shortcut(scene: Scene, vertices, rng: np.random.Generator, *, rounds: int = 60,

@@ -30,7 +30,7 @@ __all__ = ["DENSITIES", "SEARCH_SHARE", "FreeMotionPlanner", "make"]
 
 SEARCH_SHARE = 0.8
 """The share of a leg's budget its search may take; the rest is for shortening, smoothing, timing
-and checking the path found (on the free-motion bench these take 0.1-0.3 s together)."""
+and checking the path found (on the free-motion bench these take 0.02-0.15 s together)."""
 
 DENSITIES = (None, 0.3, 0.1, 0.03)
 """[rad] the spline's repair: its points along the found segments at most this far apart (None:
@@ -96,7 +96,8 @@ class FreeMotionPlanner(TimeLawPlanner):
         offsets = np.concatenate([[0.0], np.cumsum([leg.timing.duration for leg in legs])[:-1]])
         accepted = replace(legs[0].check, times=np.concatenate([leg.check.times + offset
                                                                  for leg, offset in zip(legs, offsets)]),
-                           spacing=max(leg.check.spacing for leg in legs))
+                           spacing=max(leg.check.spacing for leg in legs),
+                           distances=np.concatenate([leg.check.distances for leg in legs]))
         self.checked_scenes.add(checker.fingerprint)  # the timed motion checked as every plan is
         self.legs = legs
         self._planned_in = (checker.fingerprint, accepted)
@@ -117,7 +118,7 @@ class FreeMotionPlanner(TimeLawPlanner):
             try:
                 solutions = np.atleast_2d(kinematics.inverse_kinematics_all(pose))
             except ValueError as error:
-                raise DrakeTrajError(f"poses[{k}] cannot be reached: {error}", field=("poses", k),
+                raise DrakeTrajError(f"pose {k} cannot be reached: {error}", field=("poses", k),
                                      cause=Cause.UNREACHABLE) from None
             yield solutions
 
@@ -126,49 +127,71 @@ class FreeMotionPlanner(TimeLawPlanner):
         outside = np.flatnonzero((q < low) | (q > high))
         if len(outside):
             j = int(outside[0])
-            raise DrakeTrajError(f"{field_[0]}[{field_[1]}]: {joint_label(j, self.robot.joint_names)} = {q[j]:.4g} rad "
+            raise DrakeTrajError(f"goal {field_[1]}: {joint_label(j, self.robot.joint_names)} = {q[j]:.4g} rad "
                                  f"is outside its range [{low[j]:.4g}, {high[j]:.4g}] rad", field=field_,
                                  cause=Cause.JOINT_RANGE)
 
     def _pose_goals(self, scene: Scene, solutions, previous) -> list[np.ndarray]:
         """A pose's IK solutions, each moved by whole turns towards ``previous`` within the ranges,
         those inside the ranges and clear of the cell, nearest ``previous`` first."""
-        goals = []
-        for q in solutions:
-            turns = np.round((previous - q) / (2 * np.pi))
-            shifted = q + 2 * np.pi * turns
-            shifted = np.where((shifted < scene.lower) | (shifted > scene.upper), q, shifted)
-            if scene.valid(shifted):
-                goals.append(shifted)
+        goals = [q for q in (_turned(scene, q, previous) for q in solutions) if scene.valid(q)]
         return sorted(goals, key=lambda q: float(np.linalg.norm(q - previous)))
+
+    @staticmethod
+    def _in_the_way(scene: Scene, checker, solutions, previous) -> str:
+        """Why none of a pose's IK ``solutions`` is a goal: how many leave the joint ranges, and
+        what the others come closer than the clearance to (the cell's parts by name, or the arm
+        itself), nearest first per solution."""
+        outside, names = 0, {}
+        for q in (_turned(scene, q, previous) for q in solutions):
+            if np.any(q < scene.lower) or np.any(q > scene.upper):
+                outside += 1
+                continue
+            nearest = checker.contacts(q, within=np.inf)[0]  # SceneGraph's nearest pair (the error path only)
+            name = "the arm itself" if all(nearest.on_arm) else nearest.bodies[nearest.on_arm.index(False)]
+            names[name] = names.get(name, 0) + 1
+        parts = [f"{outside} outside the joint ranges"] if outside else []
+        if names:
+            counts = sorted(names.items(), key=lambda item: -item[1])
+            parts.append(f"of the {sum(names.values())} inside them, closer than cell.clearance: " + ", ".join(
+                f"{count} to {name}" for name, count in counts))
+        return "; ".join(parts)
 
     def _leg(self, scene: Scene, checker, rng, k: int, start, candidates, deadline: float) -> "tuple[Leg, np.ndarray]":
         """The timed leg from ``start`` to whichever of ``candidates`` one search reaches first,
-        planned by ``deadline`` (a ``time.perf_counter()`` value) where it can be."""
+        planned by ``deadline`` (a ``time.perf_counter()`` value) where it can be; where no smooth
+        motion along the path found keeps the clearance, another search (the next seed) while the
+        budget lasts."""
         word, field_ = ("goal", ("goals", k)) if len(self.config.goals) else ("pose", ("poses", k))
         goals = candidates if len(self.config.goals) else self._pose_goals(scene, candidates, start)
         if not goals:
             raise PlanningError(f"{word} {k}: none of its {len(candidates)} inverse-kinematics solutions is inside the "
-                                "joint ranges and clear of the cell", field=field_, cause=Cause.COLLISION)
-        budget = SEARCH_SHARE * max(deadline - time.perf_counter(), 0.0)
-        found = search(scene, start, np.array(goals), planning_time=max(budget, 1e-3),
-                       seed=int(rng.integers(2**31 - 1)), planner=self.config.planner, max_step=self.config.max_step)
-        if found.vertices is None:
-            raise PlanningError(self._not_found(word, k, len(goals), found), field=field_, cause=Cause.PLANNING)
-        vertices = shortcut(scene, found.vertices, rng, rounds=self.config.shortcut_rounds, deadline=deadline)
-        for density in DENSITIES:
-            timed = self._smooth_and_time(checker, vertices, density)
-            if timed is not None:
-                return Leg(found.vertices, vertices, *timed, density, found.seconds, found.samples), vertices[-1]
-        raise PlanningError(f"{word} {k}: a path was found ({len(vertices)} vertices) but no smooth motion along it "
+                                f"joint ranges and clear of the cell ({self._in_the_way(scene, checker, candidates, start)})",
+                                field=field_, cause=Cause.COLLISION)
+        unsmooth = []  # vertices of the paths found along which no smooth motion kept the clearance
+        while not unsmooth or time.perf_counter() < deadline:  # another search while the budget lasts
+            budget = SEARCH_SHARE * max(deadline - time.perf_counter(), 0.0)
+            found = search(scene, start, np.array(goals), planning_time=max(budget, 1e-3),
+                           seed=int(rng.integers(2**31 - 1)), planner=self.config.planner, max_step=self.config.max_step)
+            if found.vertices is None and not unsmooth:
+                raise PlanningError(self._not_found(word, k, len(goals), found), field=field_, cause=Cause.PLANNING)
+            if found.vertices is None:
+                break
+            vertices = shortcut(scene, found.vertices, rng, rounds=self.config.shortcut_rounds, deadline=deadline)
+            for density in DENSITIES:
+                timed = self._smooth_and_time(scene, checker, vertices, density)
+                if timed is not None:
+                    return Leg(found.vertices, vertices, *timed, density, found.seconds, found.samples), vertices[-1]
+            unsmooth.append(len(vertices))
+        found_text = (f"a path was found ({unsmooth[0]} vertices)" if len(unsmooth) == 1 else
+                      f"{len(unsmooth)} paths were found ({', '.join(map(str, unsmooth))} vertices)")
+        raise PlanningError(f"{word} {k}: {found_text} but no smooth motion along {'it' if len(unsmooth) == 1 else 'any'} "
                             f"kept the clearance (points along it down to {DENSITIES[-1]} rad apart)",
                             field=field_, cause=Cause.PLANNING)
 
     def _not_found(self, word: str, k: int, goals: int, found) -> str:
         """The refusal of a search that found no path in its budget: what it tried, and what to change."""
         budget = self.config.planning_time
-        if np.isnan(found.seconds):  # the child process ended without a result
-            return f"the search for {word} {k} failed: {found.status}"
         return (f"no collision-free path to {word} {k} found within planning_time = {budget:g} s "
                 f"({PLANNERS[self.config.planner]}, {goals} configuration{'s' * (goals > 1)} tried, {found.samples} "
                 f"states sampled in {found.seconds:.2f} s of search); " + (
@@ -176,13 +199,18 @@ class FreeMotionPlanner(TimeLawPlanner):
                     "seed), or " if budget < MAX_PLANNING_TIME else "try another seed, or ") +
                 f"move the {word} further from the obstacles")
 
-    def _smooth_and_time(self, checker, vertices, density):
+    def _smooth_and_time(self, scene: Scene, checker, vertices, density):
         """(the timed spline through ``vertices`` (points ``density`` [rad] apart along the
         segments), its cell check's MotionCheck), or None where the spline leaves the ranges or
-        the timed motion comes closer than the clearance."""
+        the timed motion comes closer than the clearance. A spline that leaves the ranges, or comes
+        closer than the clearance at one of 2001 points along it by the compiled model (the timed
+        motion keeps to it within 1e-4 rad), is not timed: 2 ms where a timing and a refused
+        check took 60-100 ms."""
         path = waypoint_path(_densified(vertices, density))
         q = path.vector_values(np.linspace(path.start_time(), path.end_time(), 2001)).T
         if np.any(q < self.robot.lower_limits) or np.any(q > self.robot.upper_limits):
+            return None
+        if scene.model is not None and not scene.model.valid(q).all():
             return None
         timing = time_path(path, self.velocity, self.acceleration, self.jerk, grid_points=self.config.grid_points)
         try:
@@ -220,6 +248,13 @@ class FreeMotionPlanner(TimeLawPlanner):
         if not self.legs:
             return np.zeros((0, self.num_joints))
         return np.concatenate([self.legs[0].vertices] + [leg.vertices[1:] for leg in self.legs[1:]])
+
+
+def _turned(scene: Scene, q, previous) -> np.ndarray:
+    """``q`` [rad] moved by whole turns towards ``previous`` where that keeps it within the
+    scene's joint ranges."""
+    shifted = q + 2 * np.pi * np.round((previous - q) / (2 * np.pi))
+    return np.where((shifted < scene.lower) | (shifted > scene.upper), q, shifted)
 
 
 def _densified(vertices, density: float | None) -> np.ndarray:

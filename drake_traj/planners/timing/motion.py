@@ -11,10 +11,10 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.trajectories import PiecewisePolynomial, Trajectory
 
-from drake_traj.compiled import compiled
 from drake_traj.errors import Cause, DrakeTrajError
 from drake_traj.planners.base import piecewise_trajectory
 from drake_traj.planners.laws.hermite import HermiteLaw, sigma_derivatives
+from drake_traj.planners.laws.polynomials import rate_peaks
 
 __all__ = ["InfeasibleTimingError", "SmoothTiming", "exact_peaks", "stretched"]
 
@@ -64,86 +64,12 @@ class SmoothTiming:
         return self.trajectory if self.given_path is None else self.given_path
 
 
-@compiled
-def _polynomial(c, x):
-    """sum_p c[p] x^p (Horner)."""
-    value = 0.0
-    for p in range(len(c) - 1, -1, -1):
-        value = value * x + c[p]
-    return value
-
-
-@compiled
-def _bracketed_root(c, lo, hi, f_lo):
-    """The root in [lo, hi] of the cubic c (coefficients (4,)), monotone there, whose value at lo
-    is f_lo and changes sign by hi: Newton's steps kept inside the bracket, which every step
-    narrows (a bisection where a step would leave it), to round-off."""
-    x = 0.5 * (lo + hi)
-    for _ in range(200):
-        f = _polynomial(c, x)
-        if f == 0.0:
-            return x
-        if (f < 0.0) == (f_lo < 0.0):
-            lo = x
-        else:
-            hi = x
-        step = x - f / ((3.0 * c[3] * x + 2.0 * c[2]) * x + c[1])
-        if not lo < step < hi:  # also a NaN or infinite step
-            step = 0.5 * (lo + hi)
-        if step == x or not lo < step < hi:
-            return step
-        x = step
-    return x
-
-
-@compiled
-def _rate_peaks(velocity, acceleration):
-    """(max |q̇|, max |q̈|) per (interval, joint) over sigma in [-1, 1] [rad/s, rad/s²], from q̇ as quartics
-    (``velocity`` (5, K, n)) and q̈ as cubics (``acceleration`` (4, K, n)) in sigma: at the ends
-    and where q̈ = 0 (each monotone piece of the cubic between its turning points holds at most
-    one root) and where q⃛ = 0 (a quadratic, closed form)."""
-    K, n = velocity.shape[1], velocity.shape[2]
-    v_peak, a_peak = np.empty((K, n)), np.empty((K, n))
-    edges = np.empty(4)
-    for k in range(K):
-        for j in range(n):
-            v, c = velocity[:, k, j], acceleration[:, k, j]
-            v_peak[k, j] = max(abs(_polynomial(v, -1.0)), abs(_polynomial(v, 1.0)))
-            a_peak[k, j] = max(abs(_polynomial(c, -1.0)), abs(_polynomial(c, 1.0)))
-            # q⃛ = 3 c3 s² + 2 c2 s + c1: its roots in (-1, 1), the cubic's turning points
-            a, b, d = 3.0 * c[3], 2.0 * c[2], c[1]
-            count = 1
-            edges[0] = -1.0
-            if a == 0.0:
-                if b != 0.0 and -1.0 < -d / b < 1.0:
-                    edges[1] = -d / b
-                    count = 2
-            elif b * b - 4.0 * a * d >= 0.0:
-                q = -0.5 * (b + np.copysign(np.sqrt(b * b - 4.0 * a * d), b))
-                for root in (q / a, d / q if q != 0.0 else 2.0):
-                    if -1.0 < root < 1.0:
-                        edges[count] = root
-                        count += 1
-                if count == 3 and edges[2] < edges[1]:
-                    edges[1], edges[2] = edges[2], edges[1]
-            for e in range(1, count):
-                a_peak[k, j] = max(a_peak[k, j], abs(_polynomial(c, edges[e])))
-            edges[count] = 1.0
-            for e in range(count):
-                f_lo, f_hi = _polynomial(c, edges[e]), _polynomial(c, edges[e + 1])
-                if f_lo * f_hi <= 0.0:
-                    root = edges[e] if f_lo == 0.0 else _bracketed_root(c, edges[e], edges[e + 1], f_lo)
-                    v_peak[k, j] = max(v_peak[k, j], abs(_polynomial(v, root)))
-    return v_peak, a_peak
-
-
 def exact_peaks(knots, coefficients) -> np.ndarray:
     """max |q̇|, |q̈|, |q⃛| per joint [rad/s, rad/s², rad/s³] over piecewise quintics (monomial
-    ``coefficients`` (K, 6, n) in t - knots[k] [s]), exact to round-off: (3, n). Compiled
-    (:func:`_rate_peaks`): 0.34 ms on 400 pieces, where the vectorised bisection of
-    :mod:`~drake_traj.planners.laws.polynomials` took 3.3 ms for the same peaks."""
+    ``coefficients`` (K, 6, n) in t - knots[k] [s]), exact to round-off: (3, n); |q̇| and |q̈| by
+    :func:`~drake_traj.planners.laws.polynomials.rate_peaks`, |q⃛| (a quadratic) in closed form."""
     _, _, (velocity, acceleration, jerk) = sigma_derivatives(knots, np.asarray(coefficients, dtype=float), 3)
-    v_peak, a_peak = _rate_peaks(np.ascontiguousarray(velocity), np.ascontiguousarray(acceleration))
+    v_peak, _, a_peak, _ = rate_peaks(velocity, acceleration)
     with np.errstate(divide="ignore", invalid="ignore"):
         vertex = np.where(jerk[2] != 0, -jerk[1] / (2 * jerk[2]), np.nan)
     vertex = np.where(np.abs(vertex) <= 1, vertex, np.nan)

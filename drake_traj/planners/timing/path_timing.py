@@ -34,7 +34,7 @@ from drake_traj.planners.laws.hermite import HermiteLaw, quintic_hermite_coeffic
 from drake_traj.planners.timing.grid import initial_grid, node_samples, node_times, refined_grid
 from drake_traj.planners.timing.limits import check_least_durations, joint_limits
 from drake_traj.planners.timing.motion import InfeasibleTimingError, SmoothTiming, stretched
-from drake_traj.planners.timing.paths import PATH_TOLERANCE, PathValues, check_path
+from drake_traj.planners.timing.paths import PATH_TOLERANCE, checked_path
 from drake_traj.planners.timing.program import solve_on_grid
 from drake_traj.validation import positive_scalar, whole_number
 
@@ -148,10 +148,9 @@ def _time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, gri
                iterations: int = 8, max_duration: float = 600.0) -> SmoothTiming:
     """The work of :func:`time_path`."""
     grid_points = whole_number(grid_points, "grid_points", minimum=20, maximum=MAX_GRID_POINTS)
-    path, fit = check_path(path)
+    path, fit, values = checked_path(path)
     velocity, acceleration, jerk = joint_limits(path.rows(), velocity_limit, acceleration_limit, jerk_limit)
     max_duration = positive_scalar(max_duration, "max_duration", "s")
-    values = PathValues(path)
     s_all = np.linspace(path.start_time(), path.end_time(), 2001)
     travel = np.trapezoid(np.abs(values(s_all, 1)[0]), s_all, axis=0)  # per joint [rad]
     # A joint's travel D is made of rest-to-rest pieces (it stops where it turns back), and the sums

@@ -15,7 +15,7 @@ from drake_traj.errors import DrakeTrajError
 from drake_traj.planners.timing.motion import InfeasibleTimingError
 from drake_traj.validation import real_array, require_finite
 
-__all__ = ["PATH_TOLERANCE", "PathValues", "check_path", "sample_path", "waypoint_path"]
+__all__ = ["PATH_TOLERANCE", "PathValues", "check_path", "checked_path", "sample_path", "waypoint_path"]
 
 PATH_TOLERANCE = 1e-4
 """The largest joint-space deviation [rad] of the timed motion from the given path."""
@@ -68,9 +68,15 @@ class PathValues:
 
 
 def check_path(path, name: str = "path") -> tuple[Trajectory, float]:
-    """``path`` as a Drake Trajectory q(s) and its largest deviation from what was given [rad]:
-    a Trajectory as it is (0), joint samples (N, n) as the C2 cubic spline through knots picked
-    from them (:func:`sample_path`).
+    """``path`` as a Drake Trajectory q(s) and its largest deviation from what was given [rad]
+    (:func:`checked_path`)."""
+    return checked_path(path, name)[:2]
+
+
+def checked_path(path, name: str = "path") -> tuple[Trajectory, float, PathValues]:
+    """``path`` as a Drake Trajectory q(s), its largest deviation from what was given [rad] and its
+    :class:`PathValues`: a Trajectory as it is (0), joint samples (N, n) as the C2 cubic spline
+    through knots picked from them (:func:`sample_path`).
 
     Raises:
         InfeasibleTimingError: samples that turn back (two consecutive steps more than 120°
@@ -98,7 +104,7 @@ def check_path(path, name: str = "path") -> tuple[Trajectory, float]:
         path, fit = sample_path(samples, name=name)
         values = PathValues(path)
     _check_cusps(path, values, name)
-    return path, fit
+    return path, fit, values
 
 
 def sample_path(samples, max_knots: int = 200, *, name: str = "path") -> tuple[PiecewisePolynomial, float]:
