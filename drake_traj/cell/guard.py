@@ -56,6 +56,8 @@ class MotionGuard:
         check_motion: False only where the user asked for an unchecked run.
         unprotected_links: the robot's links without collision shapes, which the robot says may run
             unprotected (the cell check refuses any other: :func:`~drake_traj.cell.clearance.refuse_unprotected_links`).
+        unchecked_pairs: the pairs of the robot's links the checks leave out
+            (:class:`~drake_traj.robots.UncheckedPair`: :func:`~drake_traj.robots.exclude_self_contact`).
         preflight: ``preflight(planner, horizon)``, the scenario's preflight and cell check where
             the station was made from a scenario (a refusal then located in its file:
             :func:`drake_traj.scenario.preflight`), or None.
@@ -69,6 +71,7 @@ class MotionGuard:
     check_motion: bool = True
     preflight: object = None
     unprotected_links: tuple = ()  # the robot's links without collision shapes (said to run unprotected)
+    unchecked_pairs: tuple = ()  # the pairs of the robot's links the checks leave out (UncheckedPair)
     _checker: CellChecker | None = field(default=None, repr=False)
 
     def checker(self) -> CellChecker:

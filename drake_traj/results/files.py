@@ -60,7 +60,10 @@ def write_result(result, staging) -> None:
     meta = {"name": result.name, "duration": result.duration, "failure": failure, "wall_time": result.wall_time,
             "joint_types": list(result.joint_types), "robot": result.robot,
             "waypoint_neighbourhood": result.waypoint_neighbourhood, "planning_time": result.planning_time,
-            "unchecked_links": list(result.unchecked_links)}
+            "unchecked_links": list(result.unchecked_links),
+            "unchecked_collision_pairs": [list(pair) for pair in result.unchecked_collision_pairs],
+            "estimated_inertia": dict(result.estimated_inertia), "inertia_density": result.inertia_density,
+            "locked_joints": dict(result.locked_joints)}
     staging.write("result.npz", lambda path: np.savez_compressed(
         path, meta=json.dumps(json_ready(meta), allow_nan=False), **arrays))
     staging.write("metrics.json", lambda path: path.write_text(
@@ -102,7 +105,8 @@ def load_result(cls, directory):
             meta["failure"] = Failure.from_dict(meta["failure"])
         meta["joint_types"] = tuple(meta.get("joint_types", ()))
         meta["unchecked_links"] = tuple(meta.get("unchecked_links", ()))
-        for key in ("duration", "wall_time", "waypoint_neighbourhood", "planning_time"):  # NaN is saved as null
+        meta["unchecked_collision_pairs"] = tuple(tuple(pair) for pair in meta.get("unchecked_collision_pairs", ()))
+        for key in ("duration", "wall_time", "waypoint_neighbourhood", "planning_time", "inertia_density"):  # NaN: null
             if key in meta:  # (a result saved before the neighbourhood was has none)
                 meta[key] = float("nan") if meta[key] is None else float(meta[key])
     except (KeyError, TypeError, ValueError) as error:

@@ -24,7 +24,7 @@ from drake_traj.results.figures import (figures_of, joint_figure, save_figures, 
                                         tracking_figure)
 from drake_traj.results.files import load_result, save_result, write_result
 from drake_traj.results.metrics import Metrics, metrics_of
-from drake_traj.robots import ROBOT_NAMES, get_robot
+from drake_traj.robots import ROBOT_NAMES, estimated_torque_note, get_robot
 from drake_traj.validation import invalid, path_argument, positive_scalar, real_array
 
 __all__ = ["DEFAULT_TRACKING_TOLERANCE", "LOGGERS", "SimulationResult"]
@@ -85,6 +85,10 @@ class SimulationResult:
     waypoint_neighbourhood: float = float("nan")  # [m] see PlannerSystem.waypoint_neighbourhood(); NaN: none
     planning_time: float = float("nan")  # [s] the planner's own planning (PlannerSystem.planning_time_s); NaN: none
     unchecked_links: tuple[str, ...] = ()  # the robot's links without collision shapes: no self or cell check saw them
+    unchecked_collision_pairs: tuple[tuple[str, str, str], ...] = ()  # (link, link, reason): pairs the checks left out
+    estimated_inertia: dict = field(default_factory=dict)  # {link: mass [kg]} estimated from its shapes (robot.inertia)
+    inertia_density: float = float("nan")  # [kg/m³] of those estimates; NaN: none
+    locked_joints: dict = field(default_factory=dict)  # {joint: position [rad or m]} held (robot.locked_joints)
 
     def __post_init__(self):
         """Every array as a float array of its shape (:data:`SHAPES`), or ValueError naming it.
@@ -161,7 +165,8 @@ class SimulationResult:
             return Failure(Cause.SATURATION, f"{joint_label(j, self.joint_names)}'s torque reached its effort limit "
                                              f"{self.effort_limit[j]:g} at t = {self.t[first]:.3f} s and stayed there "
                                              f"{saturated[:, j].sum() * self.log_period:.3f} s in all: the arm could "
-                                             "not follow the reference", float(self.t[first]), tuple(self.q_meas[first]))
+                                             f"not follow the reference{estimated_torque_note(self.estimated_inertia, self.inertia_density)}", float(self.t[first]),
+                           tuple(self.q_meas[first]))
         error = self.tcp_position_error()
         if len(error) and not error.max() <= tracking_tolerance:  # NaN is not within the tolerance
             first = int(np.argmax(~(error <= tracking_tolerance)))
@@ -231,6 +236,10 @@ class SimulationResult:
             waypoint_neighbourhood=planner.waypoint_neighbourhood(),
             planning_time=float(getattr(planner, "planning_time_s", float("nan"))),
             unchecked_links=tuple(getattr(planner.guard, "unprotected_links", ())),
+            unchecked_collision_pairs=tuple(tuple(pair.row()) for pair in getattr(planner.guard, "unchecked_pairs", ())),
+            estimated_inertia=dict(getattr(robot, "estimated_inertia", {})),
+            inertia_density=float(getattr(robot, "inertia_density", None) or float("nan")),
+            locked_joints=dict(getattr(robot, "locked_joints", {})),
         )
         if result.failure is None:
             result.failure = _unfinished_failure(count, station_context.get_time(), result.duration)

@@ -27,7 +27,7 @@ from drake_traj.errors import joint_label
 from drake_traj.robots.chain_kinematics import CHAIN, NUM_JOINTS
 from drake_traj.validation import finite_array, invalid, real_array
 
-__all__ = ["SerialChain", "dh_link_frames", "dh_table"]
+__all__ = ["SerialChain", "dh_link_frames", "dh_table", "kinematic_path"]
 
 DH_COLUMNS = ("d", "a", "alpha", "theta_offset")
 CONVENTIONS = ("standard", "modified")
@@ -186,34 +186,64 @@ def _kind(joint) -> str:
     return type(joint).__name__.split("_")[0]
 
 
+def kinematic_path(plant, base_body, tool_body) -> tuple[list, list]:
+    """The joints between two bodies of ``plant`` (finalized or not) through their nearest common
+    ancestor A in the kinematic tree: (the joints from ``base_body`` up to A, base first; the joints
+    from A down to ``tool_body``, A first). The first list is empty where the base is an ancestor
+    of the tool; where it is not (a REP-199 ``base`` frame fixed to ``base_link`` beside the arm's
+    first joint) it holds the joints that hang the base from A. Two bodies in separate trees (an
+    unfinalized plant's free roots): DrakeTrajError at ``tool_frame``."""
+    by_child = {plant.get_joint(index).child_body().index(): plant.get_joint(index)
+                for index in plant.GetJointIndices()}
+
+    def up(body) -> list:  # the joints from ``body`` to its tree's root, bottom first
+        joints = []
+        while body.index() in by_child:
+            joints.append(by_child[body.index()])
+            body = joints[-1].parent_body()
+        return joints
+
+    above_tool, above_base = up(tool_body), up(base_body)
+    tool_ancestors = [tool_body.index()] + [joint.parent_body().index() for joint in above_tool]
+    base_ancestors = [base_body.index()] + [joint.parent_body().index() for joint in above_base]
+    common = next((body for body in base_ancestors if body in tool_ancestors), None)
+    if common is None:
+        raise invalid("tool_frame", f"the tool frame's body {tool_body.name()!r} and the base frame's body "
+                                    f"{base_body.name()!r} are in separate kinematic trees: nothing joins them")
+    return above_base[:base_ancestors.index(common)], above_tool[:tool_ancestors.index(common)][::-1]
+
+
 def plant_chain(plant, base_frame, tool_frame):
     """(fixed (7, 4, 4), axes (6, 3), the six RevoluteJoints) of the kinematic path from
-    ``base_frame`` to ``tool_frame`` of the finalized ``plant`` (:meth:`SerialChain.from_plant`)."""
+    ``base_frame`` to ``tool_frame`` of the finalized ``plant`` (:meth:`SerialChain.from_plant`),
+    through the nearest body above both (:func:`kinematic_path`): the base may hang beside the
+    arm's first joint by fixed joints (REP-199's ``base`` below ``base_link``), not by moving ones."""
     if not isinstance(plant, MultibodyPlant) or not plant.is_finalized():
         raise invalid("plant", f"plant must be a finalized MultibodyPlant, got {type(plant).__name__}"
                                + ("" if not isinstance(plant, MultibodyPlant) else " (not finalized)"))
     base, tool = plant_frame(plant, base_frame, "base_frame"), plant_frame(plant, tool_frame, "tool_frame")
-    by_child = {plant.get_joint(index).child_body().index(): plant.get_joint(index)
-                for index in plant.GetJointIndices()}
-    path, body = [], tool.body()
-    while body.index() != base.body().index():
-        if body.index() not in by_child:
-            raise invalid("tool_frame", f"tool frame {tool.name()!r} is not below the base frame {base.name()!r} in the "
-                                        "plant's kinematic tree")
-        joint = by_child[body.index()]
-        path.append(joint)
-        body = joint.parent_body()
-    path.reverse()
+    beside, path = kinematic_path(plant, base.body(), tool.body())
+    if any(joint.parent_body().index() == plant.world_body().index() for joint in beside):
+        raise invalid("tool_frame", f"tool frame {tool.name()!r} is not below the base frame {base.name()!r} in the "
+                                    "plant's kinematic tree")
+    for joint in beside:
+        if not isinstance(joint, WeldJoint):
+            raise invalid("base_frame", f"the base frame {base.name()!r} hangs from the {_kind(joint)} joint "
+                                        f"{joint.name()!r} beside the arm: a base is fixed to the arm's root")
     movable = [joint for joint in path if not isinstance(joint, WeldJoint)]
     if len(movable) != NUM_JOINTS:
         names = ", ".join(f"{joint.name()!r} ({_kind(joint)})" for joint in movable)
+        hint = (": hold the extra ones at a fixed position with locked_joints: {name: position}"
+                if len(movable) > NUM_JOINTS else "")
         raise invalid("plant", f"{len(movable)} joints between {base.name()} and {tool.name()}: {names or 'none'}; "
-                               "a 6-axis arm has exactly 6 revolute joints")
+                               f"a 6-axis arm has exactly 6 revolute joints{hint}")
     for joint in movable:
         if not isinstance(joint, RevoluteJoint):
             raise invalid("plant", f"joint {joint.name()!r} is {_kind(joint)}: a 6-axis arm has revolute joints only")
     fixed, axes = [], []
     current = base.GetFixedPoseInBodyFrame().inverse()  # X_{M(i-1) P}: from the last joint frame to a body
+    for joint in beside:  # up from the base's body to the common ancestor (fixed joints)
+        current = current @ _pose_in_parent(joint).inverse()
     for joint in path:
         current = current @ joint.frame_on_parent().GetFixedPoseInBodyFrame()
         if isinstance(joint, WeldJoint):
@@ -225,3 +255,9 @@ def plant_chain(plant, base_frame, tool_frame):
         current = current @ joint.frame_on_child().GetFixedPoseInBodyFrame().inverse()
     fixed.append((current @ tool.GetFixedPoseInBodyFrame()).GetAsMatrix4())
     return np.array(fixed), np.array(axes), movable
+
+
+def _pose_in_parent(weld: WeldJoint) -> RigidTransform:
+    """X_PC: the child body's pose in the parent body's frame across the WeldJoint ``weld``."""
+    return (weld.frame_on_parent().GetFixedPoseInBodyFrame() @ weld.X_FM()
+            @ weld.frame_on_child().GetFixedPoseInBodyFrame().inverse())

@@ -12,17 +12,19 @@ from pathlib import Path
 
 import numpy as np
 from pydrake.multibody.parsing import Parser
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
-from pydrake.systems.framework import DiagramBuilder
+from pydrake.multibody.plant import MultibodyPlant
 
 from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_label
+from drake_traj.robots.inertia_estimate import DEFAULT_DENSITY
 from drake_traj.robots.model_files import add_model_file, joint_efforts
+from drake_traj.robots.model_setup import ModelSetup, drake_reason, read_model
 from drake_traj.robots import ROBOT_NAMES, arm_checks
 from drake_traj.robots.base import Robot, TaskKinematics, format_point, joint_actuators
 from drake_traj.robots.chain import SerialChain, plant_chain, plant_frame
 from drake_traj.robots.chain_kinematics import (NUM_JOINTS, chain_reach, chain_singularity_factors,
                                                 inverse_kinematics_all, inverse_kinematics_near)
 from drake_traj.robots.compiled_kinematics import task_kinematics as arm_kinematics, task_kinematics_into
+from drake_traj.robots.self_contact import srdf_file
 from drake_traj.robots.task_space import orientation_error, pose_error, wrap_angle, wrapped
 from drake_traj.robots.urdf_writer import dh_table_urdf
 from drake_traj.validation import finite_array, invalid, joint_bound, joint_limit, path_argument
@@ -40,8 +42,7 @@ __all__ = ["ChainArm"]
 KP_PER_EFFORT = 4000.0 / 330.0  # [1/rad]
 KD_PER_KP = 0.05  # [s]
 LIMIT_ARGUMENTS = ("lower_limits", "upper_limits", "velocity_limits", "acceleration_limits", "effort_limits",
-                   "rated_payload", "home", "data_source", "unchecked_links")  # the **limits of the constructors
-WORLD_POSE_TOLERANCE = 1e-9  # [m, rad] a model's own weld of its base to the world must be the identity
+                   "rated_payload", "home", "data_source", "unchecked_links", "srdf")  # the **limits of the constructors
 FK_AGREEMENT = 1e-6  # [m and rad], a DH table and its model file must agree to this
 
 
@@ -72,11 +73,14 @@ class ChainArm(Robot):
         packages: {package name: folder} for the model's ``package://`` URLs (with those of
             ``ROS_PACKAGE_PATH``: :mod:`drake_traj.robots.model_files`).
         xacro_args: a ``.xacro`` model's arguments.
-        base_welded: the model welds ``base_frame`` to its world itself (at the world's origin);
-            :meth:`add_to_plant` then uses that weld instead of adding one.
+        setup: what the model file needed to run (:class:`~drake_traj.robots.model_setup.ModelSetup`:
+            joints held, inertia estimated, the base's weld to the world), applied by
+            :meth:`add_to_plant`; None: the model used as it is, ``base_frame`` welded to the world.
         unchecked_links: links without collision shapes that may run unprotected, said
             explicitly (``("all",)``: every link); the cell check refuses an arm with such a link
             otherwise, and a run's metrics name them.
+        srdf: the arm's MoveIt configuration (a ``.srdf`` file) whose ``<disable_collisions>``
+            pairs the checks leave out (:mod:`~drake_traj.robots.self_contact`); None: none.
 
     Its :attr:`reach` is the chain's bound :func:`~drake_traj.robots.chain_kinematics.chain_reach` [m].
     """
@@ -86,8 +90,8 @@ class ChainArm(Robot):
     def __init__(self, chain: SerialChain, *, name: str, model_file, base_frame: str, tool_frame: str, joint_names,
                  lower_limits, upper_limits, velocity_limits, acceleration_limits, effort_limits,
                  rated_payload: float | None = None, home=None, data_source: str = "", model_text: str | None = None,
-                 packages: dict | None = None, xacro_args: dict | None = None, base_welded: bool = False,
-                 unchecked_links=()):
+                 packages: dict | None = None, xacro_args: dict | None = None, setup: ModelSetup | None = None,
+                 unchecked_links=(), srdf=None):
         if not isinstance(chain, SerialChain):
             raise TypeError(f"chain must be a SerialChain, got {type(chain).__name__}")
         arm_checks.arm_name(name, "name", plain=False)
@@ -99,8 +103,13 @@ class ChainArm(Robot):
         self.model_text = model_text
         self.packages = {str(k): Path(v) for k, v in (packages or {}).items()}
         self.xacro_args = dict(xacro_args or {})
-        self.base_welded = bool(base_welded)
+        self.setup = setup
+        self.base_welded = setup is not None and setup.root_link is None  # the model's own weld to the world, as it is
+        self.locked_joints = dict(setup.locked_joints) if setup is not None else {}
+        self.estimated_inertia = setup.estimated_masses if setup is not None else {}
+        self.inertia_density = setup.density if setup is not None and setup.inertias else None
         self.unchecked_links = tuple(str(link) for link in unchecked_links)
+        self.srdf = None if srdf is None else srdf_file(srdf)
         self.base_frame, self.tool_frame = str(base_frame), str(tool_frame)
         given = dict(lower_limits=lower_limits, upper_limits=upper_limits, velocity_limits=velocity_limits,
                      acceleration_limits=acceleration_limits, effort_limits=effort_limits)
@@ -129,7 +138,8 @@ class ChainArm(Robot):
     # ---- constructors ------------------------------------------------------------------------
     @classmethod
     def from_model_file(cls, path, *, base_frame: str, tool_frame: str, name: str | None = None,
-                        packages: dict | None = None, xacro_args: dict | None = None, **limits) -> "ChainArm":
+                        packages: dict | None = None, xacro_args: dict | None = None, locked_joints: dict | None = None,
+                        inertia_density: float | None = DEFAULT_DENSITY, **limits) -> "ChainArm":
         """The arm of a URDF/SDF file: the chain between ``base_frame`` and ``tool_frame`` read
         through MultibodyPlant (:meth:`SerialChain.from_plant`), the joint names and the
         position, velocity and effort limits from the file where it has them. ``limits`` (the
@@ -137,30 +147,36 @@ class ChainArm(Robot):
         acceleration_limits, effort_limits, rated_payload, home, data_source) override the file;
         acceleration_limits must be given (URDF has none). ``packages`` ({name: folder}) and
         ``ROS_PACKAGE_PATH`` resolve ``package://`` URLs; a ``.xacro`` file is expanded with
-        ``xacro_args`` (:mod:`drake_traj.robots.model_files`). A model that welds its base to a
-        ``world`` link itself is used as it is (that weld at the world's origin).
+        ``xacro_args`` (:mod:`drake_traj.robots.model_files`). What the description leaves open
+        is decided once (:func:`~drake_traj.robots.model_setup.read_model`) and applied to every
+        plant: the joints off the base-to-tool path and those of ``locked_joints`` ({name:
+        position [rad or m]}) held; the moving links without inertia estimated from their shapes
+        at ``inertia_density`` [kg/m³] (None: refused); ``base_frame`` at the world's origin (a
+        model that welds it there itself is used as it is; REP-199's ``base`` below ``base_link``
+        is put there by welding ``base_link``).
 
         Raises:
             DrakeTrajError: the file unreadable, the chain not six revolute joints, a limit
-                neither in the file nor given (naming the field).
+                neither in the file nor given, a bad lock, a link without inertia refused
+                (naming the field).
         """
         path = path_argument(path, "model_file")
         name = _default_name(name, path.stem.removesuffix(".urdf"), f"the model file's name {path.name!r}")
         packages = {str(k): Path(v) for k, v in (packages or {}).items()}
-        plant = _parsed(path, packages, xacro_args)
+        plant, setup = read_model(path, base_frame=base_frame, tool_frame=tool_frame, packages=packages,
+                                  xacro_args=xacro_args, locked_joints=locked_joints, density=inertia_density)
         if limits.get("effort_limits") is None:  # the file's <limit effort> where it gives no actuators
             efforts = joint_efforts(path, packages, xacro_args=xacro_args)
             joints = plant_chain(plant, base_frame, tool_frame)[2]
             if efforts and all(np.isfinite(efforts.get(j.name(), np.inf)) and efforts.get(j.name(), 0) > 0 for j in joints):
                 limits["effort_limits"] = np.array([efforts[j.name()] for j in joints])
         return cls.from_plant(plant, base_frame=base_frame, tool_frame=tool_frame, model_file=path,
-                              name=name, packages=packages, xacro_args=xacro_args,
-                              base_welded=_base_welded(plant, base_frame), **limits)
+                              name=name, packages=packages, xacro_args=xacro_args, setup=setup, **limits)
 
     @classmethod
     def from_plant(cls, plant: MultibodyPlant, *, base_frame, tool_frame, name: str | None = None, model_file=None,
                    chain: SerialChain | None = None, model_text: str | None = None, packages: dict | None = None,
-                   xacro_args: dict | None = None, base_welded: bool = False, **limits) -> "ChainArm":
+                   xacro_args: dict | None = None, setup: ModelSetup | None = None, **limits) -> "ChainArm":
         """The arm of a finalized ``plant`` (a user's own, beside which a planner built from this
         arm runs): the chain from ``base_frame`` to ``tool_frame`` (Frames or names), the joint
         names, and the limits the plant has (position and velocity limits of the joints, effort
@@ -169,7 +185,8 @@ class ChainArm(Robot):
         cannot add itself to a station); ``model_text``: the arm's URDF text instead of a file;
         ``chain``: use this chain instead of the plant's (it
         must agree with the plant's to 1e-6 m and rad: :meth:`from_dh`); ``name`` defaults to
-        the tool body's model instance name.
+        the tool body's model instance name; ``setup``: what :meth:`add_to_plant` applies to the
+        model file (:meth:`from_model_file`'s).
         """
         unknown = sorted(set(limits) - set(LIMIT_ARGUMENTS))
         if unknown:
@@ -194,7 +211,7 @@ class ChainArm(Robot):
         return cls(chain or from_plant, name=name,
                    model_file=model_file, base_frame=base.name(), tool_frame=tool.name(),
                    joint_names=[j.name() for j in joints], model_text=model_text, packages=packages,
-                   xacro_args=xacro_args, base_welded=base_welded, unchecked_links=limits.get("unchecked_links") or (),
+                   xacro_args=xacro_args, setup=setup, unchecked_links=limits.get("unchecked_links") or (),
                    **{key: limits.get(key) for key in LIMIT_ARGUMENTS if key != "unchecked_links"})
 
     @classmethod
@@ -225,8 +242,9 @@ class ChainArm(Robot):
         arm_checks.dh_reach(np.asarray(table, dtype=float), "table")  # an absurd model before it is written
         if model_file is not None:
             path = path_argument(model_file, "model_file")
-            return cls.from_plant(_parsed(path), base_frame=base_frame, tool_frame=tool_frame, name=name,
-                                  model_file=path, chain=chain, **limits)
+            plant, setup = read_model(path, base_frame=base_frame, tool_frame=tool_frame)
+            return cls.from_plant(plant, base_frame=base_frame, tool_frame=tool_frame, name=name,
+                                  model_file=path, chain=chain, setup=setup, **limits)
         arm_checks.arm_name(name, "name")  # (the written model's name)
         needed = dict(masses=masses, **{key: limits.get(key) for key in LIMIT_ARGUMENTS[:5]})
         for key, value in needed.items():
@@ -295,16 +313,19 @@ class ChainArm(Robot):
         return self.model_file
 
     def add_to_plant(self, plant):
-        """Parse the model (its URDF text, else its file) into ``plant`` (not finalized), weld
-        ``base_frame`` to the world, and give each of the six joints an actuator (the model's,
+        """Parse the model (its URDF text, else its file with its :attr:`setup` applied: joints
+        held, inertia estimated) into ``plant`` (not finalized), put ``base_frame`` at the world's
+        origin, and give each of the six joints an actuator (the model's,
         whatever its name: :func:`~drake_traj.robots.base.joint_actuators`; ``{joint}_actuator``
         added where the model has none) with the arm's effort limit [N m]. Returns the model
         instance."""
         if self.model_text is not None:
             (instance,) = Parser(plant).AddModelsFromString(self.model_text, "urdf")
+        elif self.setup is not None:
+            instance = self.setup.add_to(plant, self.model_path(), self.packages, self.xacro_args)
         else:
             (instance,) = add_model_file(plant, self.model_path(), self.packages, xacro_args=self.xacro_args)
-        if not self.base_welded:  # a model that welds its base to a world link has its weld already
+        if self.setup is None:  # (a model written from a DH table has none)
             plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(self.base_frame, instance))
         actuated = joint_actuators(plant, instance)
         for joint_name, effort in zip(self.joint_names, self._effort):
@@ -389,48 +410,6 @@ class ChainArm(Robot):
                               functools.partial(chain_singularity_factors, self.model), self.model)
 
 
-def _parsed(path: Path, packages: dict | None = None, xacro_args: dict | None = None) -> MultibodyPlant:
-    """A finalized plant of the model file ``path`` alone (its packages, xacro arguments:
-    :func:`~drake_traj.robots.model_files.add_model_file`), with SceneGraph, so that a ``package://``
-    URL that resolves nowhere is found here."""
-    if not path.is_file():
-        raise invalid("model_file", f"model file not found: {path}")
-    builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlantSceneGraph(builder, 0.0)
-    try:
-        add_model_file(plant, path, packages, xacro_args=xacro_args)
-        plant.Finalize()
-    except (RuntimeError, SystemExit) as error:  # Drake's parser exits on some bad data (a limit's lower > upper)
-        raise invalid("model_file", f"the model file {path} could not be read: {_drake_reason(error)}") from None
-    return plant
-
-
-def _base_welded(plant: MultibodyPlant, base_frame: str) -> bool:
-    """True where the model welds ``base_frame`` to the world itself (a ``world`` link and a fixed
-    joint, as ROS descriptions do), at the world's origin; DrakeTrajError naming ``base_frame``
-    where it puts it elsewhere or joins it to the world by a moving joint."""
-    frame = plant_frame(plant, base_frame, "base_frame")
-    world = plant.world_body()
-    welded = {body.index() for body in plant.GetBodiesWeldedTo(world)}
-    if frame.body().index() in welded:
-        pose = frame.CalcPoseInWorld(plant.CreateDefaultContext())
-        offset = max(float(np.abs(pose.translation()).max()), float(np.abs(pose.rotation().matrix() - np.eye(3)).max()))
-        if offset > WORLD_POSE_TOLERANCE:
-            raise invalid("base_frame", f"the model welds base_frame {base_frame!r} to its world at "
-                                        f"xyz {np.round(pose.translation(), 6).tolist()} (and a rotation): poses and the "
-                                        "cell are given in the base frame at the world's origin; name the link the "
-                                        "model welds to the world at its origin as base_frame, or remove the offset")
-        return True
-    for index in plant.GetJointIndices():
-        joint = plant.get_joint(index)
-        if (joint.child_body().index() == frame.body().index() and joint.parent_body().index() == world.index()
-                and not joint.type_name().endswith("floating")):  # Finalize's own floating joint of a free base
-            raise invalid("base_frame", f"the model joins base_frame {base_frame!r} to its world by a {joint.type_name()} "
-                                        f"joint {joint.name()!r}: an arm's base must be fixed (remove the joint or make "
-                                        "it fixed)")
-    return False
-
-
 def _parsed_text(text: str) -> MultibodyPlant:
     """A finalized plant of the URDF ``text`` (written from a DH table) alone."""
     plant = MultibodyPlant(0.0)
@@ -438,13 +417,8 @@ def _parsed_text(text: str) -> MultibodyPlant:
         Parser(plant).AddModelsFromString(text, "urdf")
         plant.Finalize()
     except (RuntimeError, SystemExit) as error:
-        raise invalid("table", f"the model written from the DH table could not be read: {_drake_reason(error)}") from None
+        raise invalid("table", f"the model written from the DH table could not be read: {drake_reason(error)}") from None
     return plant
-
-
-def _drake_reason(error: BaseException) -> str:
-    """Drake's message of a parser failure (a SystemExit carries it as its code)."""
-    return str(error.code if isinstance(error, SystemExit) else error).strip()
 
 
 def _default_name(name: str | None, default: str, origin: str) -> str:

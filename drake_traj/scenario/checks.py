@@ -12,7 +12,7 @@ from pydrake.math import RollPitchYaw, RotationMatrix
 from drake_traj.cell import Cell, CellChecker
 from drake_traj.errors import Cause, DrakeTrajError, Field, field_text, joint_label
 from drake_traj.planners import PlannerSystem
-from drake_traj.robots import Robot
+from drake_traj.robots import Robot, estimated_torque_note
 from drake_traj.robots.base import joint_actuators
 from drake_traj.robots.custom import CustomArm, DhArm
 from drake_traj.validation import MAX_RUN_DURATION
@@ -64,9 +64,10 @@ def check_in_cell(scenario: Scenario, planner: PlannerSystem, checker: CellCheck
     try:
         return checker.check_planner(planner, start_field=("q_initial",) if len(scenario.q_initial) else ("planner",))
     except DrakeTrajError as error:
+        if error.field and error.field[0] in {item.name for item in fields(scenario.planner)}:
+            # a planner that plans in the cell: its goals, written as the preflight's ("planner.poses[0]: pose 0 ...")
+            raise in_planner_field(scenario, error, message_leads_with_field=False) from None
         field = error.field or ("planner",)
-        if field[0] in {item.name for item in fields(scenario.planner)}:  # a planner that plans in the cell: its goals
-            field = ("planner", *field)
         raise error.relocated(field, locate_in_scenario(scenario, field, str(error))) from None
 
 
@@ -124,7 +125,8 @@ def check_start_torques(checker: CellChecker, q, field=None) -> None:
             f"{field_text(where)}: {joint_label(j, robot.joint_names)} of the {robot.name} cannot hold the start "
             f"configuration against gravity{payload}: it needs {needed:.4g} {unit} there, beyond its effort limit of "
             f"±{limit:.4g} {unit}, so its drive saturates from t = 0 and the arm falls; raise the effort limit, lighten "
-            "the payload or bring its centre of mass closer to the flange, or start in another configuration",
+            "the payload or bring its centre of mass closer to the flange, or start in another configuration"
+            f"{estimated_torque_note(getattr(robot, 'estimated_inertia', {}), getattr(robot, 'inertia_density', None))}",
             field=where, cause=Cause.SATURATION)
 
 

@@ -18,7 +18,7 @@ import numpy as np
 import yaml
 from pydrake.common.schema import Transform
 
-from drake_traj.errors import DrakeTrajError, Field, field_text
+from drake_traj.errors import DrakeTrajError, Field, did_you_mean, field_text
 
 __all__ = ["ScenarioError", "checked_document"]
 
@@ -173,7 +173,12 @@ class _Checker:
     def check_union(self, node, options, field: Field) -> None:
         """A union of records chosen by a YAML tag (``planner: !PajakConfig``), one of which may be
         text (``robot: ur10e`` or ``robot: !DhArm {...}``): pydrake reads an untagged value as
-        the first type."""
+        the first type; or a union of text, numbers and true/false (a xacro argument)."""
+        scalars = {str: (_STR,), int: (_INT,), float: (_INT, _FLOAT), bool: (_BOOL,)}
+        if all(option in scalars for option in options):
+            if not isinstance(node, yaml.ScalarNode) or node.tag not in {tag for o in options for tag in scalars[o]}:
+                self.fail(node, field, f"expected text, a number or true/false, found {_describe(node)}")
+            return None
         text = str in options
         names = {option.__name__: option for option in options if option is not str}
         if text and isinstance(node, yaml.ScalarNode) and not node.tag.startswith("!"):
@@ -182,9 +187,11 @@ class _Checker:
             either = "a name or " if text else ""
             self.fail(node, field, f"expected {either}a mapping tagged with one of !{', !'.join(names)}, found {_describe(node)}")
         tag = node.tag[1:] if node.tag.startswith("!") and not node.tag.startswith("!!") else None
-        if tag is None and text:
+        if tag is None and options[0] is str:
             self.fail(node, field, f"a mapping needs a tag naming its type, one of !{', !'.join(names)} (e.g. "
                                    f"{field_text(field)}: !{next(iter(names))})")
+        if tag is None and len(names) == 1:  # untagged, one record (robot.inertia: {density: 1800}): that one
+            return self.check_record(node, options[0], field)
         if tag is None:  # untagged: pydrake reads the first type
             keys = {key.value for key, _ in node.value}
             if not keys <= set(_fields(options[0])) | {"<<"}:
@@ -193,7 +200,8 @@ class _Checker:
                                        f"{options[0].__name__}, which has no {sorted(keys - set(_fields(options[0])))}")
             return self.check_record(node, options[0], field)
         if tag not in names:
-            self.fail(node, field, f"unknown type !{tag}; expected one of !{', !'.join(names)}")
+            hint = did_you_mean(tag, names, tags=True)
+            self.fail(node, field, f"unknown type !{tag}; expected one of !{', !'.join(names)}{f' ({hint})' if hint else ''}")
         return self.check_record(node, names[tag], field)
 
     def check_record(self, node, schema, field: Field) -> None:
@@ -206,9 +214,8 @@ class _Checker:
         for key, value in self.mapping_items(node, field):
             name = field + (key.value,)
             if key.value not in fields:
-                close = [known for known in fields if known.startswith(key.value[:3])]
-                hint = f" (did you mean {close[0]!r}?)" if close else ""
-                self.fail(key, name, f"unknown field{hint}; {schema.__name__} has {sorted(fields)}")
+                hint = did_you_mean(key.value, fields)
+                self.fail(key, name, f"unknown field{f' ({hint})' if hint else ''}; {schema.__name__} has {sorted(fields)}")
             self.check(value, fields[key.value], name)
 
 

@@ -45,7 +45,7 @@ from drake_traj.cell import Cell, MotionGuard, add_cell, refuse_free_bodies
 from drake_traj.cell.clearance import scene_fingerprint, unprotected_links
 from drake_traj.planners.base import PlannerSystem
 from drake_traj.results import LOGGERS
-from drake_traj.robots import UR10E, Robot
+from drake_traj.robots import UR10E, Robot, exclude_self_contact
 from drake_traj.robots.base import joint_actuators
 from drake_traj.scenario import ControllerGains, Scenario, SpeedOverride, default_plant_config
 from drake_traj.scenario import preflight as scenario_preflight
@@ -164,7 +164,9 @@ def station_config(builder, planner, *, robot, gains, plant_config, log_period, 
 def add_robot_plant(builder: DiagramBuilder, planner: PlannerSystem, config: StationConfig):
     """The finalized plant (and its scene graph, and the robot's model instance): the robot with
     its PD-controlled actuators, the cell and tool (contact with them, and between the arm's
-    non-adjacent links, is simulated and ends the run: :func:`~drake_traj.station.run_station`),
+    non-adjacent links, is simulated and ends the run: :func:`~drake_traj.station.run_station`;
+    the pairs of links the checks leave out, :func:`~drake_traj.robots.exclude_self_contact`, are
+    filtered here too),
     the bodies of ``before_finalize``; its default positions are the planner's start. Gives the
     planner the :class:`~drake_traj.cell.MotionGuard` of this scene."""
     plant, scene_graph = AddMultibodyPlant(config.plant_config, builder)
@@ -180,11 +182,13 @@ def add_robot_plant(builder: DiagramBuilder, planner: PlannerSystem, config: Sta
     if config.before_finalize is not None:
         config.before_finalize(plant, scene_graph)
     plant.Finalize()
+    unchecked_pairs = exclude_self_contact(plant, scene_graph, instance, robot)  # as the cell check's plant
     refuse_free_bodies(plant, instance, fields)  # the controller drives the robot's joints only
     plant.SetDefaultPositions(instance, planner.initial_positions())
     planner.guard = MotionGuard(robot, config.cell, config.cell_directory, config.before_finalize,
                                 scene_fingerprint(plant, scene_graph.model_inspector()), config.check_motion,
-                                unprotected_links=tuple(unprotected_links(plant, instance, robot.joint_names)))
+                                unprotected_links=tuple(unprotected_links(plant, instance, robot.joint_names)),
+                                unchecked_pairs=unchecked_pairs)
     return plant, scene_graph, instance
 
 
