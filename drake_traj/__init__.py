@@ -12,10 +12,10 @@ Planner configs (``PajakConfig``, ``QuinticConfig``, ...) build planners with
 
 import importlib
 
-from drake_traj.version import __version__
-
 # each public name -> the module it comes from, imported on first use (PEP 562): ``import
-# drake_traj`` (and ``drake-traj --version``, whose module is in this package) does not import Drake
+# drake_traj`` (and ``drake-traj --version``, whose module is in this package) does not import Drake,
+# nor, until ``__version__`` is asked for, the installed package's metadata (``drake-traj`` handles
+# Ctrl-C from its first moment, which comes after this package is imported)
 _SOURCES = {
     **dict.fromkeys(("add_station", "build_station", "make_station", "run_station", "simulate"), "drake_traj.station"),
     **dict.fromkeys(("Cause", "DrakeTrajError", "Failure", "PlanningError", "SingularConfigurationError"),
@@ -30,6 +30,7 @@ _SOURCES = {
 
 
 __all__ = sorted(_SOURCES)
+_SOURCES["__version__"] = "drake_traj.version"  # served the same way, not one of the API's names
 
 
 def __getattr__(name: str):

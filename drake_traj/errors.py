@@ -15,14 +15,15 @@ what it logged and describes why in a :class:`Failure`, whose ``cause`` is a :cl
 
 from __future__ import annotations
 
+import difflib
 import enum
 from dataclasses import dataclass
 
 import numpy as np
 
 __all__ = [
-    "Cause", "DrakeTrajError", "Failure", "Field", "PlanningError", "SingularConfigurationError", "field_text",
-    "joint_label",
+    "Cause", "DrakeTrajError", "Failure", "Field", "PlanningError", "SingularConfigurationError", "did_you_mean",
+    "field_text", "joint_label",
 ]
 
 Field = tuple  # tuple[str | int, ...]: field names and list indices, outermost first
@@ -69,6 +70,22 @@ def joint_label(j: int, names=None) -> str:
     """Joint ``j`` (0-based index) as every message names it: ``joint 2 (shoulder_lift_joint)``,
     1-based, with its name where known."""
     return f"joint {j + 1}" + (f" ({names[j]})" if names is not None else "")
+
+
+def did_you_mean(word, known, *, tags: bool = False) -> str:
+    """"did you mean 'goals'?" naming the entries of ``known`` closest to ``word`` (a misspelt
+    field, scenario, variant or robot): up to three of :func:`difflib.get_close_matches`, those
+    nearly as close as the closest, quoted, or written as YAML tags with ``tags`` ("did you mean
+    !PajakConfig?"); "" when none is close."""
+    if not isinstance(word, str):
+        return ""
+    ratios = {item: difflib.SequenceMatcher(None, word, item).ratio() for item in map(str, known)}
+    best = max(ratios.values(), default=0.0)
+    close = [f"!{item}" if tags else repr(item) for item in difflib.get_close_matches(word, ratios, n=3)
+             if ratios[item] >= best - 0.1]
+    if not close:
+        return ""
+    return f"did you mean {close[0] if len(close) == 1 else ', '.join(close[:-1]) + ' or ' + close[-1]}?"
 
 
 def _restore(cls, message: str, state: dict):

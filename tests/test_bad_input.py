@@ -631,7 +631,7 @@ def test_a_log_whose_time_runs_backwards_is_refused(saved_run, tmp_path):
 
 
 def test_signals_while_writing_wait_until_the_files_are_written():
-    with commands._interrupts_deferred() as received:
+    with commands.signals_held() as received:
         os.kill(os.getpid(), signal.SIGINT)
         os.kill(os.getpid(), signal.SIGTERM)
         time.sleep(0.05)  # the handlers run here, and record instead of raising

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import browser
-from drake_traj import cli, scenario
+from drake_traj import catalogue, cli
 from drake_traj.cli import commands
 from drake_traj.robots import ROBOT_NAMES, get_robot
 from drake_traj.scenario import load_scenario, shipped_scenarios
@@ -49,37 +49,43 @@ def test_a_commands_help_lists_its_options(capsys):
     assert "--format {csv,ros2,urscript}" in capsys.readouterr().out
 
 
-def test_list_gives_each_shipped_files_path_above_its_scenarios(capsys):
-    assert cli.main(["list"]) == cli.EXIT_OK
-    lines = capsys.readouterr().out.splitlines()[1:]  # below which copy runs
+@pytest.mark.parametrize("verbose", [False, True])
+def test_list_gives_each_shipped_files_name_above_its_scenarios(verbose, capsys):
+    # by default the file's name (no absolute path); -v its path, below which copy of the files runs
+    assert cli.main(["list", "-v"] if verbose else ["list"]) == cli.EXIT_OK
+    lines = capsys.readouterr().out.splitlines()[1:]  # below the heading
     for entry in shipped_scenarios():
-        header = lines.index(str(entry.path))
+        header = lines.index(str(entry.path) if verbose else entry.path.name)
         below = lines[header + 1:]
         below = below[:next((k for k, line in enumerate(below) if not line.startswith("  ")), len(below))]
         assert any(line.split()[0] == entry.name for line in below), (entry.name, lines)
+    assert any(line.startswith("/") for line in lines) == verbose
 
 
-
-def test_list_and_show_say_which_copy_of_the_shipped_files_runs(capsys, monkeypatch, tmp_path):
+def test_only_list_v_and_show_where_say_which_copy_of_the_shipped_files_runs(capsys, monkeypatch, tmp_path):
     """A source tree's diagrams/ (a checkout, an editable install: an edit changes what runs) or
-    the installed package's (CI installs it so): list's first line and show's note say which."""
-    from drake_traj.scenario import shipped as scenario_module
-
+    the installed package's (CI installs it so): said by list -v's first line and show --where,
+    never by list and show themselves, which name no absolute path."""
     directory = shipped_scenarios()[0].path.parent
-    here = scenario_module.shipped_copy()
+    here = catalogue.shipped_copy()
     in_tree = (directory.parent / "pyproject.toml").is_file()
     assert here.startswith("this source tree's diagrams/" if in_tree else "the installed package") and str(directory) in here
-    assert cli.main(["list"]) == cli.EXIT_OK
+    assert cli.main(["list", "-v"]) == cli.EXIT_OK
     assert capsys.readouterr().out.splitlines()[0] == f"shipped scenarios, from {here}"
-    assert cli.main(["show", "quintic_ptp"]) == cli.EXIT_OK
-    assert f"that is {directory / 'quintic_ptp.yaml'}, from {here}; run a copy with" in capsys.readouterr().err
+    assert cli.main(["show", "quintic_ptp", "--where"]) == cli.EXIT_OK
+    where = capsys.readouterr()
+    assert where.out == f"{directory / 'quintic_ptp.yaml'}\n" and where.err == f"drake-traj: from {here}\n"
+    for argv in (["list"], ["show", "quintic_ptp"], ["robots"]):
+        assert cli.main(argv) == cli.EXIT_OK
+        captured = capsys.readouterr()
+        assert str(directory) not in captured.out + captured.err, argv
     for tree in (True, False):  # both wordings, whichever way this copy is installed
         folder = tmp_path / str(tree) / "diagrams"
         folder.mkdir(parents=True)
         if tree:
             (folder.parent / "pyproject.toml").write_text("[project]\n")
-        monkeypatch.setattr(scenario_module, "shipped_directory", lambda folder=folder: folder)
-        said = scenario_module.shipped_copy()
+        monkeypatch.setattr(catalogue, "shipped_directory", lambda folder=folder: folder)
+        said = catalogue.shipped_copy()
         assert said.startswith("this source tree's diagrams/" if tree else "the installed package") and str(folder) in said
 
 
@@ -87,12 +93,16 @@ def test_an_installed_copy_says_a_checkouts_diagrams_are_not_read(tmp_path, monk
     installed = tmp_path / "site-packages" / "drake_traj" / "diagrams"  # no pyproject.toml beside it
     installed.mkdir(parents=True)
     (installed / "quintic_ptp.yaml").write_text((shipped_scenarios()[0].path.parent / "quintic_ptp.yaml").read_text())
-    monkeypatch.setattr(scenario.shipped, "shipped_directory", lambda: installed)
-    assert cli.main(["list"]) == cli.EXIT_OK
+    monkeypatch.setattr(catalogue, "shipped_directory", lambda: installed)
+    assert cli.main(["list", "-v"]) == cli.EXIT_OK
     assert capsys.readouterr().out.splitlines()[:2] == [
         f"shipped scenarios, from the installed package ({installed}; a checkout's diagrams/ is not read: copy a "
         "scenario with drake-traj show NAME > my_task.yaml, edit the copy and run it by its path)",
         str(installed / "quintic_ptp.yaml")]
+    assert cli.main(["list"]) == cli.EXIT_OK
+    assert capsys.readouterr().out.splitlines()[1:3] == ["quintic_ptp.yaml", "  quintic_ptp  ur10e  Benotsmane et al.'s "
+                                                         "synchronised quintic moves through three joint goals and back"]
+
 
 @pytest.mark.parametrize("argv, variant", [(["show", "quintic_ptp"], None), (["show", "pajak_sim3"], "sim3"),
                                            (["show", "pajak", "--variant", "sim2"], "sim2")])
@@ -102,7 +112,7 @@ def test_show_prints_the_shipped_file_to_copy_and_run(argv, variant, tmp_path, c
     shipped = next(entry for entry in shipped_scenarios()
                    if entry.name == argv[1] or (entry.path.stem, entry.variant) == (argv[1], variant))
     assert captured.out == shipped.path.read_text()
-    assert str(shipped.path) in captured.err
+    assert f"that is the shipped file {shipped.path.name} (--where: its path); run a copy with" in captured.err
     assert ("--variant " + variant in captured.err) if variant else "--variant" not in captured.err
     copy = tmp_path / "my_copy.yaml"
     copy.write_text(captured.out)
@@ -192,5 +202,7 @@ def test_robots_tabulates_every_known_robot_with_its_ratings(capsys):
         np.testing.assert_allclose(np.array(fields[4:4 + n], dtype=float), robot.velocity_limits, rtol=5e-4)
         np.testing.assert_allclose(np.array(fields[4 + n:4 + 2 * n], dtype=float), robot.effort_limits, rtol=5e-4)
         assert rows[name].endswith(robot.data_source)
+        # an installed package has no docs/ folder: the source is said in words (the manual's page by its title)
+        assert robot.data_source and "docs/" not in robot.data_source and ".md" not in robot.data_source, robot.data_source
     ur10e = rows["ur10e"].split()
     assert ur10e[1:4] == ["6", "1.3", "12.5"] and ur10e[4:6] == ["2.094", "2.094"] and ur10e[10:16] == ["330", "330", "150", "56", "56", "56"]

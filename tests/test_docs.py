@@ -25,6 +25,7 @@ The blocks of one page run in order in one folder (a later block may use an earl
 a block run alone first runs the blocks before it on its page. Pages run two at a time.
 """
 
+import json
 import os
 import re
 import shutil
@@ -37,13 +38,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
+import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+# The repository's other top-level pages: not in the site and run nowhere, but their links are checked.
+FRONT_PAGES = [ROOT / "CONTRIBUTING.md", ROOT / "CHANGELOG.md"]
 
 # Blocks that are not run, by (page, first line): every one must carry a not-run comment, and every
 # not-run comment must be listed here.
 NOT_RUN = {
+    ("README.md", "pip wheel --no-deps . -w dist && pip install dist/drake_traj-*.whl"),
     ("README.md", "python3 -m venv .venv && . .venv/bin/activate && pip install . && drake-traj run --out out"),
     ("README.md", "apt-get update && apt-get install -y chromium"),
     ("docs/getting-started.md", "python3 -m venv .venv && . .venv/bin/activate && pip install ."),
@@ -128,9 +133,14 @@ def normalized(text: str) -> str:
     return " ".join(text.split())
 
 
+# the progress a long command prints on stderr (a line after seconds of silence: on a busy machine,
+# before the output a page shows) is not part of the page's output
+PROGRESS_LINE = re.compile(r"^drake-traj (run|bench): .*\n?", flags=re.MULTILINE)
+
+
 def matches(expected: str, actual: str) -> bool:
     pattern = ".*?".join(re.escape(part) for part in normalized(expected).split("..."))
-    return re.fullmatch(pattern, normalized(actual), flags=re.DOTALL) is not None
+    return re.fullmatch(pattern, normalized(PROGRESS_LINE.sub("", actual)), flags=re.DOTALL) is not None
 
 
 def environment() -> dict:
@@ -268,6 +278,30 @@ def test_block_runs_as_written(block, page_runs):
     page_runs.result(block)
 
 
+# Numbers a page states about a run its own blocks make: (page, the statement with the number as its
+# group, the run's metrics.json in the page's folder, the metric). The number must be the run's,
+# rounded to the digits the page gives.
+RUN_NUMBERS = [
+    ("docs/free-motion.md", r"`duration_s` (\d+\.\d+) s", "out/free_motion_shelf/metrics.json", "duration_s"),
+    ("docs/smooth_timing.md", r"\| `smooth_waypoints` \| (\d+\.\d+) s through", "out/smooth_waypoints/metrics.json",
+     "duration_s"),
+    ("docs/smooth_timing.md", r"\| `pajak_retimed` \| (\d+\.\d+) s against", "out/pajak_retimed/metrics.json", "duration_s"),
+    ("docs/smooth_timing.md", r"max jerk (\d+\.\d+) rad/s³ against", "out/pajak_retimed/metrics.json", "max_jerk"),
+]
+
+
+@pytest.mark.parametrize("page, statement, metrics, key", RUN_NUMBERS, ids=[f"{row[0]}:{row[3]}" for row in RUN_NUMBERS])
+def test_a_number_a_page_states_is_its_runs(page, statement, metrics, key, page_runs):
+    path = ROOT / page
+    stated = re.findall(statement, path.read_text(encoding="utf-8"))
+    assert len(stated) == 1, f"{page}: {statement!r} found {len(stated)} times"
+    for block in steps(path):
+        page_runs.result(block)  # the page's blocks ran (a failing block fails here too)
+    measured = json.loads((page_runs.base / path.stem / metrics).read_text(encoding="utf-8"))[key]
+    digits = len(stated[0].partition(".")[2])
+    assert f"{measured:.{digits}f}" == stated[0], f"{page} says {stated[0]}; the run's {key} is {measured}"
+
+
 def test_the_blocks_not_run_are_the_listed_ones():
     marked = {(str(b.page.relative_to(ROOT)), b.first_line) for page in PAGES for b in ALL_BLOCKS[page]
               if "not-run" in b.markers}
@@ -332,7 +366,7 @@ def links(page: Path):
             yield number, match["target"].strip("<>")
 
 
-@pytest.mark.parametrize("page", PAGES, ids=[str(p.relative_to(ROOT)) for p in PAGES])
+@pytest.mark.parametrize("page", PAGES + FRONT_PAGES, ids=[str(p.relative_to(ROOT)) for p in PAGES + FRONT_PAGES])
 def test_relative_links_point_at_files_and_headings(page):
     broken = []
     for number, target in links(page):
@@ -374,3 +408,33 @@ def test_the_site_builds_with_warnings_as_errors(tmp_path):
     for page in (ROOT / "docs").glob("*.md"):
         built = site / ("index.html" if page.stem == "index" else f"{page.stem}/index.html")
         assert built.exists(), f"{page.name} is not in the site"
+
+
+# ---------------------------------------------------------------------------------------------
+# the front door: licence and citation
+
+
+def test_the_licence_and_the_citation_say_what_pyproject_says():
+    import tomllib
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert project["license"]["text"] == "BSD-3-Clause"
+    assert (ROOT / "LICENSE").read_text(encoding="utf-8").startswith("BSD 3-Clause License")
+    citation = yaml.safe_load((ROOT / "CITATION.cff").read_text(encoding="utf-8"))
+    assert citation["cff-version"] == "1.2.0" and citation["title"] == project["name"]
+    assert citation["version"] == project["version"] and citation["license"] == project["license"]["text"]
+
+
+def test_the_citations_references_are_the_papers_as_docs_papers_md_cites_them():
+    papers = normalized((ROOT / "docs" / "papers.md").read_text(encoding="utf-8"))
+    references = yaml.safe_load((ROOT / "CITATION.cff").read_text(encoding="utf-8"))["references"]
+    assert len(references) == 4
+    for reference in references:
+        assert normalized(reference["title"]) in papers, reference["title"]
+        for author in reference["authors"]:
+            assert f"{author['given-names']} {author['family-names']}" in papers, author
+        if "journal" in reference:  # volume(issue), first–last page, as the table of names gives them
+            assert f"{reference['volume']}({reference['issue']}), {reference['start']}–{reference['end']}" in papers
+            assert str(reference["year"]) in papers
+        if "doi" in reference:
+            assert f"DOI [{reference['doi']}](https://doi.org/{reference['doi']})" in papers

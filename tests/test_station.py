@@ -145,7 +145,7 @@ def test_diagram_scripts_run(script, tmp_path, monkeypatch, capsys):
     result = namespace["main"]([str(tmp_path)])
     assert (tmp_path / script.replace(".py", ".png")).stat().st_size > 10_000
     steps = np.abs(np.diff(result.qdd_ref[1:], axis=0)).max()
-    assert steps < 0.1 and result.metrics().max_acceleration_over_limit <= 1 + 1e-9
+    assert steps < 0.1 and result.metrics().peak_acceleration_fraction <= 1 + 1e-9
     if script == "light_curtain.py":
         assert result.succeeded
         # slowed to 25 % while the person is inside (1.5-3.5 s), back to full speed after

@@ -168,12 +168,12 @@ def _row(task, name, result, planning, optimal) -> dict:
     return {
         "task": task, "planner": name, "succeeded": result.succeeded, "T_s": result.duration,
         "T_over_optimal": result.duration / optimal if optimal > 0 else float("nan"),
-        "max_qd_over_limit": metrics.max_velocity_over_limit,
-        "max_qdd_over_limit": metrics.max_acceleration_over_limit, "max_jerk": metrics.max_jerk,
+        "max_qd_over_limit": metrics.peak_velocity_fraction,
+        "max_qdd_over_limit": metrics.peak_acceleration_fraction, "max_jerk": metrics.max_jerk,
         "qdd_continuous": bool(steps.max() <= JUMP) if steps.size else float("nan"),
         "tracking_joint_rad": metrics.tracking_error_joint_max_rad,
         "tracking_tcp_m": metrics.tracking_error_tcp_max_m,
-        "peak_torque_over_limit": max(metrics.peak_torque_over_limit), "planning_s": planning,
+        "peak_torque_over_limit": max(metrics.peak_torque_fraction), "planning_s": planning,
         "real_time_factor": metrics.real_time_factor, "failure": metrics.failure or "", "optimal_failure": no_optimum,
     }
 

@@ -1,15 +1,14 @@
-"""The commands of ``drake-traj`` (:mod:`drake_traj.cli` has the usage and the exit codes): each
-command's options (:data:`OPTIONS`) and what it does; :func:`execute` runs one, turning errors into
-a message and an exit code. :mod:`drake_traj.cli` imports this module (and with it Drake) only once
-a command is given.
+"""The commands of ``drake-traj`` but ``list`` (:mod:`drake_traj.cli` has the usage and the exit
+codes, :mod:`drake_traj.cli.listing` the list): each command's options (:data:`OPTIONS`) and what
+it does; :func:`execute` runs one, turning bad input and failed writes into a message and an exit
+code. :mod:`drake_traj.cli` imports this module (and with it Drake) only once a command is given;
+Ctrl-C, SIGTERM and unforeseen errors are :func:`drake_traj.cli.main`'s.
 """
 
 import contextlib
 import json
-import os
 import signal
 import sys
-import threading
 import traceback
 from pathlib import Path
 from time import sleep
@@ -19,13 +18,15 @@ from tqdm import tqdm
 
 from drake_traj.version import __version__
 from drake_traj.cli.exit_codes import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, EXIT_TERMINATED
+from drake_traj.cli.signals import signals_held
 from drake_traj.bench import bench, free_bench
 from drake_traj.cell import CollisionError, refusal_figure
-from drake_traj.errors import Cause, DrakeTrajError, Failure, PlanningError
+from drake_traj.errors import DrakeTrajError, Failure, PlanningError
 from drake_traj.results.exports import FORMATS, UR_CYCLE, ExportError
-from drake_traj.station import add_live_view, draw_refusal, draw_task, draw_tcp_path, export_html, frame_task, simulate, start_meshcat, wait_for_browser
+from drake_traj.station import (add_live_view, draw_refusal, draw_task, draw_tcp_path, export_html, frame_task, simulate,
+                                start_meshcat, wait_for_browser)
 from drake_traj.results import SimulationResult, WriteError, locked, working_folder
-from drake_traj.robots import ROBOT_NAMES, get_robot
+from drake_traj.robots import ROBOT_NAMES, get_robot, self_contact, setup_note
 from drake_traj.results import (MANIFEST, REFUSAL, add_to_manifest, claim_run_folder, earlier_run, run_files,
                                write_manifest)
 from drake_traj.scenario import (DEFAULT_SCENARIO, check_planned_duration, default_scenario_path, find_scenario,
@@ -36,30 +37,8 @@ from drake_traj.validation import REALTIME_RATES
 # [s] how long the live view's recording stays served after the run when no terminal is attached
 # (on a terminal: until Ctrl-C); --serve-after sets it
 DEFAULT_SERVE_AFTER = 60.0
-SUMMARY = ("name", "succeeded", "failure", "failure_cause", "duration_s", "max_velocity_over_limit", "max_acceleration_over_limit",
+SUMMARY = ("name", "succeeded", "failure", "failure_cause", "duration_s", "peak_velocity_fraction", "peak_acceleration_fraction",
            "tracking_error_joint_max_rad", "tracking_error_tcp_max_m", "real_time_factor")
-
-
-class Progress:
-    """The stage and the simulated time, as a tqdm bar on a terminal; silent otherwise."""
-
-    def __init__(self, total: float, *, enabled: bool):
-        self._bar = tqdm(total=round(total, 3), unit="s", desc="planning", disable=not enabled, file=sys.stderr,
-                         bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}]")
-
-    def stage(self, name: str) -> None:
-        self._bar.set_description_str(name)
-
-    def expect(self, total: float) -> None:
-        """The simulated time the run is expected to take [s]."""
-        self._bar.total = round(total, 3)
-
-    def simulated(self, t: float) -> None:
-        self._bar.n = min(round(t, 3), self._bar.total)
-        self._bar.refresh()
-
-    def close(self) -> None:
-        self._bar.close()
 
 
 def _scenario_reference(args) -> tuple[Path, str | None]:
@@ -68,101 +47,126 @@ def _scenario_reference(args) -> tuple[Path, str | None]:
     return find_scenario(args.scenario, args.variant)
 
 
-@contextlib.contextmanager
-def _interrupts_deferred():
-    """Ctrl-C and SIGTERM wait until the block is done (writing a run's files); yields the list
-    of the signals received meanwhile. Outside the main thread, signals are not ours to handle."""
-    received = []
-    if threading.current_thread() is not threading.main_thread():
-        yield received
-        return
-    previous = {number: signal.signal(number, lambda signum, frame: received.append(signum))
-                for number in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield received
-    finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
-
-
 def run(args) -> int:
-    """``drake-traj run``: simulate one scenario and write its outputs; returns the exit code."""
+    """``drake-traj run``: simulate one scenario and write its outputs; returns the exit code. Its
+    stages are said on ``args.progress`` (:class:`~drake_traj.cli.progress.Progress`). Ctrl-C (or
+    SIGTERM) while it simulates: the run's files so far are written as a failed run's, then the
+    interrupt goes on (exit 130, 143)."""
+    progress = args.progress
+    progress.stage("reading the scenario")
     scenario = load_scenario(*_scenario_reference(args))
     if args.out == "":
         raise DrakeTrajError("--out must name a folder, got empty text")
-    progress = Progress(scenario.max_duration, enabled=sys.stderr.isatty())
-    interrupts = []
-    claimed = None
+    claimed = stopped = None
     try:
+        progress.stage("planning")
         arguments = scenario.station_arguments() | scenario.run_settings()
         planner = arguments.pop("planner")
         planned_path = None
         if args.preflight:
-            progress.stage("preflight")
+            progress.stage("checking the task in the cell")
             try:
                 planned_path = preflight(scenario, planner)
             except CollisionError as error:
+                progress.close()
                 raise with_refusal_picture(error, scenario, args) from None
         check_planned_duration(scenario, planner)
+        _say_unchecked_pairs(arguments["robot"])
+        if setup_note(arguments["robot"]):
+            tqdm.write(f"drake-traj: {setup_note(arguments['robot'])}", file=sys.stderr)
         duration = planner.planned_duration()
         expected = duration + scenario.settle_time if np.isfinite(duration) else scenario.max_duration
+        progress.stage("building the station")
         # checked and locked before the simulation; written (an earlier run replaced, with
         # --overwrite) only once the new run's files are complete on disk
         claimed = claim_run_folder(_run_folder(args, scenario), overwrite=args.overwrite,
                                    samples=expected / scenario.logging_period(), command=args.command_line)
-        out_dir = claimed.directory
         progress.expect(expected)
-        meshcat = start_meshcat(args.port, announce=args.meshcat)
-        draw_task(meshcat, planner.task_waypoints(), neighbourhood=planner.waypoint_neighbourhood(),
-                  planned_path=planned_path)
-        frame_task(meshcat, np.vstack([planner.task_waypoints().reshape(-1, 3),
-                                       planned_path if planned_path is not None else np.zeros((0, 3))]))
-        add_systems = before_run = None
-        if args.meshcat:
-            arguments["simulator_config"].target_realtime_rate = args.rate
-            profile = arguments.pop("speed_override")  # the live view's slider scales it
-            print(f"Meshcat: {meshcat.web_url()}", file=sys.stderr, flush=True)
-
-            def add_systems(builder, station):
-                add_live_view(builder, station, meshcat, arguments["robot"], speed_override=profile)
-
-            def before_run(simulator):
-                if args.wait:
-                    print(f"waiting up to {args.wait_timeout:g} s for a browser at {meshcat.web_url()} "
-                          "(--no-wait starts at once)", file=sys.stderr, flush=True)
-                    if not wait_for_browser(meshcat, args.wait_timeout):
-                        print(f"no browser connected within {args.wait_timeout:g} s; starting the motion",
-                              file=sys.stderr, flush=True)
-
-        progress.stage("simulating")
-        result = simulate(planner, meshcat=meshcat, progress=progress.simulated, add_systems=add_systems,
-                          before_run=before_run, preflight=False, **arguments)
-        progress.stage("writing figures")
-        # a second Ctrl-C must not leave half a run
-        with _interrupts_deferred() as interrupts, claimed.replace() as staging:
-            result.write_into(staging)
-            for stem, figure in (result.figures() | planner.figures()).items():
-                staging.write(f"{stem}.png", lambda path: figure.savefig(path, dpi=110))
-            draw_tcp_path(meshcat, result.tcp)
-            staging.write("meshcat.html", lambda path: export_html(meshcat, path))
-            files = list(staging.files)
-            write_manifest(staging, files, scenario=scenario.name, drake_traj=__version__,
-                           failure=None if result.failure is None else result.failure.to_dict())
+        meshcat, add_systems, before_run = _live_view(args, arguments, planner, planned_path)
+        try:
+            result = simulate(planner, meshcat=meshcat, progress=progress.simulated, add_systems=add_systems,
+                              before_run=before_run, preflight=False, **arguments)
+        except KeyboardInterrupt as interrupted:  # while it simulated: the result so far is written as a failed run's
+            if getattr(interrupted, "result", None) is None:
+                raise
+            result, stopped = interrupted.result, interrupted
+        progress.stage("writing the run's files")
+        files, interrupts = _write_run(claimed, result, planner, scenario, meshcat)
     finally:
         progress.close()
         if claimed is not None:
             claimed.release()
     metrics = result.metrics().to_dict()
     print(json.dumps({key: metrics[key] for key in SUMMARY}, indent=2))
-    print(f"wrote {out_dir}: {', '.join(sorted(files))}")
+    print(f"wrote {claimed.directory}: {', '.join(sorted(files))}")
+    if stopped is not None:
+        print(f"drake-traj: the run stopped at t = {stopped.failure.time:.3f} s; what it logged is in {claimed.directory}",
+              file=sys.stderr)
+        raise stopped
     if args.meshcat:
         serve_recording(meshcat.web_url(), args.serve_after)
     if interrupts:
         print("drake-traj: interrupted while writing; the run's files were completed first", file=sys.stderr)
         return EXIT_TERMINATED if signal.SIGTERM in interrupts else EXIT_INTERRUPTED
-    if result.succeeded:
-        return EXIT_OK
-    return EXIT_INTERRUPTED if result.failure.cause is Cause.INTERRUPTED else EXIT_RUN_FAILED
+    return EXIT_OK if result.succeeded else EXIT_RUN_FAILED
+
+
+def _live_view(args, arguments: dict, planner, planned_path):
+    """The run's Meshcat, the task (and the planned path) drawn; with ``--meshcat``, the live
+    view's systems and the wait for a browser (:func:`simulate`'s ``add_systems`` and
+    ``before_run``, else None), the real-time rate set in ``arguments`` and its speed override
+    taken out of them (the live view's slider scales it)."""
+    meshcat = start_meshcat(args.port, announce=args.meshcat)
+    draw_task(meshcat, planner.task_waypoints(), neighbourhood=planner.waypoint_neighbourhood(), planned_path=planned_path)
+    frame_task(meshcat, np.vstack([planner.task_waypoints().reshape(-1, 3),
+                                   planned_path if planned_path is not None else np.zeros((0, 3))]))
+    if not args.meshcat:
+        return meshcat, None, None
+    arguments["simulator_config"].target_realtime_rate = args.rate
+    profile = arguments.pop("speed_override")
+    print(f"Meshcat: {meshcat.web_url()}", file=sys.stderr, flush=True)
+
+    def add_systems(builder, station):
+        add_live_view(builder, station, meshcat, arguments["robot"], speed_override=profile)
+
+    def before_run(simulator):
+        if args.wait:
+            args.progress.stage("waiting for a browser")
+            print(f"waiting up to {args.wait_timeout:g} s for a browser at {meshcat.web_url()} "
+                  "(--no-wait starts at once)", file=sys.stderr, flush=True)
+            if not wait_for_browser(meshcat, args.wait_timeout):
+                print(f"no browser connected within {args.wait_timeout:g} s; starting the motion",
+                      file=sys.stderr, flush=True)
+
+    return meshcat, add_systems, before_run
+
+
+def _write_run(claimed, result: SimulationResult, planner, scenario, meshcat) -> tuple[list[str], list]:
+    """Write the run's files into the ``claimed`` folder (an earlier run replaced only once they
+    are complete); returns their names and the signals received meanwhile (a second Ctrl-C must
+    not leave half a run)."""
+    with signals_held() as interrupts, claimed.replace() as staging:
+        result.write_into(staging)
+        for stem, figure in (result.figures() | planner.figures()).items():
+            staging.write(f"{stem}.png", lambda path: figure.savefig(path, dpi=110))
+        draw_tcp_path(meshcat, result.tcp)
+        staging.write("meshcat.html", lambda path: export_html(meshcat, path))
+        files = list(staging.files)
+        write_manifest(staging, files, scenario=scenario.name, drake_traj=__version__,
+                       failure=None if result.failure is None else result.failure.to_dict(),
+                       unchecked_collision_pairs=[list(pair) for pair in result.unchecked_collision_pairs],
+                       estimated_inertia_links=dict(result.estimated_inertia), locked_joints=dict(result.locked_joints))
+    return files, interrupts
+
+
+def _say_unchecked_pairs(robot) -> None:
+    """Say once, on stderr, the pairs of the arm's links the self and cell checks leave out and
+    why (:func:`~drake_traj.robots.self_contact`; none on the shipped arms)."""
+    pairs = self_contact(robot).rows()
+    if pairs:
+        tqdm.write("drake-traj: the checks leave out these pairs of the arm's links (metrics.json: "
+                   f"unchecked_collision_pairs): {'; '.join(f'{a} and {b}, {reason}' for a, b, reason in pairs)}",
+                   file=sys.stderr)
 
 
 def _run_folder(args, scenario) -> Path:
@@ -219,21 +223,6 @@ def serve_recording(url: str, seconds: float | None) -> None:
         pass
 
 
-def list_scenarios(args) -> int:
-    """``drake-traj list``: which copy of the shipped files runs (:func:`shipped_copy`), then the
-    shipped scenarios, a line each (name, robot, description), under the path of their file."""
-    entries = shipped_scenarios()
-    print(f"shipped scenarios, from {shipped_copy()}")
-    width = max(len(entry.name) for entry in entries)
-    robot_width = max(len(entry.robot) for entry in entries)
-    for path in dict.fromkeys(entry.path for entry in entries):
-        print(path)
-        for entry in entries:
-            if entry.path == path:
-                print(f"  {entry.name:{width}}  {entry.robot:{robot_width}}  {entry.description}")
-    return EXIT_OK
-
-
 ROBOT_COLUMNS = ("robot", "joints", "reach [m]", "payload [kg]", "rated speeds [rad/s | m/s]", "torque limits [N m | N]",
                  "data source")
 
@@ -266,21 +255,28 @@ def list_robots(args) -> int:
         if entry.robot not in ROBOT_NAMES:
             own.setdefault(entry.robot, (entry.path, []))[1].append(entry.name)
     for label, (path, names) in own.items():
-        print(f"  e.g. {label} in {path} ({', '.join(names)}; drake-traj show {names[0]})")
+        print(f"  e.g. {label} in {path.name} ({', '.join(names)}; drake-traj show {names[0]})")
     return EXIT_OK
 
 
 def show_scenario(args) -> int:
     """``drake-traj show``: the text of a scenario's file (a shipped one by its name), to copy
-    and edit; on stderr, its path and how to run the copy."""
+    and edit; on stderr, which file it is and how to run the copy. ``--where``: the file's path
+    instead (and, for a shipped file, which copy of the shipped files it is, on stderr)."""
     path, variant = _scenario_reference(args)
     variants = scenario_variants(path)
     if variant is not None and variant not in variants:
         load_scenario(path, variant)  # refuses it, naming the file's variants as ``run`` does
+    shipped = path.parent == shipped_directory()
+    if args.where:
+        print(path.resolve())
+        if shipped:
+            print(f"drake-traj: from {shipped_copy()}", file=sys.stderr)
+        return EXIT_OK
     print(path.read_text(), end="")
     option = f" --variant {variant or '|'.join(variants)}" if variants else ""
-    shipped = f", from {shipped_copy()}" if path.parent == shipped_directory() else ""
-    print(f"drake-traj: that is {path}{shipped}; run a copy with: drake-traj run my_copy.yaml{option}", file=sys.stderr)
+    which = f"the shipped file {path.name} (--where: its path)" if shipped else str(path)
+    print(f"drake-traj: that is {which}; run a copy with: drake-traj run my_copy.yaml{option}", file=sys.stderr)
     return EXIT_OK
 
 
@@ -314,13 +310,18 @@ def _exports() -> list[str]:
 
 def run_bench(args) -> int:
     """``drake-traj bench``; bad arguments, ``--out`` or ``--scheduler`` are refused before any run.
-    ``--suite free``: the free-motion suite (:func:`drake_traj.bench.free_bench`) instead."""
+    ``--suite free``: the free-motion suite (:func:`drake_traj.bench.free_bench`) instead. The
+    bench says its own progress (``--quiet``: none)."""
+    args.progress.close()
+    stream = None if args.quiet else sys.stderr
     if args.suite == "free":
         free_bench(args.out or "out/free", count=5 if args.count is None else args.count, seed=args.seed,
-                   workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite, command=args.command_line)
+                   workers=args.workers, scheduler=args.scheduler, progress=stream, overwrite=args.overwrite,
+                   command=args.command_line)
         return EXIT_OK
     bench(args.out or "out/bench", count=20 if args.count is None else args.count, seed=args.seed, repeats=args.repeats,
-          workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite, command=args.command_line)
+          workers=args.workers, scheduler=args.scheduler, progress=stream, overwrite=args.overwrite,
+          command=args.command_line)
     return EXIT_OK
 
 
@@ -374,6 +375,8 @@ def _run_options(parser) -> None:
 def _show_options(parser) -> None:
     parser.set_defaults(handler=show_scenario)
     _add_scenario_arguments(parser, "a shipped scenario's name", "show")
+    parser.add_argument("--where", action="store_true",
+                        help="print the file's path instead of its text (and which copy of the shipped files it is)")
 
 
 def _export_options(parser) -> None:
@@ -409,10 +412,10 @@ def _bench_options(parser) -> None:
                         help="run on the existing Dask cluster of this scheduler (e.g. tcp://host:8786)")
 
 
-# each command of drake_traj.cli.COMMANDS -> the function adding its options and handler to its parser
+# each command of drake_traj.cli.COMMANDS but list (drake_traj.cli.listing) -> the function adding its
+# options and handler to its parser
 OPTIONS = {
     "run": _run_options,
-    "list": lambda parser: parser.set_defaults(handler=list_scenarios),
     "robots": lambda parser: parser.set_defaults(handler=list_robots),
     "show": _show_options,
     "export": _export_options,
@@ -422,46 +425,20 @@ OPTIONS = {
 
 def execute(args) -> int:
     """Run the command ``args`` (parsed by :func:`drake_traj.cli.build_parser` with :data:`OPTIONS`,
-    with ``command_line`` set); returns the exit code. Bad input is one message on stderr (exit
-    2), a failed write or an internal error exit 1; ``--debug`` adds the traceback."""
-    for stream in (sys.stdout, sys.stderr):  # e.g. PYTHONIOENCODING=ascii: print "ą" as \u0105
-        with contextlib.suppress(AttributeError, ValueError):
-            stream.reconfigure(errors="backslashreplace")
-    on_main_thread = threading.current_thread() is threading.main_thread()
-    terminated = []  # SIGTERM (a job scheduler, kill) stops a run like Ctrl-C: its log is kept
-
-    def terminate(signum, frame):
-        terminated.append(signum)
-        raise KeyboardInterrupt
-
-    if on_main_thread:
-        previous_sigterm = signal.signal(signal.SIGTERM, terminate)
+    with ``command_line`` and ``progress`` set); returns the exit code. Bad input is one message
+    on stderr (exit 2), a failed write exit 1; ``--debug`` adds the traceback."""
     try:
         if args.command in ("run", "export", "bench"):
             working_folder()  # named when it was deleted, before Drake fails on it
         check_options(args)
-        code = args.handler(args)
-        return EXIT_TERMINATED if code == EXIT_INTERRUPTED and terminated else code
-    except KeyboardInterrupt:
-        print("drake-traj: terminated (SIGTERM)" if terminated else "drake-traj: interrupted", file=sys.stderr)
-        return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED
+        return args.handler(args)
     except WriteError as error:  # disk full, a permission lost, ...: the earlier content is intact
-        print(f"drake-traj: error: {error}", file=sys.stderr)
-        failure, code = error, EXIT_RUN_FAILED
+        failure, code, kind = error, EXIT_RUN_FAILED, "error"
     except (DrakeTrajError, ValueError) as error:  # bad input: one paragraph, no traceback
         kind = "the task cannot be done" if isinstance(error, PlanningError) else "error"
-        print(f"drake-traj: {kind}: {error}", file=sys.stderr)
         failure, code = error, EXIT_BAD_INPUT
-    except BrokenPipeError:  # stdout's reader stopped early (drake-traj list | head): nothing more to say
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # Python's last flush of stdout goes nowhere
-        return EXIT_OK
-    except Exception as error:  # a bug, or the machine (disk full, ...): still no traceback unless asked
-        print(f"drake-traj: internal error: {type(error).__name__}: {error} (--debug shows where)", file=sys.stderr)
-        failure, code = error, EXIT_RUN_FAILED
-    finally:
-        if on_main_thread:
-            signal.signal(signal.SIGTERM, previous_sigterm)
+    args.progress.close()  # before the message
+    print(f"drake-traj: {kind}: {failure}", file=sys.stderr)
     if args.debug:
         traceback.print_exception(failure)
     return code
-

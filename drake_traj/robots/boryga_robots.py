@@ -69,7 +69,7 @@ _SINGULAR_TOL = 1e-9
 class _PaperRobot(PointRobot):
     """Boryga's robots: three joints placing a point; adds the rates along a tool motion."""
 
-    data_source: ClassVar[str] = "Boryga, section 4 (dimensions); joint limits chosen here (the URDFs); docs/papers.md"
+    data_source: ClassVar[str] = "Boryga, section 4 (dimensions; the manual's papers page); joint limits chosen here (the URDFs)"
 
     # ---- rates -------------------------------------------------------------------------------
     def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:

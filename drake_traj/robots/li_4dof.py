@@ -100,7 +100,7 @@ class Li4Dof(PointRobot):
 
     name: ClassVar[str] = "li_4dof"
     model_file: ClassVar[str] = "li_4dof.urdf"
-    data_source: ClassVar[str] = "Li et al. 2019, Tables 3 and 5 (DH table, joint ranges and limits); docs/papers.md"
+    data_source: ClassVar[str] = "Li et al. 2019, Tables 3 and 5 (DH table, joint ranges and limits; the manual's papers page)"
     joint_names: ClassVar[tuple[str, ...]] = ("joint1", "joint2", "joint3", "joint4")
     joint_types: ClassVar[tuple[str, ...]] = ("revolute",) * 4
     base_frame: ClassVar[str] = "base"

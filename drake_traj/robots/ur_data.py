@@ -79,7 +79,7 @@ class URData:
     size: float
     base_mass: float = 4.0  # approximate (the ROS description flags it); the base is welded
     position_limit: tuple[float, ...] = (_FULL_TURN,) * NUM_JOINTS  # symmetric
-    data_source: str = "docs/ur_family.md (Universal Robots' DH table and data sheets, UR's ROS 2 description)"
+    data_source: str = "Universal Robots' DH table, data sheets and ROS 2 description (the manual's UR e-Series page)"
 
     @property
     def model(self) -> np.ndarray:
@@ -145,7 +145,7 @@ UR10E_DATA = URData(
     # docs/ur10e.md's rounded speeds and its 56 N m wrists (the ROS description: 54), kept as shipped
     velocity_limit=(2.094, 2.094, 3.1416, 3.1416, 3.1416, 3.1416), effort_limit=UR10E_EFFORT_LIMIT,
     rated_payload=12.5, reach=1.3, tube_offsets=(0.176, 0.039), size=1.0,
-    data_source="docs/ur10e.md (Universal Robots' DH and dynamics table, UR10e data sheet)")
+    data_source="Universal Robots' DH and dynamics table and UR10e data sheet (the manual's UR10e page)")
 
 UR16E_DATA = URData(
     name="ur16e", title="UR16e",

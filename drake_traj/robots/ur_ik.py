@@ -141,6 +141,7 @@ def branch_solutions(model, title: str, pose: np.ndarray, tol: float):
     shoulder_singular = h_abs < tol * reach
     psi = math.atan2(o5[1], o5[0])
     solutions, failures = {}, {}
+    unreached = []  # [m] the wrist-1 joint's distances from the shoulder joint that no elbow reaches
     elbow_singular = set()
     wrist_singular = set()
     for shoulder in (1, -1):
@@ -167,11 +168,9 @@ def branch_solutions(model, title: str, pose: np.ndarray, tol: float):
             dist = math.hypot(u, v)
             c3 = (dist * dist - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
             if abs(c3) > 1.0 + tol:
+                unreached.append(dist)
                 for elbow in (1, -1):
-                    failures[(shoulder, elbow, wrist)] = (
-                        f"the wrist-1 joint would be {dist:.6g} m from the shoulder joint, outside the "
-                        f"reach [{abs(abs(a2) - abs(a3)):.6g}, {reach:.6g}] m of the {title}'s upper arm and forearm"
-                    )
+                    failures[(shoulder, elbow, wrist)] = _beyond_the_elbow(f"{dist:.6g} m", a2, a3, title)
                 continue
             c3 = min(1.0, max(-1.0, c3))
             s3_abs = math.sqrt(1.0 - c3 * c3)
@@ -187,9 +186,17 @@ def branch_solutions(model, title: str, pose: np.ndarray, tol: float):
     if not solutions and not wrist_singular:
         centre = math.hypot(r, o5[2] - d1)
         max_centre = math.hypot(reach + d5, d4)
-        reasons = "; ".join(dict.fromkeys(failures.values()))
+        near, far = min(unreached), max(unreached)  # one per shoulder and wrist branch
+        distance = f"{near:.6g} m" if f"{near:.6g}" == f"{far:.6g}" else f"{near:.6g} to {far:.6g} m (by IK branch)"
         raise DrakeTrajError(
             f"{describe_pose(pose)} is out of reach: the wrist centre (flange - d6 z) is {centre:.6g} m "
-            f"from the shoulder point (0, 0, d1) (the {title} reaches at most {max_centre:.6g} m); {reasons}",
-            cause=Cause.UNREACHABLE)
+            f"from the shoulder point (0, 0, d1) (the {title} reaches at most {max_centre:.6g} m); "
+            f"{_beyond_the_elbow(distance, a2, a3, title)}", cause=Cause.UNREACHABLE)
     return solutions, failures, flags
+
+
+def _beyond_the_elbow(distance: str, a2: float, a3: float, title: str) -> str:
+    """Why no elbow angle exists: the wrist-1 joint ``distance`` (text with its unit) from the
+    shoulder joint, outside what the upper arm ``a2`` and forearm ``a3`` [m] span."""
+    return (f"the wrist-1 joint would be {distance} from the shoulder joint, outside the reach "
+            f"[{abs(abs(a2) - abs(a3)):.6g}, {abs(a2) + abs(a3):.6g}] m of the {title}'s upper arm and forearm")

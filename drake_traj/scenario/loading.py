@@ -8,7 +8,7 @@ from pathlib import Path
 
 from pydrake.common.yaml import yaml_load_typed
 
-from drake_traj.errors import DrakeTrajError
+from drake_traj.errors import DrakeTrajError, did_you_mean
 from drake_traj.scenario.scenario import Scenario, ScenarioSource
 from drake_traj.scenario.yaml_schema import ScenarioError, checked_document, locate
 
@@ -31,7 +31,8 @@ def read_scenario(path: Path, variant: str | None) -> Scenario:
             variant = next(iter(variants))
         if variant not in variants:
             asked = "no variant was given" if variant is None else f"there is no variant {variant!r}"
-            raise ScenarioError(f"{path}: {asked}; its variants are {list(variants)}")
+            hint = did_you_mean(variant, variants)
+            raise ScenarioError(f"{path}: {asked}; its variants are {list(variants)}{f'; {hint}' if hint else ''}")
         marks = check(variants[variant])
     elif variant is not None:
         raise ScenarioError(f"{path} holds one scenario, not variants; got variant {variant!r}")

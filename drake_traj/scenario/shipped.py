@@ -1,17 +1,16 @@
 """The scenarios shipped with the package (the files of ``diagrams/``) and finding a scenario by
 its file or its name: :func:`load_scenario` takes either, as ``drake-traj run`` does
-(:func:`find_scenario`, then the file read by :func:`~drake_traj.scenario.loading.read_scenario`);
-:func:`shipped_scenarios` lists every shipped scenario, :func:`shipped_copy` says which copy of
-the files runs."""
+(:func:`find_scenario`, then the file read by :func:`~drake_traj.scenario.loading.read_scenario`).
+The shipped scenarios' names, robots and descriptions come from :mod:`drake_traj.catalogue`
+(:func:`shipped_scenarios`, read without building anything), which also says which copy of the
+files runs (:func:`shipped_copy`)."""
 
-import functools
-from dataclasses import dataclass
 from pathlib import Path
 
-from drake_traj.data import data_directory
-from drake_traj.robots.custom import robot_label
+from drake_traj.catalogue import ShippedScenario, shipped_copy, shipped_directory, shipped_scenarios
+from drake_traj.errors import did_you_mean
 from drake_traj.validation import instance_of, path_argument
-from drake_traj.scenario.loading import read_scenario, scenario_variants
+from drake_traj.scenario.loading import read_scenario
 from drake_traj.scenario.scenario import Scenario
 from drake_traj.scenario.yaml_schema import ScenarioError
 
@@ -23,46 +22,9 @@ __all__ = [
 DEFAULT_SCENARIO = ("pajak.yaml", "sim3")  # what ``drake-traj run`` runs when given no scenario
 
 
-def shipped_directory() -> Path:
-    """The folder of the scenario files shipped with the package (``diagrams/``)."""
-    return data_directory("diagrams")
-
-
 def default_scenario_path() -> Path:
     """The scenario file ``drake-traj run`` uses when none is given (its variant: ``sim3``)."""
     return shipped_directory() / DEFAULT_SCENARIO[0]
-
-
-@dataclass(frozen=True)
-class ShippedScenario:
-    """A scenario shipped with the package: its name, file, variant (None for a file of one
-    scenario), one-line description and robot (:func:`~drake_traj.robots.custom.robot_label`)."""
-
-    name: str
-    path: Path
-    variant: str | None
-    description: str
-    robot: str
-
-
-def shipped_scenarios() -> list[ShippedScenario]:
-    """Every scenario of the shipped files, in file order. Read once per version of the files
-    (each file's modification time and size): a shipped name is looked up on every
-    :func:`load_scenario` by name, and loading every shipped scenario takes about 20 ms each."""
-    versions = tuple((path, path.stat().st_mtime_ns, path.stat().st_size)
-                     for path in sorted(shipped_directory().glob("*.yaml")))
-    return list(_shipped_entries(versions))
-
-
-@functools.lru_cache(maxsize=4)
-def _shipped_entries(versions: tuple[tuple[Path, int, int], ...]) -> tuple[ShippedScenario, ...]:
-    """The :class:`ShippedScenario` entries of the files ``versions`` ((path, mtime, size), in order)."""
-    entries = []
-    for path, _, _ in versions:
-        for variant in scenario_variants(path) or [None]:
-            scenario = load_scenario(path, variant)
-            entries.append(ShippedScenario(scenario.name, path, variant, scenario.description, robot_label(scenario.robot)))
-    return tuple(entries)
 
 
 def find_scenario(reference: str, variant: str | None = None) -> tuple[Path, str | None]:
@@ -99,9 +61,10 @@ def _find_scenario(path: Path, reference: str, variant: str | None) -> tuple[Pat
     stem = shipped_directory() / f"{reference}.yaml"
     if stem.is_file():
         return stem, variant
-    names = ", ".join(entry.name for entry in shipped)
-    raise ScenarioError(f"no scenario file {reference!r} and no shipped scenario of that name; "
-                     f"shipped: {names} (drake-traj list)")
+    known = dict.fromkeys([entry.name for entry in shipped] + [entry.path.stem for entry in shipped])  # names, then files
+    hint = did_you_mean(reference, known)
+    raise ScenarioError(f"no scenario file {reference!r} and no shipped scenario of that name; shipped: "
+                        f"{', '.join(entry.name for entry in shipped)} (drake-traj list){f'; {hint}' if hint else ''}")
 
 
 def _in_working_folder() -> str:
@@ -126,17 +89,6 @@ def _shipped_alternative(path: Path, variant: str | None) -> str:
     name = next((entry.name for entry in entries if (file.name, entry.variant) == DEFAULT_SCENARIO), entries[0].name)
     return (f"; the shipped file of that name holds {', '.join(entry.name for entry in entries)}: run one by its "
             f"name, e.g. `drake-traj run {name}` (Python: load_scenario({name!r}))")
-
-
-def shipped_copy() -> str:
-    """Which copy of the shipped scenario files runs, said by ``drake-traj list`` and ``show``: a
-    source tree's ``diagrams/`` (a checkout, an editable install), where an edit changes what
-    runs, or the installed package's, which a checkout's ``diagrams/`` does not change."""
-    directory = shipped_directory()
-    if (directory.parent / "pyproject.toml").is_file():
-        return f"this source tree's diagrams/ ({directory}; an edit there changes what runs)"
-    return (f"the installed package ({directory}; a checkout's diagrams/ is not read: copy a scenario with "
-            "drake-traj show NAME > my_task.yaml, edit the copy and run it by its path)")
 
 
 def _is_shipped_name(reference: str) -> bool:

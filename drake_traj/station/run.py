@@ -1,6 +1,7 @@
 """Advancing a simulator over a station (:mod:`drake_traj.station.loop`) until its planner has
 finished: the motion checked before it starts, watched while it runs, and contact reported by the
-plant turned into a failed run (:func:`run_station`, :func:`contact_failure`)."""
+plant turned into a failed run (:func:`run_station`, :func:`contact_failure`); Ctrl-C stops it
+with what it logged, and goes on up to the caller."""
 
 import numpy as np
 from pydrake.systems.analysis import Simulator
@@ -27,10 +28,14 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
     to anything, between logged samples included, it fails the run naming the bodies and the
     time (cause "collision"), as contact reported by the plant does.
 
-    Any exception from the simulation, and Ctrl-C (KeyboardInterrupt), is caught: the state and
-    logs stay as they were when it happened. ``progress(t)`` is called with the simulated time
-    every 10 ms of it. Returns None when the planner finished, else the :class:`Failure`
-    (cause "interrupted" for Ctrl-C).
+    Any exception from the simulation is caught: the state and logs stay as they were when it
+    happened, and the :class:`Failure` is returned. Ctrl-C (KeyboardInterrupt) stops the run the
+    same way, and the KeyboardInterrupt goes on to the caller (whose script stops, as on any
+    Ctrl-C, unless it catches it) with a ``failure`` attribute: the :class:`Failure` (cause
+    "interrupted", the simulated time); the station's loggers hold the log up to it
+    (``SimulationResult.from_station(station, context, failure=stop.failure)``).
+    ``progress(t)`` is called with the simulated time every 10 ms of it. Returns None when the
+    planner finished, else the :class:`Failure`.
 
     TypeError unless ``simulator`` is a ``Simulator`` and ``station`` a station Diagram in its
     diagram; ValueError for a ``max_duration`` outside (0, 600] s or a ``settle_time`` outside
@@ -73,8 +78,9 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
             return None
         return Failure(Cause.TIMEOUT, f"planner did not finish within max_duration = {max_duration} s", root.get_time(),
                        tuple(planner.reference_state(planner_context)[: planner.num_joints].tolist()))
-    except KeyboardInterrupt:
-        return Failure(Cause.INTERRUPTED, f"interrupted at t = {root.get_time():.4f} s", root.get_time())
+    except KeyboardInterrupt as stop:  # the caller stops too, told where the run stopped
+        stop.failure = Failure(Cause.INTERRUPTED, f"interrupted at t = {root.get_time():.4f} s", root.get_time())
+        raise
     except Exception as error:  # keep the log up to the failure; the reason goes in the result
         return Failure.from_exception(error, root.get_time())
 

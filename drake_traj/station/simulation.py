@@ -176,7 +176,8 @@ def station_simulator(planner: PlannerSystem, settings: RunSettings, *, meshcat:
 def run_recorded(simulator: Simulator, station: Diagram, settings: RunSettings, *, before_run,
                  progress) -> SimulationResult:
     """Initialize ``simulator``, call ``before_run(simulator)``, run the station
-    (:func:`run_station`; recorded in Meshcat where it has a visualizer) and return its result."""
+    (:func:`run_station`; recorded in Meshcat where it has a visualizer) and return its result.
+    Ctrl-C while it runs: the KeyboardInterrupt goes on, carrying the result so far (``result``)."""
     visualizer = station.GetSubsystemByName("visualizer") if station.HasSubsystemNamed("visualizer") else None
     if visualizer is not None:
         visualizer.StartRecording(True)  # and draw live
@@ -185,15 +186,25 @@ def run_recorded(simulator: Simulator, station: Diagram, settings: RunSettings, 
         before_run(simulator)
         simulator.ResetStatistics()  # the real-time rate counts from here, not from Initialize()
     start = time.perf_counter()
-    failure = run_station(simulator, station, settle_time=settings.settle_time, max_duration=settings.max_duration,
-                          progress=progress)
+    stopped = None
+    try:
+        failure = run_station(simulator, station, settle_time=settings.settle_time, max_duration=settings.max_duration,
+                              progress=progress)
+    except KeyboardInterrupt as interrupted:  # stopped while it ran: run_station says where (``failure``)
+        failure, stopped = interrupted.failure, interrupted
     wall_time = time.perf_counter() - start
     if visualizer is not None:
         visualizer.StopRecording()
         visualizer.PublishRecording()
-    return SimulationResult.from_station(station, station.GetMyContextFromRoot(simulator.get_context()),
-                                         name=settings.name, failure=failure, wall_time=wall_time,
-                                         tracking_tolerance=settings.tracking_tolerance)
+    result = SimulationResult.from_station(station, station.GetMyContextFromRoot(simulator.get_context()),
+                                           name=settings.name, failure=failure, wall_time=wall_time,
+                                           tracking_tolerance=settings.tracking_tolerance)
+    if stopped is not None:
+        stopped.result = result
+        stopped.add_note(f"{failure}: the run so far is this KeyboardInterrupt's .result (a failed run; "
+                         ".result.save(folder) keeps it)")
+        raise stopped
+    return result
 
 
 def simulate(planner: PlannerSystem | Scenario, *, meshcat: Meshcat | None = None, progress=None, add_systems=None,
@@ -212,9 +223,13 @@ def simulate(planner: PlannerSystem | Scenario, *, meshcat: Meshcat | None = Non
 
     The run stops at ``max_duration`` [s] (at most 600 s; the preflight looks as far ahead) if
     the planner has not finished; ``settle_time`` is at most 60 s. Whatever stops the run
-    early (an exception from a planner, a timeout, Ctrl-C) is caught: the result holds everything
-    logged up to that point and ``failure`` gives the reason. With ``meshcat``, the run is recorded
-    there (see :func:`drake_traj.station.meshcat.export_html`).
+    early (an exception from a planner, a timeout) is caught: the result holds everything logged
+    up to that point and ``failure`` gives the reason. Ctrl-C while it simulates stops the script
+    as any Ctrl-C does (the KeyboardInterrupt goes on), with the run so far kept in the
+    exception's ``result`` attribute: a failed run, ``failure.cause`` "interrupted" (``except
+    KeyboardInterrupt as stop: partial = getattr(stop, "result", None)``; None where Ctrl-C came
+    before the motion). With
+    ``meshcat``, the run is recorded there (see :func:`drake_traj.station.meshcat.export_html`).
 
     Args (the rest as :func:`~drake_traj.station.add_station`):
         progress: called with the simulated time [s] as the run goes (see :func:`run_station`).

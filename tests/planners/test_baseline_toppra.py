@@ -172,8 +172,8 @@ def test_planner_runs_in_the_closed_loop():
     assert result.succeeded, result.failure
     assert result.duration == pytest.approx(duration, abs=0.02)
     metrics = result.metrics()
-    assert metrics.max_velocity_over_limit <= 1.01
-    assert metrics.max_acceleration_over_limit <= 1.05
+    assert metrics.peak_velocity_fraction <= 1.01
+    assert metrics.peak_acceleration_fraction <= 1.05
     np.testing.assert_allclose(result.q_ref[-1], trajectory.value(trajectory.end_time()).ravel(), atol=1e-5)
 
 

@@ -141,7 +141,7 @@ def test_a_users_loop_runs_within_the_limits_and_ends_at_e():
     result = simulate(make_planner_from_config(config, UR10E, UR10E.home_configuration), settle_time=0.1)
     assert result.succeeded, result.failure
     metrics = result.metrics()
-    assert metrics.max_acceleration_over_limit <= 1 + 1e-9 and metrics.max_velocity_over_limit <= 1 + 1e-9
+    assert metrics.peak_acceleration_fraction <= 1 + 1e-9 and metrics.peak_velocity_fraction <= 1 + 1e-9
     np.testing.assert_allclose(result.tcp[-1, :3], config.E, atol=1e-6)
 
 

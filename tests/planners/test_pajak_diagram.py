@@ -63,7 +63,7 @@ def test_sim3_closed_loop_tracking_and_torques(sim3):
     # Measured: 3.6e-5 rad and 2.8e-5 m; peak torque 0.28 of the effort limit (elbow).
     assert metrics.tracking_error_joint_max_rad < 1e-4
     assert metrics.tracking_error_tcp_max_m < 1e-4
-    assert max(metrics.peak_torque_over_limit) < 1.0
+    assert max(metrics.peak_torque_fraction) < 1.0
 
 
 def test_sim3_acceleration_is_continuous_in_the_diagram():

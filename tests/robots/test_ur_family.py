@@ -150,7 +150,7 @@ def test_each_arm_has_its_own_published_numbers():
     assert ARMS["ur5e"].effort_limits.tolist() == [150, 150, 150, 28, 28, 28]
     assert ARMS["ur3e"].velocity_limits[3:].tolist() == [2 * np.pi] * 3  # 360 deg/s wrists
     for arm in UR_ARMS:
-        assert "docs/ur" in arm.data_source
+        assert arm.data_source.startswith("Universal Robots'") and "the manual's UR" in arm.data_source
         speed, acceleration = arm.joint_move_limits
         assert np.array_equal(speed, np.minimum(1.05, arm.velocity_limits)) and np.all(acceleration == 1.40)
         assert np.array_equal(arm.task_kinematics().model, [0.0, arm.data.d[0], arm.data.a[1], arm.data.a[2],
