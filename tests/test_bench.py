@@ -161,7 +161,7 @@ class Terminal(io.StringIO):
 
 def test_progress_without_a_terminal_is_a_line_at_a_time(monkeypatch):
     # a log or CI: no bar redrawn in place; a first line, then the runs done, failed and time left
-    monkeypatch.setattr(engine, "LOG_INTERVAL", 0.0)  # a line after every run (30 s apart as shipped)
+    monkeypatch.setattr(engine, "LOG_INTERVAL", 0.0)  # a line after every run (8 s apart as shipped)
     stream = io.StringIO()
     progress = engine._Progress(4, stream, "in this process, one after another")
     progress.done({"succeeded": True})

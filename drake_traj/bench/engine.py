@@ -34,7 +34,7 @@ from drake_traj.errors import DrakeTrajError
 
 __all__ = ["BenchSetupError"]
 
-LOG_INTERVAL = 30.0  # [s] at most between progress lines where the progress is not a terminal
+LOG_INTERVAL = 8.0  # [s] where the progress is not a terminal: a line at the first run to end this long after the last line
 SCHEDULER_TIMEOUT = 10.0  # [s] a --scheduler address answers as a Dask scheduler within this, or is refused
 
 
@@ -93,7 +93,8 @@ def _collect(runs: dict, bar, row_of, failed) -> dict:
 
 class _Progress:
     """Runs done, failed and the time left: a tqdm bar on a terminal; on another stream (a log
-    file, CI) a line at most every :data:`LOG_INTERVAL`; nothing when the stream is None. A first
+    file, CI) a line at the first run to end :data:`LOG_INTERVAL` after the last line (a run
+    takes seconds: a log is never silent much longer); nothing when the stream is None. A first
     line says how many runs there are and where they run."""
 
     def __init__(self, total: int, stream, where: str):

@@ -93,8 +93,8 @@ def bench(out_dir, *, count: int = 20, seed: int = 0, repeats: int = 5, workers:
             can import. A build or planner that raises gives failed rows.
         progress: stream of the progress (stderr by default; None: none): a first line with the
             number of runs and where they run, then on a terminal a bar with the runs done, failed
-            and the time left, elsewhere (a log, CI) a line of the same at most every
-            :data:`~drake_traj.bench.engine.LOG_INTERVAL` (30 s) and at the end. ``print``s
+            and the time left, elsewhere (a log, CI) a line of the same once
+            :data:`~drake_traj.bench.engine.LOG_INTERVAL` (8 s) have passed, as a run ends, and at the end. ``print``s
             bench.md's tables and a last line naming the files written.
         overwrite: replace an earlier bench in ``out_dir``.
         command: names this process to another writer of ``out_dir`` (default its command line).
