@@ -123,9 +123,8 @@ def _cache_folder() -> Path:
     folder = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "drake_traj" / "meshes"
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        probe = folder / ".write_test"
-        probe.write_text("")
-        probe.unlink()
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".write_test_"):  # a name of its own: processes share the folder
+            pass
         return folder
     except OSError:
         return Path(tempfile.mkdtemp(prefix="drake_traj_meshes_"))
