@@ -24,6 +24,7 @@ import numpy as np
 
 from drake_traj.cell.cell import Cell
 from drake_traj.cell.clearance import CellChecker
+from drake_traj.cell.reach import TRAVEL_MARGIN
 from drake_traj.errors import Cause, Failure, PlanningError
 from drake_traj.robots import Robot
 
@@ -112,8 +113,8 @@ class ClearanceWatch:
     Fed the measured joint positions q_k the station logs at t_k (every plant step at the
     default log period), it bounds the distance between every two bodies along the whole
     measured motion, between samples included. Over a span of samples no point of the arm moves
-    more than δ = 1.1 Σ_k Σ_j R_j |Δq_j,k| (R_j the cell check's joint reach bounds, the margin
-    its own), so two bodies come at most 2δ closer. SceneGraph's signed distances are queried at
+    more than δ = 1.1 Σ_k Σ_j R_j |Δq_j,k| (R_j the cell check's joint reach bounds, 1.1 its
+    TRAVEL_MARGIN), so two bodies come at most 2δ closer. SceneGraph's signed distances are queried at
     the span's ends out to limit + 2δ: a pair found at neither end stays beyond the limit inside,
     and a pair found at one end (d0, d1, the query's radius where it was not found) is no closer
     than (d0 + d1 - 2δ) / 2; where that does not decide, the span is halved at its middle sample
@@ -132,7 +133,7 @@ class ClearanceWatch:
     def __init__(self, checker: CellChecker, logger, root_context, num_joints: int, *, checked: bool = True):
         self.checker = checker
         self.limit = 0.5 * checker.clearance  # [m]
-        self._travel = 2.2 * checker.reach  # [m/rad] two bodies' relative travel per |Δq|, 1.1 margin
+        self._travel = 2 * TRAVEL_MARGIN * checker.reach  # [m/rad] two bodies' relative travel per |Δq|
         self._log = logger.FindLog(root_context)
         self._n = num_joints
         self._last = None  # (index, (t, q, {pair: distance}, radius)) of the last queried sample
