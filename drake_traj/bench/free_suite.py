@@ -55,11 +55,11 @@ class ClearanceProbe:
     ``ComputeSignedDistancePairwiseClosestPoints`` directly. Joint positions in rad, world = base frame."""
 
     def __init__(self, robot, cell):
-        self._checker = CellChecker(robot, cell)
+        self.checker = CellChecker(robot, cell)  # its plant and SceneGraph, asked directly
 
     def distance(self, q, within: float = WITHIN) -> float:
         """The least distance at ``q``; ``within`` [m] where every pair is further apart."""
-        pairs = self._checker.pose_query(q).ComputeSignedDistancePairwiseClosestPoints(within)
+        pairs = self.checker.pose_query(q).ComputeSignedDistancePairwiseClosestPoints(within)
         return min((pair.distance for pair in pairs), default=within)
 
     def along(self, configurations, within: float = WITHIN) -> float:

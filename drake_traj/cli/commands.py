@@ -19,7 +19,7 @@ from tqdm import tqdm
 from drake_traj.version import __version__
 from drake_traj.cli.exit_codes import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK, EXIT_RUN_FAILED, EXIT_TERMINATED
 from drake_traj.cli.signals import signals_held
-from drake_traj.bench import bench, free_bench
+from drake_traj.bench import SOAK_ARMS, SOAK_PLANNERS, bench, free_bench, merge_soaks, soak_bench
 from drake_traj.cell import CollisionError, refusal_figure
 from drake_traj.errors import DrakeTrajError, Failure, PlanningError
 from drake_traj.results.exports import FORMATS, UR_CYCLE, ExportError
@@ -319,10 +319,30 @@ def run_bench(args) -> int:
                    workers=args.workers, scheduler=args.scheduler, progress=stream, overwrite=args.overwrite,
                    command=args.command_line)
         return EXIT_OK
+    if args.suite == "soak":
+        return _soak(args, stream)
     bench(args.out or "out/bench", count=20 if args.count is None else args.count, seed=args.seed, repeats=args.repeats,
           workers=args.workers, scheduler=args.scheduler, progress=stream, overwrite=args.overwrite,
           command=args.command_line)
     return EXIT_OK
+
+
+def _soak(args, stream) -> int:
+    """``drake-traj bench --suite soak`` (or ``--merge`` of its parts); exit 1 where any task went
+    wrong, the first ten named with the command that reruns each."""
+    if args.merge:
+        rows = merge_soaks(args.out or "out/soak", args.merge, progress=stream, overwrite=args.overwrite,
+                           command=args.command_line)
+    else:
+        rows = soak_bench(args.out or "out/soak", count=10 if args.count is None else args.count, seed=args.seed,
+                          arms=args.arms or SOAK_ARMS, planners=args.planners or SOAK_PLANNERS,
+                          workers=args.workers, scheduler=args.scheduler, progress=stream, overwrite=args.overwrite,
+                          command=args.command_line)
+    wrong = [row for row in rows if row["wrong"]]
+    for row in wrong[:10]:
+        print(f"wrong: {row['arm']} {row['planner']} seed {row['seed']}: {row['message'][:200]}\n  rerun: {row['rerun']}",
+              file=sys.stderr)
+    return EXIT_RUN_FAILED if wrong else EXIT_OK
 
 
 def check_options(args) -> None:
@@ -341,6 +361,11 @@ def check_options(args) -> None:
                                                   ("--serve-after", args.serve_after is not None)) if given]
         if live_only and not args.meshcat:
             raise DrakeTrajError(f"{live_only[0]} sets up the live view; add --meshcat (or leave {live_only[0]} out)")
+    if args.command == "bench" and args.suite != "soak":
+        soak_only = [option for option, value in (("--arms", args.arms), ("--planners", args.planners),
+                                                  ("--merge", args.merge)) if value is not None]
+        if soak_only:
+            raise DrakeTrajError(f"{soak_only[0]} applies to --suite soak only (this is --suite {args.suite})")
     for option, ok, value, expected in checks:
         if not ok:
             raise DrakeTrajError(f"{option} must be {expected}, got {value}")
@@ -396,20 +421,28 @@ def _export_options(parser) -> None:
 
 def _bench_options(parser) -> None:
     parser.set_defaults(handler=run_bench)
-    parser.add_argument("--suite", choices=("planners", "free"), default="planners",
+    parser.add_argument("--suite", choices=("planners", "free", "soak"), default="planners",
                         help="planners: every planner and baseline on UR10e tasks (default); free: the free-motion "
-                             "planner on seeded scenes of every kind")
-    parser.add_argument("--out", default=None, help="output directory (default: out/bench; --suite free: out/free)")
+                             "planner on seeded scenes of every kind; soak: seeded random tasks for every planner on "
+                             "every shipped arm, each plan checked independently (exit 1 on any wrong result)")
+    parser.add_argument("--out", default=None,
+                        help="output directory (default: out/bench; --suite free: out/free; --suite soak: out/soak)")
     parser.add_argument("--overwrite", action="store_true", help="replace an earlier bench in the output directory")
     parser.add_argument("--count", type=int, default=None,
                         help="seeded random tasks besides the paper's (default 20); --suite free: queries per scene "
-                             "kind (default 5)")
+                             "kind (default 5); --suite soak: tasks per arm and planner (default 10)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--repeats", type=int, default=5, help="planning-time repeats on the paper task (--suite planners)")
     parser.add_argument("--workers", type=int, default=None,
                         help="processes of the local Dask cluster (default: one per core; 1: no Dask, in order)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
                         help="run on the existing Dask cluster of this scheduler (e.g. tcp://host:8786)")
+    parser.add_argument("--arms", nargs="+", default=None, metavar="ARM",
+                        help=f"--suite soak: the arms (default all: {' '.join(SOAK_ARMS)})")
+    parser.add_argument("--planners", nargs="+", default=None, metavar="PLANNER",
+                        help=f"--suite soak: the planners (default all: {' '.join(SOAK_PLANNERS)})")
+    parser.add_argument("--merge", nargs="+", default=None, metavar="DIR",
+                        help="--suite soak: write one report (into --out) of soaks run in parts into these folders")
 
 
 # each command of drake_traj.cli.COMMANDS but list (drake_traj.cli.listing) -> the function adding its
