@@ -15,7 +15,7 @@ from drake_traj import MovejConfig, RetimedPajakConfig, RuckigConfig, SmoothWayp
 from drake_traj.scenario import preflight
 
 JOINT_SPACE = {
-    "movej": lambda goals: MovejConfig(goals=goals),  # (its blends exceed the acceleration limit, as UR's do: README)
+    "movej": lambda goals: MovejConfig(goals=goals),  # (no blends: blend_radius 0)
     "ruckig": lambda goals: RuckigConfig(goals=goals),
     "toppra": lambda goals: ToppraConfig(path=goals, grid_points=1000),
     "smooth_waypoints": lambda goals: SmoothWaypointsConfig(goals=goals),

@@ -2,7 +2,8 @@
 UR10e, with the UR joint-move limits (1.05 rad/s, 1.40 rad/s^2), gives one row of the table.
 
 - ``pajak_blend`` / ``pajak_stop``: Pająk 2024's planner, passing or stopping at the waypoints;
-- ``movej_blend``: UR-style joint moves with a 0.05 m blend radius;
+- ``movej_blend``: UR-style joint moves with a 0.05 m blend radius, blends superposed at the limits
+  as Pająk 2024 measured on the controller (``keep_limits=False``: they exceed the acceleration limit);
 - ``quintic_stop``: synchronised quintic moves (Benotsmane et al.) through the IK of the waypoints;
 - ``ruckig_stop``: Ruckig's jerk-limited moves through the same joint waypoints;
 - ``smooth_waypoints``: the smooth path through the same joint waypoints, timed jerk-limited and
@@ -71,7 +72,7 @@ def pajak_stop_config(poses, joints):
 
 
 def movej_blend_config(poses, joints):
-    return MovejConfig(goals=joints[1:].tolist(), blend_radius=BLEND_RADIUS)
+    return MovejConfig(goals=joints[1:].tolist(), blend_radius=BLEND_RADIUS, keep_limits=False)  # the paper's flaw
 
 
 def quintic_stop_config(poses, joints):

@@ -1,16 +1,23 @@
 """UR-style MoveJ baseline with radius blending (Pająk 2024, experiment 1)."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from pydrake.systems.analysis import Simulator
 
+from drake_traj.robots import UR10E
 from drake_traj.robots import ur10e as robot
+from drake_traj.bench.soak_tasks import draw_task
 from drake_traj.bench.task_sets import joint_waypoints, paper_task
 from drake_traj.planners.baselines.movej import (
     MovejBlendLaw,
+    MovejConfig,
     MovejPlanner,
+    make,
     trapezoid_profile,
 )
+from drake_traj.scenario.scenario import make_planner
 
 V_LIMIT = robot.DEFAULT_JOINT_MOVE_VELOCITY  # 1.05 rad/s
 A_LIMIT = robot.DEFAULT_JOINT_MOVE_ACCELERATION  # 1.40 rad/s^2
@@ -31,6 +38,12 @@ def stop_law(waypoints):
 @pytest.fixture(scope="module")
 def blend_law(waypoints):
     return MovejBlendLaw(waypoints, V_LIMIT, A_LIMIT, PAPER_BLEND_RADIUS)
+
+
+@pytest.fixture(scope="module")
+def paper_law(waypoints):
+    """The blends as Pająk 2024 measured them on the controller: superposed at the limits."""
+    return MovejBlendLaw(waypoints, V_LIMIT, A_LIMIT, PAPER_BLEND_RADIUS, keep_limits=False)
 
 
 def dense(law, num=20001):
@@ -87,10 +100,10 @@ def test_limits_hold_without_blends(stop_law):
     assert np.max(np.abs(qdd)) <= A_LIMIT * (1 + 1e-12)
 
 
-def test_blends_exceed_the_acceleration_limit(blend_law, stop_law, capsys):
-    """The baseline's known flaw: superposed segments exceed 1.40 rad/s^2 in the blends."""
-    t, q, qd, qdd = dense(blend_law, 40001)
-    intervals = blend_law.blend_intervals()
+def test_paper_blends_exceed_the_acceleration_limit(paper_law, blend_law, stop_law, capsys):
+    """The controller's flaw (keep_limits=False): superposed segments exceed 1.40 rad/s^2 in the blends."""
+    t, q, qd, qdd = dense(paper_law, 40001)
+    intervals = paper_law.blend_intervals()
     assert np.all(intervals[:, 1] > intervals[:, 0])
     in_blend = np.zeros_like(t, dtype=bool)
     for a, b in intervals:
@@ -99,31 +112,46 @@ def test_blends_exceed_the_acceleration_limit(blend_law, stop_law, capsys):
     peak_outside = np.max(np.abs(qdd[~in_blend]))
     with capsys.disabled():
         print(
-            f"\nMoveJ paper task: T = {stop_law.duration:.3f} s without blends, {blend_law.duration:.3f} s with "
+            f"\nMoveJ paper task: T = {stop_law.duration:.3f} s without blends, {paper_law.duration:.3f} s with "
             f"r = {PAPER_BLEND_RADIUS} m; peak |qdd| in blends {peak_blend:.3f} rad/s^2 (limit {A_LIMIT}, "
-            f"paper measured {PAPER_BLEND_ACCELERATION}); outside {peak_outside:.3f}; peak |qd| {np.abs(qd).max():.3f}"
+            f"paper measured {PAPER_BLEND_ACCELERATION}); outside {peak_outside:.3f}; peak |qd| {np.abs(qd).max():.3f}; "
+            f"keeping the limits T = {blend_law.duration:.3f} s"
         )
     assert peak_blend > A_LIMIT * 1.1
     assert peak_outside <= A_LIMIT * (1 + 1e-12)
-    assert blend_law.duration < stop_law.duration
+    assert paper_law.duration < blend_law.duration < stop_law.duration
+    np.testing.assert_array_equal(paper_law.blend_slowdowns, 1.0)
 
 
-def test_blend_starts_inside_the_sphere(blend_law):
+def test_kept_limits_on_the_paper_task(blend_law):
+    """keep_limits (the default): the same blends within both limits, slowed where a joint reverses."""
+    _, _, qd, qdd = dense(blend_law, 40001)
+    assert np.max(np.abs(qd)) <= V_LIMIT * (1 + 1e-12)
+    assert np.max(np.abs(qdd)) <= A_LIMIT * (1 + 1e-12)
+    assert np.all(blend_law.blend_overlaps > 0.0)  # still blends
+    assert np.min(blend_law.blend_slowdowns) < 1.0
+
+
+@pytest.mark.parametrize("law_name", ["blend_law", "paper_law"])
+def test_blend_starts_inside_the_sphere(law_name, request):
     """Each overlap lies where the TCP is within r of its waypoint (on both segments)."""
-    points = blend_law.tcp_positions()
-    for k, (a, b) in enumerate(blend_law.blend_intervals(), start=1):
+    law = request.getfixturevalue(law_name)
+    points = law.tcp_positions()
+    for k, (a, b) in enumerate(law.blend_intervals(), start=1):
         for t in np.linspace(a, b, 11):
-            q, _, _ = blend_law.sample(t)
+            q, _, _ = law.sample(t)
             assert np.linalg.norm(robot.flange_pose(q)[:3, 3] - points[k]) <= PAPER_BLEND_RADIUS + 1e-9
-    # one of the two sphere crossings bounds each overlap exactly
-    for k, (a, b) in enumerate(blend_law.blend_intervals(), start=1):
-        d = [np.linalg.norm(robot.flange_pose(blend_law.sample(t)[0])[:3, 3] - points[k]) for t in (a, b)]
-        assert max(d) == pytest.approx(PAPER_BLEND_RADIUS, abs=1e-9)
+    # one of the two sphere crossings bounds each overlap exactly (unless the ramps shrank it)
+    ramps = np.minimum(law.segment_brakes[:-1], law.segment_ramps[1:])
+    for k, (a, b) in enumerate(law.blend_intervals(), start=1):
+        d = [np.linalg.norm(robot.flange_pose(law.sample(t)[0])[:3, 3] - points[k]) for t in (a, b)]
+        if b - a < ramps[k - 1]:
+            assert max(d) == pytest.approx(PAPER_BLEND_RADIUS, abs=1e-9)
 
 
-@pytest.mark.parametrize("radius", [0.0, PAPER_BLEND_RADIUS])
-def test_position_continuity_and_consistency(radius, waypoints):
-    law = MovejBlendLaw(waypoints, V_LIMIT, A_LIMIT, radius)
+@pytest.mark.parametrize("radius, keep_limits", [(0.0, True), (PAPER_BLEND_RADIUS, True), (PAPER_BLEND_RADIUS, False)])
+def test_position_continuity_and_consistency(radius, keep_limits, waypoints):
+    law = MovejBlendLaw(waypoints, V_LIMIT, A_LIMIT, radius, keep_limits=keep_limits)
     t, q, qd, qdd = dense(law, 40001)
     dt = t[1] - t[0]
     # C^1: position steps bounded by the velocity, velocity steps by the acceleration.
@@ -175,6 +203,7 @@ def test_duplicate_waypoints_are_dropped(waypoints):
         (dict(blend_radius=-0.01), "blend_radius"),
         (dict(blend_radius=np.nan), "blend_radius"),
         (dict(blend_radius=1.0), "blend_radius"),  # blend spheres would overlap
+        (dict(keep_limits="no"), "keep_limits"),
     ],
 )
 def test_validation_names_the_argument(waypoints, kwargs, name):
@@ -187,3 +216,87 @@ def test_validation_names_the_argument(waypoints, kwargs, name):
 def test_planner_rejects_other_laws():
     with pytest.raises(TypeError, match="law must be a MovejBlendLaw"):
         MovejPlanner(object())
+
+
+# --- the limits in the blends (keep_limits) ------------------------------------------------------
+
+def plan_peaks(plan, velocity_limit, acceleration_limit, step=1e-4):
+    """(peak |q̇| / limit, peak |q̈| / limit) of Drake's ``plan`` at ``step`` [s] samples."""
+    t = np.append(np.arange(plan.start_time(), plan.end_time(), step), plan.end_time())
+    qd = plan.MakeDerivative(1).vector_values(t)
+    qdd = plan.MakeDerivative(2).vector_values(t)
+    return (float(np.max(np.abs(qd) / np.reshape(velocity_limit, (-1, 1)))),
+            float(np.max(np.abs(qdd) / np.reshape(acceleration_limit, (-1, 1)))))
+
+
+# Soak tasks whose blends broke a limit (paper peak |q̈| / limit, or |q̇| for 28) and one that did not (23).
+SOAK_SEEDS = {1: 1.46, 2: 1.65, 5: 1.31, 7: 1.98, 8: 1.51, 20: 1.59, 26: 1.95, 28: 1.0, 23: 1.0}
+
+
+@pytest.mark.parametrize("seed", sorted(SOAK_SEEDS))
+def test_soak_tasks_keep_both_limits(seed):
+    task = draw_task("ur10e", "movej", seed)
+    assert task.scenario.planner.blend_radius > 0.0
+    planner = make_planner(task.scenario)
+    velocity, acceleration = plan_peaks(planner.plan(), planner.velocity_limit, planner.acceleration_limit)
+    assert velocity <= 1 + 1e-6
+    assert acceleration <= 1 + 1e-6
+    # the same task with the controller's superposed blends: the violation the soak found
+    paper = make_planner(replace(task.scenario, planner=replace(task.scenario.planner, keep_limits=False)))
+    paper_velocity, paper_acceleration = plan_peaks(paper.plan(), paper.velocity_limit, paper.acceleration_limit)
+    assert paper_acceleration == pytest.approx(max(SOAK_SEEDS[seed], 1.0), abs=0.01)
+    assert paper.law.duration <= planner.law.duration + 1e-12
+    if seed == 28:
+        assert paper_velocity > 1.02  # the overlap ran past the ramps: a cruise plus a start
+
+
+def unit_tcp(q):
+    """The first three joint positions as a position [m]: a hand-made TCP for a 3-joint law."""
+    return np.asarray(q, dtype=float)[:3]
+
+
+def test_reversing_joint_blend_is_slowed_to_its_limit():
+    """Joint 0 reverses at the waypoint: paper ramps add to 2 a; keep_limits halves both (lambda = 1/2)."""
+    waypoints = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+    v, a, r = 0.5, 1.0, 0.2
+    paper = MovejBlendLaw(waypoints, v, a, r, tcp_position=unit_tcp, keep_limits=False)
+    kept = MovejBlendLaw(waypoints, v, a, r, tcp_position=unit_tcp)
+    np.testing.assert_allclose(kept.blend_slowdowns, [0.5])
+    for law, peak in ((paper, 2.0 * a), (kept, a)):
+        t = np.linspace(0.0, law.duration, 200001)
+        _, qd, qdd = law.sample(t)
+        assert np.max(np.abs(qdd)) == pytest.approx(peak, rel=1e-12)
+        assert np.max(np.abs(qd)) <= v * (1 + 1e-12)
+    # by hand: each segment 1 rad (leading joint) at 0.5 rad/s, its ramp next to the waypoint at
+    # 0.5 rad/s^2: T = 1/0.5 + 0.5 * 0.5 * (1/1 + 1/0.5) = 2.75 s; the TCP is r from the waypoint
+    # where 1 - s = r on the braking ramp, 0.25 u^2 = r, and where sqrt(2) s = r on the next one
+    overlap = min(np.sqrt(4.0 * r), np.sqrt(4.0 * r / np.sqrt(2.0)))
+    assert overlap < 1.0  # within both ramps (0.5 / 0.5 = 1 s long)
+    assert kept.duration == pytest.approx(2 * 2.75 - overlap, rel=1e-9)
+
+
+def test_blend_longer_than_the_ramps_is_shrunk():
+    """Straight on through the waypoint: the sphere's overlap (cruise plus start) would move at twice
+    the speed; keep_limits shrinks it to the ramps, which then hand over at the cruise speed."""
+    waypoints = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
+    v, a, r = 0.5, 1.0, 0.4
+    paper = MovejBlendLaw(waypoints, v, a, r, tcp_position=unit_tcp, keep_limits=False)
+    kept = MovejBlendLaw(waypoints, v, a, r, tcp_position=unit_tcp)
+    np.testing.assert_allclose(kept.blend_slowdowns, [1.0])  # the ramps cancel: no slowing
+    np.testing.assert_allclose(kept.blend_overlaps, [v / a], rtol=1e-12)  # 0.5 s, both ramps
+    assert paper.blend_overlaps[0] > v / a
+    t = np.linspace(0.0, kept.duration, 100001)
+    _, qd, qdd = kept.sample(t)
+    assert np.max(np.abs(qd)) == pytest.approx(v, rel=1e-12)
+    assert np.max(np.abs(qdd)) == pytest.approx(a, rel=1e-12)
+    assert kept.duration == pytest.approx(2.0 / v + v / a, rel=1e-12)  # 2 rad at 0.5 rad/s, one start, one stop
+    _, paper_qd, _ = paper.sample(np.linspace(0.0, paper.duration, 100001))
+    assert np.max(np.abs(paper_qd)) > 1.5 * v
+
+
+def test_config_passes_keep_limits_and_checks_it(waypoints):
+    for keep in (True, False):
+        config = MovejConfig(goals=waypoints[1:].tolist(), blend_radius=PAPER_BLEND_RADIUS, keep_limits=keep)
+        assert make(config, UR10E, waypoints[0]).law.keep_limits is keep
+    with pytest.raises(ValueError, match="keep_limits"):
+        MovejConfig(goals=waypoints[1:].tolist(), keep_limits="yes").validate()

@@ -26,11 +26,26 @@ UR's own description of MoveJ and of blending:
    starts at t_k = t_{k-1} + T_{k-1} - delta_k.
 3. Superposition. Over the whole motion q(t) = q_0 + sum_k s_k(t - t_k) D_k (each s_k held at 0
    before and at 1 after its segment), so in an overlap the joint velocities and accelerations of
-   the two segments add. The leaving segment decelerates at the limit while the next accelerates
-   at the limit; where a joint reverses direction the two add to up to twice the limit. That is
-   the flaw the paper measured: the joint-space blend exceeds the acceleration (and may exceed the
-   velocity) limit. Position stays C^1 and the blended TCP path stays near the waypoint but does
-   not pass through it.
+   the two segments add. Position stays C^1 and the blended TCP path stays near the waypoint but
+   does not pass through it.
+4. Limits in the blends (``keep_limits``, default True). In an overlap that lies within segment
+   k-1's braking ramp and segment k's starting ramp, q̈ = -A_out,k-1 D_k-1 + A_in,k D_k is constant
+   and q̇ is linear between two instants where only one segment moves, so both limits hold there
+   if |-A_out,k-1 D_k-1,j + A_in,k D_k,j| <= a_j for every joint j. Where a joint reverses, the two
+   ramps at the limit add to up to 2 a_j, so both ramps of blend k are SLOWED by the factor
+   lambda_k = min(1, min_j a_j / |-A_k-1 D_k-1,j + A_k D_k,j|) (A: step 1's rates); each segment's
+   trapezoid then has a starting and a braking rate of its own (the rest of the segment is as in
+   step 1). The overlap is SHRUNK to at most both ramps (delta_k <= min(braking ramp of k-1,
+   starting ramp of k)) when the sphere would make it longer. So the velocity and acceleration
+   limits hold at every instant; the blend keeps its radius where it fits the ramps and the motion
+   takes longer only where a blend reverses a joint. Overlaps of consecutive waypoints still never
+   meet (one lies in a segment's starting ramp, the next in its braking ramp).
+
+   ``keep_limits=False`` is the controller Pająk 2024 measured: the ramps at the limits superpose
+   as they are, the leaving segment braking at the limit while the next accelerates at it; where a
+   joint reverses direction the two add to up to twice the limit. That is the paper's flaw: the
+   joint-space blend exceeds the acceleration (and may exceed the velocity) limit; the bench's
+   ``movej_blend`` runs this way to reproduce experiment 1.
 
 The TCP does not move along a straight line (this is a joint move), and the real controller's
 blend shape, its handling of the speed in the blend and its radius reduction are not modelled.
@@ -49,7 +64,7 @@ import numpy as np
 from drake_traj.planners.base import (TimeLawPlanner, joint_goals, joint_move_limits, planner_robot, start_and_goals,
                                      waypoint_rows)
 from drake_traj.robots import UR10E, Robot
-from drake_traj.validation import instance_of, invalid, positive_vector
+from drake_traj.validation import flag, instance_of, invalid, positive_vector
 
 __all__ = ["MovejBlendLaw", "MovejConfig", "MovejPlanner", "blend_radius_value", "make", "trapezoid_profile"]
 
@@ -57,35 +72,50 @@ _SAMPLES_PER_SEGMENT = 200  # FK samples for locating the sphere crossings (then
 _BISECTION_STEPS = 60
 
 
-def trapezoid_profile(tau, ta: float, duration: float, accel: float):
+def trapezoid_profile(tau, ta: float, duration: float, accel: float, decel: float | None = None):
     """Normalised trapezoidal profile s(tau) on [0, duration] and its time derivatives.
 
-    Accelerates at ``accel`` for ``ta`` seconds, cruises at accel * ta, decelerates at ``accel``
-    over the last ``ta`` seconds (ta = duration / 2 for a triangle); s(0) = 0, s(duration) = 1.
-    s is held at 0 before and at 1 from ``duration`` on, with zero derivatives: the profile is
-    half-open, [0, duration), so at a stop between two segments only the next one is active.
+    Accelerates at ``accel`` [1/s^2] for ``ta`` seconds, cruises at accel * ta, decelerates at
+    ``decel`` (default ``accel``) over the last accel * ta / decel seconds (for a triangle the two
+    ramps fill the duration); s(0) = 0, s(duration) = 1. s is held at 0 before and at 1 from
+    ``duration`` on, with zero derivatives: the profile is half-open, [0, duration), so at a stop
+    between two segments only the next one is active.
 
     Returns:
         (s, ds/dt, d2s/dt2), arrays of the shape of ``tau``.
     """
     tau = np.asarray(tau, dtype=float)
+    decel = accel if decel is None else decel
     u = duration - tau
     speed = accel * ta
+    braking_from = duration - speed / decel  # [s] where the braking ramp begins
     accelerating = (tau >= 0.0) & (tau < ta)
-    decelerating = (tau >= duration - ta) & (u > 0.0) & ~accelerating
-    cruising = (tau >= ta) & (tau < duration - ta)
+    decelerating = (tau >= braking_from) & (u > 0.0) & ~accelerating
+    cruising = (tau >= ta) & (tau < braking_from)
     s = np.where(
         tau <= 0.0,
         0.0,
         np.where(
             accelerating,
             0.5 * accel * tau**2,
-            np.where(cruising, 0.5 * accel * ta**2 + speed * (tau - ta), np.where(u > 0.0, 1.0 - 0.5 * accel * u**2, 1.0)),
+            np.where(cruising, 0.5 * accel * ta**2 + speed * (tau - ta), np.where(u > 0.0, 1.0 - 0.5 * decel * u**2, 1.0)),
         ),
     )
-    sd = np.where(accelerating, accel * tau, np.where(cruising, speed, np.where(decelerating, accel * u, 0.0)))
-    sdd = np.where(accelerating, accel, np.where(decelerating, -accel, 0.0))
+    sd = np.where(accelerating, accel * tau, np.where(cruising, speed, np.where(decelerating, decel * u, 0.0)))
+    sdd = np.where(accelerating, accel, np.where(decelerating, -decel, 0.0))
     return s, sd, sdd
+
+
+def _trapezoid_timing(speed: float, accel: float, decel: float) -> tuple[float, float, float]:
+    """(starting ramp [s], braking ramp [s], duration [s]) of the time-optimal normalised profile
+    from s = 0 to 1 at rest under ds/dt <= ``speed`` [1/s], starting rate ``accel`` and braking rate
+    ``decel`` [1/s^2]: a trapezoid if the ramps to ``speed`` cover less than s = 1, else a triangle
+    whose peak speed w has w^2 (1/accel + 1/decel) / 2 = 1."""
+    inverse = 1.0 / accel + 1.0 / decel
+    if 0.5 * speed * speed * inverse < 1.0:  # the cruise speed is reached: trapezoid
+        return speed / accel, speed / decel, 1.0 / speed + 0.5 * speed * inverse
+    peak = np.sqrt(2.0 / inverse)  # triangle
+    return float(peak / accel), float(peak / decel), float(peak * inverse)
 
 
 def blend_radius_value(blend_radius) -> float:
@@ -110,23 +140,31 @@ class MovejBlendLaw:
             every waypoint.
         tcp_position: callable q -> TCP position (3,) [m]; default the UR10e flange origin
             (requires n = 6 when r > 0).
+        keep_limits: True (default): the blends keep both limits, slowed or shrunk where they
+            would not (module doc, step 4); False: the ramps superpose at the limits as on the
+            controller Pająk 2024 measured, exceeding them in the blends.
 
     Attributes:
         q_start, q_goal (n,), duration [s], q_waypoints (m + 1, n), segment_starts (m,),
-        segment_durations (m,), blend_overlaps (m - 1,) [s] (delta_k, 0 without blending).
+        segment_durations (m,), blend_overlaps (m - 1,) [s] (delta_k, 0 without blending),
+        segment_accels, segment_decels (m,) [1/s^2] (each segment's starting and braking rate of
+        s), segment_ramps, segment_brakes (m,) [s] (their ramps' durations), blend_slowdowns
+        (m - 1,) (lambda_k, 1 where a blend needs no slowing or without ``keep_limits``).
     """
 
     # q̈ jumps where each trapezoid's ramps begin and end: None lets the planner set the reference
     # back on the law at every update (the TimeLaw contract)
     acceleration_jumps = None
 
-    def __init__(self, q_waypoints, velocity_limit, acceleration_limit, blend_radius: float = 0.0, *, tcp_position=None):
+    def __init__(self, q_waypoints, velocity_limit, acceleration_limit, blend_radius: float = 0.0, *, tcp_position=None,
+                 keep_limits: bool = True):
         waypoints = waypoint_rows(q_waypoints)
         n = waypoints.shape[1]
         self.num_joints = n
         self.velocity_limit = positive_vector(velocity_limit, "velocity_limit", n)
         self.acceleration_limit = positive_vector(acceleration_limit, "acceleration_limit", n)
         self.blend_radius = radius = blend_radius_value(blend_radius)
+        self.keep_limits = flag(keep_limits, "keep_limits")
         if tcp_position is None:
             if radius > 0.0 and n != UR10E.num_joints:
                 raise ValueError(f"tcp_position is required for blending with n = {n} joints (the default is the UR10e flange)")
@@ -140,55 +178,61 @@ class MovejBlendLaw:
         self.q_goal = waypoints[-1].copy()
         displacements = np.diff(waypoints, axis=0)  # D_k, (m, n)
         m = len(displacements)
-        accels, ramps, durations = self._trapezoids(displacements)
-        overlaps = self._blend_overlaps(ramps, accels, durations)
+        self.displacements = displacements
+        speeds, rates = self._segment_rates(displacements)
+        slowdowns = self._blend_slowdowns(displacements, rates)
+        self.blend_slowdowns = slowdowns
+        self.segment_accels = rates * np.append(1.0, slowdowns)[:m]  # lambda of the blend before
+        self.segment_decels = rates * np.append(slowdowns, 1.0)[:m]  # lambda of the blend after
+        timings = [_trapezoid_timing(*row) for row in zip(speeds, self.segment_accels, self.segment_decels)]
+        ramps, brakes, durations = np.array(timings, dtype=float).reshape(m, 3).T.copy()
+        self.segment_ramps, self.segment_brakes, self.segment_durations = ramps, brakes, durations
+        overlaps = self._blend_overlaps()
+        if self.keep_limits:  # within the braking ramp before and the starting ramp after (step 4)
+            overlaps = np.minimum(overlaps, np.minimum(brakes[:-1], ramps[1:]))
+        self.blend_overlaps = overlaps
 
         starts = np.zeros(m)
         for k in range(1, m):
             starts[k] = starts[k - 1] + durations[k - 1] - overlaps[k - 1]
-        self.displacements = displacements
         self.segment_starts = starts
-        self.segment_durations = np.array(durations)
-        self.segment_ramps = np.array(ramps)
-        self.segment_accels = np.array(accels)
-        self.blend_overlaps = overlaps
         self.duration = float(starts[-1] + durations[-1]) if m else 0.0
         # every joint is one quadratic between the segments' starts, ramp ends and ends [s]
-        ramps_at = np.array([np.zeros(m), ramps, self.segment_durations - ramps, self.segment_durations])
+        ramps_at = np.array([np.zeros(m), ramps, durations - brakes, durations])
         self.polynomial_breaks = np.unique(np.append(starts + ramps_at, 0.0))
         # Plain-Python copies for the scalar hot path.
         self._starts = starts.tolist()
-        self._ends = (starts + self.segment_durations).tolist()
-        self._ramps = ramps
-        self._accels = accels
-        self._durations = durations
-        self._d = [d.copy() for d in displacements]
+        self._segments = list(zip(durations.tolist(), ramps.tolist(), (durations - brakes).tolist(),
+                                  self.segment_accels.tolist(), self.segment_decels.tolist(),
+                                  [d.copy() for d in displacements]))
         self._zero = np.zeros(n)
 
-    def _trapezoids(self, displacements) -> tuple[list[float], list[float], list[float]]:
-        """Per segment D_k (m, n) [rad], its normalised trapezoid: (accel A [1/s²], ramp time ta
-        [s], duration T [s]), each a list of m (module doc, step 1)."""
-        accels, ramps, durations = [], [], []
+    def _segment_rates(self, displacements) -> tuple[np.ndarray, np.ndarray]:
+        """Per segment D_k (m, n) [rad], the largest speed [1/s] and rate [1/s^2] of its
+        normalised profile s under every joint's limits (module doc, step 1), each (m,)."""
+        speeds, rates = [], []
         for d in displacements:
             size = np.abs(d)
             moving = size > 0.0
-            vs = np.min(self.velocity_limit[moving] / size[moving])
-            acs = np.min(self.acceleration_limit[moving] / size[moving])
-            if vs * vs / acs < 1.0:  # the cruise speed is reached: trapezoid
-                ta = vs / acs
-                duration = 1.0 / vs + ta
-            else:  # triangle
-                ta = np.sqrt(1.0 / acs)
-                duration = 2.0 * ta
-            accels.append(float(acs))
-            ramps.append(float(ta))
-            durations.append(float(duration))
-        return accels, ramps, durations
+            speeds.append(np.min(self.velocity_limit[moving] / size[moving]))
+            rates.append(np.min(self.acceleration_limit[moving] / size[moving]))
+        return np.array(speeds, dtype=float), np.array(rates, dtype=float)
 
-    def _blend_overlaps(self, ramps, accels, durations) -> np.ndarray:
-        """delta_k [s] (m - 1,) of every intermediate waypoint (module doc, step 2; 0 without
-        blending); ValueError where the blend spheres of two waypoints overlap."""
-        m = len(durations)
+    def _blend_slowdowns(self, displacements, rates) -> np.ndarray:
+        """lambda_k (m - 1,) of every intermediate waypoint: the factor on the braking ramp before
+        it and the starting ramp after it that keeps their sum within the acceleration limit
+        (module doc, step 4); 1 without blending or without ``keep_limits``."""
+        slowdowns = np.ones(max(len(rates) - 1, 0))
+        if self.keep_limits and self.blend_radius > 0.0:
+            for k in range(1, len(rates)):
+                superposed = np.abs(rates[k] * displacements[k] - rates[k - 1] * displacements[k - 1])
+                slowdowns[k - 1] = min(1.0, float(np.min(self.acceleration_limit / np.maximum(superposed, 1e-300))))
+        return slowdowns
+
+    def _blend_overlaps(self) -> np.ndarray:
+        """delta_k [s] (m - 1,) of every intermediate waypoint as the blend spheres give it (module
+        doc, step 2; 0 without blending); ValueError where the spheres of two waypoints overlap."""
+        m = len(self.segment_durations)
         overlaps = np.zeros(max(m - 1, 0))
         radius = self.blend_radius
         if radius > 0.0 and m >= 1:
@@ -201,17 +245,19 @@ class MovejBlendLaw:
                     f"{gaps[k]:.4f} m apart, blend spheres must not overlap (radius < {0.5 * gaps.min():.4f} m)"
                 )
             for k in range(1, m):
-                tau_in = self._sphere_crossing(k - 1, points[k], last=True, ramps=ramps, accels=accels, durations=durations)
-                tau_out = self._sphere_crossing(k, points[k], last=False, ramps=ramps, accels=accels, durations=durations)
-                overlaps[k - 1] = min(durations[k - 1] - tau_in, tau_out)
+                tau_in = self._sphere_crossing(k - 1, points[k], last=True)
+                tau_out = self._sphere_crossing(k, points[k], last=False)
+                overlaps[k - 1] = min(self.segment_durations[k - 1] - tau_in, tau_out)
         return overlaps
 
-    def _sphere_crossing(self, k, centre, *, last, ramps, accels, durations):
+    def _sphere_crossing(self, k, centre, *, last):
         """Local time on segment k where |tcp - centre| = r: the last (entering) or first (leaving)."""
         q0, d, r = self.q_waypoints[k], self.q_waypoints[k + 1] - self.q_waypoints[k], self.blend_radius
+        durations = self.segment_durations
 
         def distance(tau):
-            s, _, _ = trapezoid_profile(tau, ramps[k], durations[k], accels[k])
+            s, _, _ = trapezoid_profile(tau, self.segment_ramps[k], durations[k], self.segment_accels[k],
+                                        self.segment_decels[k])
             return float(np.linalg.norm(self._tcp(q0 + float(s) * d) - centre))
 
         taus = np.linspace(0.0, durations[k], _SAMPLES_PER_SEGMENT + 1)
@@ -250,17 +296,15 @@ class MovejBlendLaw:
         qdd = None
         for j in (k - 1, k) if k > 0 else (k,):
             local = tau - self._starts[j]
-            duration = self._durations[j]
+            duration, ta, braking_from, acc, dec, d = self._segments[j]
             if local < 0.0 or local >= duration:  # segments are half-open [t_k, t_k + T_k)
                 continue
-            ta, acc = self._ramps[j], self._accels[j]
             if local < ta:
                 sd, sdd = acc * local, acc
-            elif local < duration - ta:
+            elif local < braking_from:
                 sd, sdd = acc * ta, 0.0
             else:
-                sd, sdd = acc * (duration - local), -acc
-            d = self._d[j]
+                sd, sdd = dec * (duration - local), -dec
             if qd is None:
                 qd, qdd = sd * d, sdd * d
             else:
@@ -282,9 +326,8 @@ class MovejBlendLaw:
         qd = np.zeros_like(q)
         qdd = np.zeros_like(q)
         for k, d in enumerate(self.displacements):
-            s, sd, sdd = trapezoid_profile(
-                flat - self.segment_starts[k], self.segment_ramps[k], self.segment_durations[k], self.segment_accels[k]
-            )
+            s, sd, sdd = trapezoid_profile(flat - self.segment_starts[k], self.segment_ramps[k], self.segment_durations[k],
+                                           self.segment_accels[k], self.segment_decels[k])
             q += s[:, None] * d
             qd += sd[:, None] * d
             qdd += sdd[:, None] * d
@@ -306,8 +349,9 @@ class MovejBlendLaw:
 class MovejPlanner(TimeLawPlanner):
     """Planner system for a :class:`MovejBlendLaw` (UR MoveJ baseline, see the module doc).
 
-    The promised limits are the law's; note that the blends exceed them (that is the baseline's
-    known flaw), while without blending the reference respects them.
+    The promised limits are the law's: they hold at every instant with the law's ``keep_limits``
+    (the default); without it the blends exceed them as on the controller Pająk 2024 measured,
+    while without blending the reference respects them either way.
 
     Args:
         law: the MoveJ time law.
@@ -337,20 +381,26 @@ class MovejConfig:
         goals: joint waypoints after the start [rad], one row of n per waypoint.
         blend_radius: r [m] around every intermediate waypoint's tool position; 0 stops at each.
         velocity_limit, acceleration_limit: per joint; empty: the robot's joint-move limits.
+        keep_limits: True: the blends keep both limits (slowed or shrunk where they would not);
+            False: they superpose the ramps at the limits and exceed them, as Pająk 2024 measured
+            on the UR controller (the bench's ``movej_blend``).
     """
 
     goals: list[list[float]] = field(default_factory=list)
     blend_radius: float = 0.0
     velocity_limit: list[float] = field(default_factory=list)
     acceleration_limit: list[float] = field(default_factory=list)
+    keep_limits: bool = True
 
     def validate(self, robot: Robot = UR10E) -> "MovejConfig":
         """The config, its own fields checked for ``robot`` as :func:`make` checks them first:
         the goals (rows of n joint positions [rad]), the limits (the robot's where empty), the
-        blend radius; ValueError naming the field (blend spheres that overlap are the law's)."""
+        blend radius, ``keep_limits``; ValueError naming the field (blend spheres that overlap are
+        the law's)."""
         joint_goals(self.goals, robot.num_joints)
         joint_move_limits(robot, self.velocity_limit, self.acceleration_limit)
         blend_radius_value(self.blend_radius)
+        flag(self.keep_limits, "keep_limits")
         return self
 
 
@@ -360,5 +410,6 @@ def make(config: MovejConfig, robot: Robot, q_initial) -> MovejPlanner:
     config.validate(robot)
     q = start_and_goals(q_initial, config.goals, robot.num_joints)
     velocity, acceleration = joint_move_limits(robot, config.velocity_limit, config.acceleration_limit)
-    return MovejPlanner(MovejBlendLaw(q, velocity, acceleration, config.blend_radius, tcp_position=robot.tool_position),
-                        robot=robot)
+    law = MovejBlendLaw(q, velocity, acceleration, config.blend_radius, tcp_position=robot.tool_position,
+                        keep_limits=config.keep_limits)
+    return MovejPlanner(law, robot=robot)
