@@ -87,9 +87,7 @@ def test_no_planner_beats_the_time_optimal_bound_on_its_own_path(rows):
 
 def test_limits_where_promised_and_the_movej_blend_flaw(rows):
     for row in rows:
-        if row["planner"] == "toppra":  # limits are kept on Toppra's grid only: measured 1.001 on the paper
-            assert row["max_qdd_over_limit"] <= 1.15, row  # task, 1.138 between grid points on random_0's path
-        elif row["planner"] != "movej_blend":
+        if row["planner"] != "movej_blend":  # Toppra's too: its timing stretched where Drake's exceeds them
             assert row["max_qd_over_limit"] <= 1 + 1e-6, row
             assert row["max_qdd_over_limit"] <= 1 + 1e-6, row
     paper_movej = next(row for row in rows if row["task"] == "paper" and row["planner"] == "movej_blend")

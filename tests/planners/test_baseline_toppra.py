@@ -3,11 +3,16 @@
 import numpy as np
 import pytest
 
+from pydrake.trajectories import PiecewisePolynomial
+
+from drake_traj.planners.baselines import toppra as baseline_toppra
 from drake_traj.planners.baselines.toppra import (
     ToppraLaw,
     ToppraPlanner,
+    exact_peak_fractions,
     geometric_path_from_samples,
     time_optimal_along_path,
+    within_limits,
 )
 from drake_traj.planners.quintic import plan_synchronized_quintic, quintic_profile
 
@@ -145,8 +150,6 @@ def test_errors_are_clear():
 
 
 def test_toppra_failure_is_reported(monkeypatch):
-    from drake_traj.planners.baselines import toppra as baseline_toppra
-
     class NoSolution:
         def __init__(self, *args):
             pass
@@ -190,3 +193,138 @@ def test_faster_than_the_pajak_run_on_its_own_path():
           f"(worst |qd|/Kv = {np.abs(qd).max() / KV:.4f}, |qdd|/Ka = {np.abs(qdd).max() / KA:.4f})")
     assert duration < result.duration
     np.testing.assert_allclose(trajectory.value(trajectory.end_time()).ravel(), samples[-1], atol=1e-6)
+
+
+def dense_peak_fractions(trajectory, velocity_limit, acceleration_limit, period=1e-5):
+    """(peak |qd_j| / limit_j, peak |qdd_j| / limit_j) over samples ``period`` [s] apart."""
+    t = np.linspace(trajectory.start_time(), trajectory.end_time(),
+                    int(np.ceil((trajectory.end_time() - trajectory.start_time()) / period)) + 1)
+    qd = np.abs(trajectory.MakeDerivative(1).vector_values(t)).max(axis=1)
+    qdd = np.abs(trajectory.MakeDerivative(2).vector_values(t)).max(axis=1)
+    return np.max(qd / velocity_limit), np.max(qdd / acceleration_limit)
+
+
+# per-joint limits [rad/s, rad/s^2] for the C^1 path below
+KV_JOINTS, KA_JOINTS = np.array([1.0, 1.0, 1.2, 1.2, 1.5, 1.5]), np.array([1.4, 1.4, 2.0, 2.0, 3.0, 3.0])
+
+
+def shape_preserving_path():
+    """A C^1 cubic (Fritsch-Carlson) through four joint waypoints, in arc length: q'' jumps at its knots."""
+    knots = np.array([Q0, Q0 + [0.6, -0.3, 0.4, 0.2, 0.1, 0.0], Q0 + [0.9, 0.2, 0.7, -0.3, 0.2, 0.4], Q1])
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(knots, axis=0), axis=1))])
+    return PiecewisePolynomial.CubicShapePreserving(arc, knots.T, zero_end_point_derivatives=False)
+
+
+def test_exact_peaks_are_the_sampled_peaks():
+    # a C^2 spline (geometric_path_from_samples) and a C^1 one
+    kv, ka = KV_JOINTS, KA_JOINTS
+    for path in (geometric_path_from_samples(curved_samples(300)), shape_preserving_path()):
+        _, trajectory = time_optimal_along_path(path, kv, ka)
+        exact = exact_peak_fractions(trajectory, kv, ka)
+        sampled = dense_peak_fractions(trajectory, kv, ka)
+        print(f"exact peaks {exact}, sampled every 10 us {sampled}")
+        # the samples come within what 10 us of motion can change (1.2e-4 at a jump of the C^1
+        # path's q''), never above
+        np.testing.assert_allclose(exact, sampled, rtol=5e-4)
+        assert np.all(np.array(sampled) <= np.array(exact) * (1 + 1e-12))
+        assert exact[1] > 1 + 1e-4  # Toppra's timing exceeds the acceleration limit between grid points
+
+
+def test_within_limits_is_the_least_uniform_stretch():
+    _, trajectory = time_optimal_along_path(shape_preserving_path(), KV_JOINTS, KA_JOINTS)
+    velocity, acceleration = dense_peak_fractions(trajectory, KV_JOINTS, KA_JOINTS)
+    stretch, stretched = within_limits(trajectory, KV_JOINTS, KA_JOINTS)
+    assert stretch == pytest.approx(max(velocity, np.sqrt(acceleration)), rel=2e-4)
+    assert stretch > 1.01
+    assert stretched.end_time() == pytest.approx(stretch * trajectory.end_time(), rel=1e-12)
+    np.testing.assert_allclose(stretched.value(stretched.end_time()), trajectory.value(trajectory.end_time()),
+                               atol=1e-12)  # the same path
+    after = dense_peak_fractions(stretched, KV_JOINTS, KA_JOINTS)
+    assert max(after) <= 1 + 1e-6
+    assert max(after) >= 1 - 2e-4  # the least stretch: some limit is reached
+    # A straight line: Toppra's timing keeps the limits between grid points too, and is kept.
+    _, straight = time_optimal_along_path(geometric_path_from_samples(np.array([Q0, Q1])), KV, KA)
+    assert within_limits(straight, KV, KA) == (1.0, straight)
+
+
+def soak_task(seed):
+    """(planner config, robot, start [rad], its path, velocity and acceleration limits [rad/s,
+    rad/s^2]) of the soak's UR10e Toppra task ``seed``."""
+    from drake_traj.bench.soak_tasks import draw_task
+    from drake_traj.planners.base import joint_move_limits
+
+    scenario = draw_task("ur10e", "toppra", seed).scenario
+    config, robot, q0 = scenario.planner, scenario.robot_with_tool(), scenario.start_configuration()
+    path = geometric_path_from_samples(np.vstack([q0, config.path]))
+    return config, robot, q0, path, *joint_move_limits(robot, config.velocity_limit, config.acceleration_limit)
+
+
+@pytest.mark.parametrize("seed", [3, 8, 17, 37])
+def test_soak_tasks_plan_within_their_limits(seed):
+    """Seeded soak tasks whose plan exceeded its limits (by 1-3.5 % in acceleration) before the
+    grid was refined at the path's end and the timing stretched."""
+    config, robot, q0, path, _, _ = soak_task(seed)
+    planner = baseline_toppra.make(config, robot, q0)
+    plan = planner.plan()
+    velocity, acceleration = dense_peak_fractions(plan, planner.velocity_limit, planner.acceleration_limit,
+                                                  period=1e-4)
+    # Toppra's own timing exceeds them; the plan is hardly longer
+    optimal, toppra = time_optimal_along_path(path, planner.velocity_limit, planner.acceleration_limit)
+    before = dense_peak_fractions(toppra, planner.velocity_limit, planner.acceleration_limit, period=1e-4)
+    duration = planner.law.trajectory.end_time()
+    print(f"seed {seed}: peaks {before} -> {velocity:.7f}, {acceleration:.7f}; T* {optimal:.4f} s -> "
+          f"{duration:.4f} s (stretch {planner.time_stretch:.6f})")
+    assert velocity <= 1 + 1e-6 and acceleration <= 1 + 1e-6
+    assert before[1] > 1.005
+    assert duration == pytest.approx(optimal, rel=2e-3)
+    assert max(velocity, acceleration) > 0.99  # still Toppra's (near) time-optimal timing
+
+
+def test_refined_end_keeps_the_acceleration_limit_there():
+    _, _, _, path, kv, ka = soak_task(3)
+    optimal, toppra = time_optimal_along_path(path, kv, ka)
+    refined_optimal, refined = time_optimal_along_path(path, kv, ka, refine_end=True)
+    # three more grid points, all in the last grid interval
+    grid, refined_grid = (scaling.vector_values(scaling.get_segment_times()).ravel()
+                          for scaling in (toppra.time_scaling(), refined.time_scaling()))
+    assert len(refined_grid) == len(grid) + 3
+    np.testing.assert_allclose(refined_grid[:len(grid) - 1], grid[:-1], atol=1e-12)
+    # the acceleration over the last 50 ms, against the limit: 2 % over before
+
+    def end_fraction(trajectory):
+        t = np.linspace(trajectory.end_time() - 0.05, trajectory.end_time(), 5001)
+        return np.max(np.abs(trajectory.MakeDerivative(2).vector_values(t)) / ka[:, None])
+    print(f"at the end: {end_fraction(toppra):.5f} -> {end_fraction(refined):.5f}; "
+          f"T* {optimal:.5f} -> {refined_optimal:.5f} s")
+    assert end_fraction(toppra) > 1.02
+    assert end_fraction(refined) <= 1 + 1e-4
+    assert refined_optimal == pytest.approx(optimal, rel=2e-3)
+
+
+def test_plain_grid_where_toppra_fails_on_the_refined_one(monkeypatch):
+    config, robot, q0, *_ = soak_task(3)
+    solve = baseline_toppra.time_optimal_along_path
+
+    def fails_when_refined(*args, refine_end=False, **kwargs):
+        if refine_end:
+            raise ValueError("Toppra found no feasible time parameterisation of the path")
+        return solve(*args, **kwargs)
+
+    monkeypatch.setattr(baseline_toppra, "time_optimal_along_path", fails_when_refined)
+    planner = baseline_toppra.make(config, robot, q0)
+    plan = planner.plan()
+    peaks = dense_peak_fractions(plan, planner.velocity_limit, planner.acceleration_limit, period=1e-4)
+    assert max(peaks) <= 1 + 1e-6
+    assert planner.time_stretch > 1.01  # the plain grid's 2.3 % over the acceleration limit, stretched away
+
+
+def test_stretch_errors_are_clear():
+    _, trajectory = time_optimal_along_path(geometric_path_from_samples(np.array([Q0, Q1])), KV, KA)
+    with pytest.raises(ValueError, match="time_stretch"):
+        ToppraPlanner(ToppraLaw(trajectory), KV, KA, time_stretch=0.9)
+    # a path of quintic pieces: its q' u + q'' x is no quadratic (the peaks would not be exact)
+    samples = curved_samples(6)
+    quintic = PiecewisePolynomial.LagrangeInterpolatingPolynomial(np.linspace(0.0, 1.0, 6), samples.T)
+    _, trajectory = time_optimal_along_path(quintic, KV, KA, grid_points=50)
+    with pytest.raises(ValueError, match="trajectory's path must be a PiecewisePolynomial of degree <= 3"):
+        within_limits(trajectory, KV, KA)
