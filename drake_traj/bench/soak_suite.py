@@ -35,7 +35,7 @@ from drake_traj.bench.soak_checks import (DENSE_PERIOD, LIMIT_TOLERANCE, Clearan
 from drake_traj.bench.soak_tasks import draw_task
 from drake_traj.bench.units import failure_reason
 from drake_traj.errors import DrakeTrajError, field_text
-from drake_traj.scenario import make_planner, preflight
+from drake_traj.scenario import check_planned_duration, make_planner, preflight
 from drake_traj.station import simulate
 
 __all__ = ["SOAK_COLUMNS", "rerun_command", "run_soak_task", "soak_row"]
@@ -82,16 +82,17 @@ def run_soak_task(arm: str, planner: str, seed: int) -> dict:
 
 
 def _planned(task, began) -> dict:
-    """Plan ``task`` as ``drake-traj run`` does, then check the plan or the refusal."""
+    """Plan ``task`` as ``drake-traj run`` does (the scenario checked, its planner made, the
+    preflight, the planned duration against ``max_duration``), then check the plan or the refusal."""
     key = (task.arm, task.planner, task.seed)
     scenario = task.scenario
-    planner = None
     try:
         scenario.validate()
         planner = make_planner(scenario)
         preflight(scenario, planner)
+        check_planned_duration(scenario, planner)
     except ValueError as error:
-        return _refused(task, key, error, planner, began)
+        return _refused(task, key, error, began)
     planning = time.perf_counter() - began
     checked = time.perf_counter()
     values, wrongs = _check_plan(task, planner)
@@ -103,15 +104,18 @@ def _planned(task, began) -> dict:
                 planning_s=planning, check_s=time.perf_counter() - checked, params=json.dumps(task.params), **values)
 
 
-def _refused(task, key, error, planner, began) -> dict:
+def _refused(task, key, error, began) -> dict:
+    """The row of a refused task: its cause, field and the independent diagnosis."""
     cause = str(getattr(error, "cause", "")) if isinstance(error, DrakeTrajError) else "value error"
     field = field_text(error.field) if isinstance(error, DrakeTrajError) and error.field else ""
-    clearance = ClearanceCheck(task.scenario.robot_with_tool(), task.scenario.cell)
-    diagnosis = diagnose(error, task.scenario.robot_with_tool(), clearance, task.scenario.cell.clearance)
+    robot = task.scenario.robot_with_tool()
+    diagnosis = "not diagnosed"
+    if cause in ("collision", "joint range"):
+        diagnosis = diagnose(error, robot, ClearanceCheck(robot, task.scenario.cell), task.scenario.cell.clearance)
     return soak_row(key, outcome="refused", cause=cause, field=field, diagnosis=diagnosis,
-                wrong=diagnosis.startswith("contradicted"), planning_s=time.perf_counter() - began,
-                message=" ".join(str(error).split())[:400], params=json.dumps(task.params),
-                clearance_m=task.scenario.cell.clearance)
+                    wrong=diagnosis.startswith("contradicted"), planning_s=time.perf_counter() - began,
+                    message=" ".join(str(error).split())[:400], params=json.dumps(task.params),
+                    clearance_m=task.scenario.cell.clearance)
 
 
 JERK_LIMITED = ("smooth_waypoints", "pajak_retimed", "free_motion", "ruckig")  # the planners that take a jerk limit
@@ -208,6 +212,15 @@ def _goal(task, planner, q_end, qd_end, clearance, values) -> list[str]:
 
 
 def _closed_loop(scenario) -> str:
-    """"succeeded", or why the closed loop's run failed."""
+    """"succeeded", or why the closed loop's run failed or broke a promised limit at a logged
+    sample of its reference (peak |q̇| or |q̈| over the planner's limit by more than
+    :data:`~drake_traj.bench.soak_checks.LIMIT_TOLERANCE`)."""
     result = simulate(scenario)
-    return "succeeded" if result.succeeded else f"{result.failure.cause}: {result.failure.message}"[:300]
+    if not result.succeeded:
+        return f"{result.failure.cause}: {result.failure.message}"[:300]
+    metrics = result.metrics()
+    for name, fraction in (("velocity", metrics.peak_velocity_fraction),
+                           ("acceleration", metrics.peak_acceleration_fraction)):
+        if fraction > 1 + LIMIT_TOLERANCE:
+            return f"the logged reference's peak {name} is {fraction:.9f} of its limit"
+    return "succeeded"
