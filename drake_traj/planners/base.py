@@ -152,7 +152,8 @@ class PlannerSystem(LeafSystem):
         1e-13 rad/s² on the shipped time-law scenarios). Pająk: the preflight's RK4 samples every step
         (``update_period``) joined by quintic Hermite pieces through (q, q̇, q̈), q̈ the law's
         after each step's update (between samples its q̈ is within 7.2e-7 rad/s² of the law's
-        evaluated on the plan, pajak_sim3 mid-step). Against the simulated reference (fixed-step RK2, 1 ms) see
+        evaluated on the plan, pajak_sim3 mid-step), slowed by a constant clock rate where the
+        pieces would pass the joint limits between the samples. Against the simulated reference (fixed-step RK2, 1 ms) see
         ``tests/test_plan.py``: the difference there is the simulator's integration error.
 
         Made at the first call and kept (the law does not change); each call returns a copy. Use

@@ -5,7 +5,7 @@ the joint limits (:func:`joint_speed_cap`)."""
 import numpy as np
 
 from drake_traj.planners.boryga.path import LoopPath
-from drake_traj.planners.laws import HermiteLaw
+from drake_traj.planners.laws import HermiteLaw, joint_speed_cap
 from drake_traj.robots import Robot
 from drake_traj.robots.base import format_point
 
@@ -61,23 +61,3 @@ class RobotLoopLaw(HermiteLaw):
         qd, qdd = self.robot.joint_rates(q, velocity, acceleration)
         return np.array([q, np.reshape(qd, -1), np.reshape(qdd, -1)])
 
-
-def joint_speed_cap(law: HermiteLaw, velocity_limit, acceleration_limit) -> tuple[float, dict]:
-    """The largest constant clock rate c <= 1 that keeps ``law`` within the joint limits.
-
-    With a constant c, joint velocity scales by c and acceleration by c^2, so
-    c = min(1, min_j v_lim_j / peak|qd_j|, sqrt(min_j a_lim_j / peak|qdd_j|)), with the law's
-    exact peaks (:meth:`HermiteLaw.peak_rates`: on each knot interval the law is a polynomial;
-    a sampled peak missed up to 0.07 % of the limit on seeded random loops).
-
-    Returns:
-        (c, peaks) with peaks = {"qd": per-joint peak |qd|, "qdd": per-joint peak |qdd|} at c = 1.
-    """
-    peak_qd, peak_qdd = law.peak_rates()
-    with np.errstate(divide="ignore"):
-        cap = min(
-            1.0,
-            float(np.min(np.asarray(velocity_limit) / peak_qd)),
-            float(np.sqrt(np.min(np.asarray(acceleration_limit) / peak_qdd))),
-        )
-    return cap, {"qd": peak_qd, "qdd": peak_qdd}

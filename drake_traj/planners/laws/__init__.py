@@ -4,6 +4,6 @@ polynomial laws (:mod:`.polynomials`) and the scaled clock with eq. 18 of Pająk
 (:mod:`.scaling`)."""
 
 from drake_traj.planners.laws.contract import TimeLaw, missing_members
-from drake_traj.planners.laws.hermite import HermiteLaw
+from drake_traj.planners.laws.hermite import HermiteLaw, joint_speed_cap
 
-__all__ = ["HermiteLaw", "TimeLaw", "missing_members"]
+__all__ = ["HermiteLaw", "TimeLaw", "joint_speed_cap", "missing_members"]
