@@ -54,6 +54,7 @@ NOT_RUN = {
     ("docs/getting-started.md", "python3 -m venv .venv && . .venv/bin/activate && pip install ."),
     ("docs/getting-started.md", "apt-get update && apt-get install -y chromium"),
     ("docs/benchmarks.md", "drake-traj bench --count 20 --out out/bench20"),
+    ("docs/benchmarks.md", "drake-traj bench --suite soak --count 10000 --arms ur10e --scheduler tcp://host:8786 --out out/soak_ur10e"),
 }
 RUNNABLE = {"bash", "sh", "shell", "console", "python"}
 TIMEOUT_S = 600

@@ -171,6 +171,15 @@ def test_the_command_writes_its_report_and_reruns_a_task(tmp_path):
     again = run_soak_task("ur10e", "quintic", 49)
     first = rows[0]
     assert again["outcome"] == first["outcome"] and again["params"] == first["params"]
+    # a second part (seed 51) merged with the first into one report; a task in two parts is refused
+    part = tmp_path / "part"
+    assert cli.main(["bench", "--suite", "soak", "--arms", "ur10e", "--planners", "quintic", "--count", "1",
+                     "--seed", "51", "--workers", "1", "--out", str(part), "--quiet"]) == 0
+    merged = tmp_path / "merged"
+    assert cli.main(["bench", "--suite", "soak", "--merge", str(out), str(part), "--out", str(merged), "--quiet"]) == 0
+    text = (merged / "soak.md").read_text()
+    assert "5 tasks, seeds 49-51, merged from parts" in text and "| ur10e | quintic | 3 |" in text
+    assert cli.main(["bench", "--suite", "soak", "--merge", str(out), str(out), "--out", str(tmp_path / "twice")]) == 2
 
 
 def test_bad_arguments_are_refused_before_any_task(tmp_path, capsys):

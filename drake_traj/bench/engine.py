@@ -95,15 +95,17 @@ class _Progress:
     """Runs done, failed and the time left: a tqdm bar on a terminal; on another stream (a log
     file, CI) a line at the first run to end :data:`LOG_INTERVAL` after the last line (a run
     takes seconds: a log is never silent much longer); nothing when the stream is None. A first
-    line says how many runs there are and where they run."""
+    line says how many runs there are and where they run. ``unit`` names a run and ``bad`` what a
+    row that did not succeed is (the soak: "task", "wrong")."""
 
-    def __init__(self, total: int, stream, where: str):
+    def __init__(self, total: int, stream, where: str, unit: str = "run", bad: str = "failed"):
         self._stream = stream
+        self._unit, self._bad = unit, bad
         terminal = stream is not None and getattr(stream, "isatty", lambda: False)()
         self._lines = stream is not None and not terminal
         if stream is not None:
-            print(f"bench: {total} runs {where}", file=stream, flush=True)
-        self._bar = tqdm(total=total, unit="run", desc="bench", file=stream or sys.stderr, disable=not terminal,
+            print(f"bench: {total} {unit}s {where}", file=stream, flush=True)
+        self._bar = tqdm(total=total, unit=unit, desc="bench", file=stream or sys.stderr, disable=not terminal,
                          dynamic_ncols=True)
         self.total, self.count, self.failed = total, 0, 0
         self._start = self._said = time.monotonic()
@@ -112,7 +114,7 @@ class _Progress:
         """Count ``row``'s run; returns the row."""
         self.count += 1
         self.failed += not row["succeeded"]
-        self._bar.set_postfix(failed=self.failed, refresh=False)
+        self._bar.set_postfix({self._bad: self.failed}, refresh=False)
         self._bar.update()
         if self._lines and time.monotonic() - self._said >= LOG_INTERVAL and self.count < self.total:
             self._say(self.line())
@@ -123,7 +125,8 @@ class _Progress:
         left estimated as the mean time per run so far times the runs left."""
         elapsed = time.monotonic() - self._start
         left = elapsed / self.count * (self.total - self.count)
-        return (f"bench: {self.count}/{self.total} runs ({100 * self.count / self.total:.0f} %), {self.failed} failed, "
+        return (f"bench: {self.count}/{self.total} {self._unit}s ({100 * self.count / self.total:.0f} %), "
+                f"{self.failed} {self._bad}, "
                 f"{tqdm.format_interval(elapsed)} elapsed, about {tqdm.format_interval(left)} left")
 
     def _say(self, text: str) -> None:
@@ -133,8 +136,8 @@ class _Progress:
     def close(self):
         self._bar.close()
         if self._lines:
-            self._say(f"bench: {self.count}/{self.total} runs in {tqdm.format_interval(time.monotonic() - self._start)}, "
-                      f"{self.failed} failed")
+            self._say(f"bench: {self.count}/{self.total} {self._unit}s in "
+                      f"{tqdm.format_interval(time.monotonic() - self._start)}, {self.failed} {self._bad}")
 
 
 def where(workers: int | None, scheduler: str | None) -> str:

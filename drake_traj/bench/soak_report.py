@@ -233,7 +233,7 @@ def soak_bench(out_dir, *, count: int = 10, seed: int = 0, arms=SOAK_ARMS, plann
     with _claim_output_directory(out_dir, overwrite, command) as claimed:
         began = time.monotonic()
         with _engine(workers, scheduler) as client:
-            bar = _Progress(len(work), progress, where(workers, scheduler))
+            bar = _Progress(len(work), progress, where(workers, scheduler), unit="task", bad="wrong")
             try:
                 by_task = _run(client, work, bar)
             finally:
