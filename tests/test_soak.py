@@ -137,6 +137,10 @@ def test_a_refusal_is_diagnosed_independently():
                     0.01) == "confirmed"
     assert diagnose(CollisionError("refused", configuration=clear, time=0.0, **made), robot, check,
                     0.01).startswith("contradicted")
+    # refused within 1 mm beyond the clearance by SceneGraph: the check's certified bound may be below it
+    beyond = check.distance(clear) - 0.0005
+    assert diagnose(CollisionError("refused", configuration=clear, time=0.0, **made), robot, check,
+                    beyond).startswith("borderline: SceneGraph puts it 0.500 mm beyond")
 
 
 def test_tasks_are_drawn_from_their_seed_alone():
@@ -180,6 +184,24 @@ def test_the_command_writes_its_report_and_reruns_a_task(tmp_path):
     text = (merged / "soak.md").read_text()
     assert "5 tasks, seeds 49-51, merged from parts" in text and "| ur10e | quintic | 3 |" in text
     assert cli.main(["bench", "--suite", "soak", "--merge", str(out), str(out), "--out", str(tmp_path / "twice")]) == 2
+
+
+def test_a_local_soak_makes_its_cluster_afresh_every_chunk(tmp_path, monkeypatch):
+    import drake_traj.bench.soak_report as report
+
+    made = []
+    engine = report._engine
+
+    def counted(workers, scheduler):
+        made.append(workers)
+        return engine(workers, scheduler)
+
+    monkeypatch.setattr(report, "LOCAL_CHUNK", 2)
+    monkeypatch.setattr(report, "_engine", counted)
+    rows = report.soak_bench(tmp_path / "soak", count=3, arms=("ur10e",), planners=("quintic",), workers=2,
+                             progress=None)
+    assert made == [2, 2] and [row["seed"] for row in rows] == [0, 1, 2]
+    assert [row["params"] for row in rows] == [run_soak_task("ur10e", "quintic", seed)["params"] for seed in range(3)]
 
 
 def test_bad_arguments_are_refused_before_any_task(tmp_path, capsys):

@@ -41,6 +41,7 @@ DENSE_PERIOD = 1e-4  # [s] between two samples of the limits' check
 CLEARANCE_PERIOD = 1e-3  # [s] the finest interval the clearance check halves to
 COARSE_STEPS = 64  # clearance samples every 64 ms first
 LIMIT_TOLERANCE = 1e-6  # relative: a peak up to (1 + 1e-6) times its limit is within it (round-off)
+BORDERLINE = 1e-3  # [m] a collision refusal SceneGraph puts this little beyond the clearance is borderline, not wrong
 QUERY_WITHIN = 0.15  # [m] SceneGraph's distances are asked up to this (a farther pair reads as 0.15)
 
 
@@ -271,15 +272,20 @@ def tool_rates(checker, robot, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
 
 def diagnose(error, robot, clearance: ClearanceCheck, cell_clearance: float) -> str:
     """Whether a refusal ``error`` (a DrakeTrajError) of a task on ``robot`` agrees with an
-    independent diagnosis: "confirmed", "contradicted: <why>" or "not diagnosed" (a cause, or a
-    refusal without the configuration, that the soak does not diagnose). A collision: SceneGraph
-    (``clearance``'s query) puts the refused configuration closer than ``cell_clearance`` [m]; a
-    joint range: the joint is past its range in the refused configuration."""
+    independent diagnosis: "confirmed", "borderline: <why>", "contradicted: <why>" or "not
+    diagnosed" (a cause, or a refusal without the configuration, that the soak does not diagnose).
+    A collision: SceneGraph (``clearance``'s query) puts the refused configuration closer than
+    ``cell_clearance`` [m] (confirmed), within :data:`BORDERLINE` beyond it (borderline: the cell
+    check refuses on the smaller of SceneGraph's distance and a certified lower bound, and
+    SceneGraph's distance of cylinders and boxes can be millimetres above the true one), or further
+    (contradicted). A joint range: the joint is past its range in the refused configuration."""
     cause = str(getattr(error, "cause", ""))
     if cause == "collision" and getattr(error, "configuration", None) is not None:
         distance = clearance.distance(error.configuration)
-        if distance < cell_clearance + 1e-6:
+        if distance < cell_clearance:
             return "confirmed"
+        if distance < cell_clearance + BORDERLINE:
+            return f"borderline: SceneGraph puts it {1e3 * (distance - cell_clearance):.3f} mm beyond the clearance"
         return f"contradicted: SceneGraph puts the refused configuration {1e3 * distance:.3f} mm from everything"
     if cause == "joint range" and getattr(error, "joint", None) is not None:
         j = error.joint

@@ -25,6 +25,11 @@ SOAK_FILES = ("soak.csv", "soak.md", "soak.png")
 SOAK_ARMS, SOAK_PLANNERS = tuple(ARMS), tuple(DRAWS)  # what --arms and --planners take, all by default
 MAX_COUNT = 100_000  # tasks per arm and planner
 SHOWN_WRONG = 50  # wrong rows listed in soak.md (all are in soak.csv)
+# tasks per local Dask cluster: pydrake 1.51 never frees what a task's Drake systems hold (about
+# 1.7 MB a task, measured, once each planner is emptied), so a local soak makes its cluster afresh
+# every LOCAL_CHUNK tasks (1-2 GB a worker at most; about 8 s to start one); workers of a cluster
+# of one's own (--scheduler) are best started with `dask worker --lifetime 10m --lifetime-restart`
+LOCAL_CHUNK = 2000
 
 
 def _worst(rows, column, pick=max) -> float:
@@ -232,12 +237,16 @@ def soak_bench(out_dir, *, count: int = 10, seed: int = 0, arms=SOAK_ARMS, plann
     work = [(arm, planner, seed + k) for arm in arms for planner in planners for k in range(count)]
     with _claim_output_directory(out_dir, overwrite, command) as claimed:
         began = time.monotonic()
-        with _engine(workers, scheduler) as client:
-            bar = _Progress(len(work), progress, where(workers, scheduler), unit="task", bad="wrong")
-            try:
-                by_task = _run(client, work, bar)
-            finally:
-                bar.close()
+        bar = _Progress(len(work), progress, where(workers, scheduler), unit="task", bad="wrong")
+        by_task = {}
+        try:
+            # a local cluster is made afresh for every LOCAL_CHUNK tasks (what pydrake leaks: _release)
+            size = len(work) if scheduler is not None else LOCAL_CHUNK
+            for first in range(0, len(work), size):
+                with _engine(workers, scheduler) as client:
+                    by_task |= _run(client, work[first:first + size], bar)
+        finally:
+            bar.close()
         rows = [by_task[unit] for unit in work]
         _write(claimed, out_dir, rows, time.monotonic() - began, progress)
     return rows
