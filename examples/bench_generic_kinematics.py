@@ -19,7 +19,7 @@ one after the other within each repeat:
    orientation and branch) at 200 points of a smooth path near the home configuration: the
    closed form against the chain's IK warm-started from the reference, per point.
 
-Prints the times and the ratios chain / closed form (issue 24 asks for at most 2 for the law),
+Prints the times and the ratios chain / closed form (our bound: at most 2 for the law),
 and the two motions' finish times. A benchmark, not a test: numbers depend on the machine.
 """
 

@@ -1,4 +1,4 @@
-"""The smooth timing (issue 22, docs/smooth_timing.md) against the bang-bang optimum on the same
+"""The smooth timing (docs/smooth_timing.md) against the bang-bang optimum on the same
 path (Drake's Toppra), on seeded random tasks: T / T_opt, planning time and its CPU against
 Toppra's, limits and path deviation.
 

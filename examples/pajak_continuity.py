@@ -1,4 +1,4 @@
-"""The continuity of the Pająk planner's q̈ on seeded sets of random tasks (issue 32, item 4).
+"""The continuity of the Pająk planner's q̈ on seeded sets of random tasks.
 
     python examples/pajak_continuity.py [--seeds 1 2 3 4 5] [--count 60] [--scale 1.0] [--dt 1e-3]
                                         [--jerk-limit 80]
@@ -10,7 +10,7 @@ the law under RK4 at ``dt``); q̈ is the planner's motion (:class:`~drake_traj.p
 the law's commanded q̈ at each update, up to rest after the finish) sampled every ``dt``. Per set it
 prints the finished tasks, the share of them with no step of q̈ above ``STEP`` = 0.1 rad/s²
 between samples, the worst step (which task, joint and time) and the median, p90 and largest of the
-per-task largest step (issue 32: >= 95 % within 0.1 rad/s² per ms on every set, nothing above 0.3).
+per-task largest step (the bounds: >= 95 % within 0.1 rad/s² per ms on every set, nothing above 0.3).
 
 Measured (the defaults): 53, 46, 49, 51 and 51 of 60 finish; on every one of them no step above
 0.1 rad/s² (the largest 0.080, the jerk limit's 80 rad/s³ over 1 ms; median of the per-task
@@ -30,8 +30,8 @@ from drake_traj.bench import pajak_walk_tasks
 from drake_traj.errors import PlanningError
 from drake_traj.planners import pajak as P
 
-STEP = 0.1  # [rad/s²] between 1 ms samples: issue 32's bound on >= 95 % of the finished tasks
-LIMIT_STEP = 0.3  # [rad/s²] between 1 ms samples: issue 32's bound on every finished task
+STEP = 0.1  # [rad/s²] between 1 ms samples: the bound on >= 95 % of the finished tasks
+LIMIT_STEP = 0.3  # [rad/s²] between 1 ms samples: the bound on every finished task
 Q0 = P.paper_initial_configuration()
 
 

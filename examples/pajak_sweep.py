@@ -1,4 +1,4 @@
-"""The Pająk law ("ours", every improvement on) on seeded random tasks at two scales (issue 22).
+"""The Pająk law ("ours", every improvement on) on seeded random tasks at two scales.
 
     python examples/pajak_sweep.py [--count 200] [--seed 9] [--steps 0.7 1.0] [--json out.json]
 
@@ -13,7 +13,7 @@ joint from the previous one, random limits. The law runs alone under its own RK4
   jerk of 100 rad/s³); and continuous, where a larger change is at most ``LIMIT_STEP`` and
   shrinks below 0.7 of itself when the task is integrated again at 0.5 ms (steep, not a jump: a
   jump keeps its size at any step);
-- the largest 1 ms change of q̈ over every finished task (issue 22: at most 0.5 rad/s²);
+- the largest 1 ms change of q̈ over every finished task (at most 0.5 rad/s²);
 - T / T_opt (median, p90, max) over the finished tasks, T_opt Drake's Toppra time-optimal
   duration along the law's own joint path (its log up to the finish) under the task's limits
   (:func:`drake_traj.bench.optimal_duration`); tasks Toppra cannot parameterise are counted.
@@ -33,7 +33,7 @@ from drake_traj.bench import optimal_duration, pajak_walk_tasks
 from drake_traj.planners import pajak as P
 
 STEP = 0.1  # [rad/s²] between 1 ms samples: the largest change of q̈ that counts as continuous
-LIMIT_STEP = 0.5  # [rad/s²] in 1 ms: issue 22's bound on every finished task
+LIMIT_STEP = 0.5  # [rad/s²] in 1 ms: the bound on every finished task
 SETTLE = 0.5  # [s] integrated past the finish (the station keeps the law running while the arm settles)
 Q0 = P.paper_initial_configuration()
 

@@ -1,4 +1,4 @@
-"""Bounded, honest and clear (issue 25, beside tests/test_bad_input.py): every run, preflight, bench
+"""Bounded, honest and clear (beside tests/test_bad_input.py): every run, preflight, bench
 and live view ends within stated limits or is refused naming the input; a result of a station
 that has not finished is not a success; the live view keeps the scenario's speed profile; the
 public station functions, a busy port, shipped names with --variant and a variant's shallow

@@ -1,4 +1,4 @@
-"""Any 6-axis arm (issue 24): the PUMA 560 from its DH table (diagrams/puma560.yaml) through the
+"""Any 6-axis arm: the PUMA 560 from its DH table (diagrams/puma560.yaml) through the
 closed loop, its written model against its table in both DH conventions, an arm from a user's
 URDF and from a user's plant, and bad input at its line."""
 

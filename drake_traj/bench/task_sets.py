@@ -55,7 +55,7 @@ def random_tasks(count: int, seed: int = 0):
 
 
 def pajak_walk_tasks(count: int, seed: int = 9, step: float = 0.7) -> list[PajakConfig]:
-    """``count`` seeded Pająk tasks of the law's random sweep (issue 22, tests/planners/test_pajak_random.py):
+    """``count`` seeded Pająk tasks of the law's random sweep (tests/planners/test_pajak_random.py):
     walks in joint space from the paper's q(0), each of 1-4 waypoints the flange pose of a
     configuration up to ``step`` [rad] per joint from the previous one, limits drawn from
     0.5-2 rad/s and 0.7-3 rad/s² (one value for every joint or one per joint, by a fair coin).

@@ -1,4 +1,4 @@
-"""The Pająk planner's q̈ is continuous on moves of 1 rad per joint (issue 32, item 4): the planned
+"""The Pająk planner's q̈ is continuous on moves of 1 rad per joint: the planned
 motion (:class:`~drake_traj.planners.pajak.PajakPlanner`'s plan: the preflight's RK4 samples at
 1 ms joined by quintic Hermite pieces, up to rest after the finish) sampled densely.
 

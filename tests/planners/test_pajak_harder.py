@@ -1,4 +1,4 @@
-"""The Pająk law ("ours") on moves of up to 1.0 rad per joint (issue 22): q̈ continuous (strictly,
+"""The Pająk law ("ours") on moves of up to 1.0 rad per joint: q̈ continuous (strictly,
 within STEP, where a velocity limit binds) and no 1 ms step above 0.5 rad/s² on the tasks below,
 and every stall names its cause.
 
@@ -20,7 +20,7 @@ from drake_traj.robots import ur10e as robot
 Q0 = P.paper_initial_configuration()
 TASKS = pajak_walk_tasks(252, seed=9, step=1.0)  # the sweep's 200 and the next 52 of the same draw
 STEP = 0.1  # [rad/s²] in 1 ms: continuous without a second look
-LIMIT_STEP = 0.5  # [rad/s²] in 1 ms: issue 22's bound on every finished task
+LIMIT_STEP = 0.5  # [rad/s²] in 1 ms: the bound on every finished task
 TOL = 1e-9
 
 
@@ -35,7 +35,7 @@ def finished_run(task, dt=1e-3):
     return result, result["qdd"][: result["finish_index"] + 1 + round(0.5 / dt)]
 
 
-# the first 8 of the set, and two that jumped before issue 22: 106 (an orientation component of
+# the first 8 of the set, and two that jumped before q̈ was made continuous: 106 (an orientation component of
 # the error passing π: 2.61 rad/s² in 1 ms and at 0.5 ms) and 156 (the penalty of eq. 15 near a
 # velocity limit, its stiffness 4000 1/s: q̈ chattered by 1.05 rad/s² in 1 ms)
 @pytest.mark.parametrize("index", [*range(8), 106, 156])

@@ -1,4 +1,4 @@
-"""The Pająk 2024 planner on tasks that are not the paper's (issue #9): 200 seeded random tasks,
+"""The Pająk 2024 planner on tasks that are not the paper's: 200 seeded random tasks,
 each event that used to make q̈ jump, and the preflight.
 
 The tasks are made like the issue's: walks in joint space from the paper's q(0), each of 1-4
@@ -76,7 +76,7 @@ def test_random_tasks(random_runs):
     # Before the jerk limit: 199 of 200 (191 of the 192 finished). Before the
     # jerk-limited viability bound and the penalty's stiffness cap of 150 1/s (was 300): 196
     # (188 of 192), the largest change 0.125 rad/s²; now 0.107. Before the 300 1/s cap and the
-    # continuous orientation error (issue 22): continuous on 195 (187 of 192), the largest change
+    # continuous orientation error: continuous on 195 (187 of 192), the largest change
     # 0.63 rad/s². Before the jerk budget: 191 finished, continuous on 187 (181 of 191). The one
     # left changed q̈ by 0.107 rad/s² in 1 ms and by half that at 0.5 ms (steep, not a jump:
     # examples/pajak_sweep.py).

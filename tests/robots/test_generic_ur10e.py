@@ -1,4 +1,4 @@
-"""The generic path on the UR10e agrees with the analytic UR10e (issue 24): a ChainArm from the
+"""The generic path on the UR10e agrees with the analytic UR10e: a ChainArm from the
 DH table of docs/ur10e.md (simulated with models/ur10e.urdf) and a ChainArm read from
 models/ur10e.urdf through MultibodyPlant run Pająk 2024's simulations 1-3 to the analytic arm's
 Table 2 finish times, through the compiled integration and, for sim 3, the closed-loop station.
@@ -26,7 +26,7 @@ DOCS_DH = np.array([[0.1807, 0.0, np.pi / 2, 0.0], [0.0, -0.6127, 0.0, 0.0], [0.
                     [0.17415, 0.0, np.pi / 2, 0.0], [0.11985, 0.0, -np.pi / 2, 0.0], [0.11655, 0.0, 0.0, 0.0]])
 # T [s] of the analytic UR10e's sims 1-3 (README "Pająk 2024: Table 2", our method; paper 4.98 / 5.22 / 5.32)
 TABLE2_ANALYTIC = {"sim1": 5.116, "sim2": 5.069, "sim3": 5.332}
-AGREEMENT = 1e-3  # relative, issue 24's 0.1 %
+AGREEMENT = 1e-3  # relative: 0.1 %
 
 
 def dh_arm():
