@@ -15,7 +15,7 @@ __all__ = ["FreeMotionLaw", "Leg"]
 class FreeMotionLaw:
     """The found and timed motion as a time law (:class:`~drake_traj.planners.laws.TimeLaw`):
     each leg's :class:`~drake_traj.planners.timing.SmoothTiming` in turn, at rest between
-    them, as one :class:`HermiteLaw` on their knots. Until the planner has planned
+    them, as one :class:`HermiteLaw` of their checked pieces. Until the planner has planned
     (:meth:`~drake_traj.planners.free.system.FreeMotionPlanner.plan_in`), asking for it raises a
     :class:`PlanningError`."""
 
@@ -35,7 +35,8 @@ class FreeMotionLaw:
             samples.append(table[first:])
             offset += timing.duration
         samples = np.concatenate(samples)
-        law = HermiteLaw(np.concatenate(knots), samples, samples)
+        pieces = np.concatenate([timing.coefficients for timing in timings])  # the legs' checked pieces themselves
+        law = HermiteLaw(np.concatenate(knots), samples, samples, pieces=pieces)
         self._law = law
         self.rates_at, self.sample = law.rates_at, law.sample  # the hot path, without this wrapper
 

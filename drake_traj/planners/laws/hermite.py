@@ -57,6 +57,15 @@ def sigma_derivatives(knots, coefficients, orders: int):
     return knots[:-1] + half, half, derivatives
 
 
+def _as_quintics(pieces, shape: tuple[int, int]) -> np.ndarray:
+    """Monomial coefficients ``pieces`` (K-1, P <= 6, n) padded with zeros to (K-1, 6, n); a
+    ValueError naming ``pieces`` where they are not (K-1, P, n) = ``shape`` with 1 <= P <= 6."""
+    pieces = np.asarray(pieces, dtype=float)
+    if pieces.ndim != 3 or (pieces.shape[0], pieces.shape[2]) != shape or not 1 <= pieces.shape[1] <= 6:
+        raise ValueError(f"pieces must have shape ({shape[0]}, P <= 6, {shape[1]}), got shape {pieces.shape}")
+    return np.pad(pieces, ((0, 0), (0, 6 - pieces.shape[1]), (0, 0)))
+
+
 class HermiteLaw:
     """A joint time law tabulated at knots, between them the quintic Hermite polynomial that meets
     q, q̇ and q̈ at both ends (so q̈ is continuous except where the samples on both sides of a
@@ -69,9 +78,14 @@ class HermiteLaw:
         left: (q, q̇, q̈) just before each knot, (K, 3, n); row 0 is not used. Where the law is
             continuous it equals ``right``.
         acceleration_jumps: the knots where q̈ jumps (for :class:`TimeLawPlanner`).
+        pieces: the law's own pieces where they are known, monomial coefficients (K-1, P <= 6, n)
+            in tau - knots[k] (a timed motion whose pieces were checked): the law is then exactly
+            them, and ``right`` and ``left`` give only its start and end. The Hermite
+            interpolation through the knots' states brings the round-off of q (eps |q|) into q⃛
+            as up to 60 eps |q| / h³: hundreds of rad/s³ on a 4 µs piece.
     """
 
-    def __init__(self, knots, right, left, acceleration_jumps=()):
+    def __init__(self, knots, right, left, acceleration_jumps=(), *, pieces=None):
         knots = np.asarray(knots, dtype=float)
         right, left = np.asarray(right, dtype=float), np.asarray(left, dtype=float)
         if knots.ndim != 1 or len(knots) < 2 or np.any(np.diff(knots) <= 0) or knots[0] != 0.0:
@@ -80,7 +94,8 @@ class HermiteLaw:
         self.duration = float(knots[-1])
         self.q_start = right[0, 0].copy()
         self.acceleration_jumps = np.asarray(acceleration_jumps, dtype=float)
-        self._coefficients = quintic_hermite_coefficients(knots, right, left)
+        self._coefficients = quintic_hermite_coefficients(knots, right, left) if pieces is None else _as_quintics(
+            pieces, (len(knots) - 1, right.shape[2]))
         # (q̇, q̈) at s as one product, powers (1, s, s², s³, s⁴) @ [j c_j | j (j - 1) c_j]: (K-1, 5, 2n)
         first = np.arange(1, 6)[None, :, None] * self._coefficients[:, 1:]
         second = np.arange(1, 5)[None, :, None] * first[:, 1:]

@@ -30,8 +30,9 @@ class SmoothTiming:
     """The timed motion.
 
     Attributes:
-        law: the motion as a time law (:class:`HermiteLaw`, quintic pieces between ``knots``)
-            for a :class:`~drake_traj.planners.base.TimeLawPlanner`.
+        law: the motion as a time law (:class:`HermiteLaw` whose pieces are ``coefficients``,
+            those checked, between its ``knots``) for a
+            :class:`~drake_traj.planners.base.TimeLawPlanner`.
         coefficients: the pieces' monomial coefficients in t - knots[k], (K - 1, 6, n).
         trajectory: the same motion as Drake's PiecewisePolynomial q(t) [rad], t in [0, duration]
             (made on first use).

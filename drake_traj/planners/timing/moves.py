@@ -84,9 +84,12 @@ def _ruckig_states(law: RuckigStopLaw, max_duration: float) -> tuple[np.ndarray,
 def _exact_timing(knots, states, jerk, limits, path) -> SmoothTiming:
     """The SmoothTiming of the cubic pieces from ``states`` (K, q/q̇/q̈, n) at ``knots`` with
     constant ``jerk`` (K - 1, n) between, along ``path`` (None: the motion itself), stretched in
-    time where Ruckig's profile exceeds a limit by its rounding (the jerk by up to 5e-6 of it)."""
+    time where Ruckig's profile exceeds a limit by its rounding (the jerk by up to 5e-6 of it). The
+    law is these pieces (a Hermite quintic through the states would turn their round-off into
+    jerk on Ruckig's shortest phases, microseconds long)."""
     coefficients = np.zeros((len(knots) - 1, 6, states.shape[2]))
     coefficients[:, :3] = states[:-1] / np.array([1.0, 1.0, 2.0])[None, :, None]
     coefficients[:, 3] = jerk / 6
     knots, states, coefficients, ratio, stretch = stretched(knots, states, coefficients, np.stack(limits), 1e-9)
-    return SmoothTiming(HermiteLaw(knots, states, states), coefficients, float(knots[-1]), path, stretch, ratio, 0.0, 0)
+    law = HermiteLaw(knots, states, states, pieces=coefficients)
+    return SmoothTiming(law, coefficients, float(knots[-1]), path, stretch, ratio, 0.0, 0)

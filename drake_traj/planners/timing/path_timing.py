@@ -204,5 +204,5 @@ def _time_path(path, velocity_limit, acceleration_limit, jerk_limit=None, *, gri
         raise InfeasibleTimingError(
             f"the timed motion leaves the path by {deviation:.3g} rad > {PATH_TOLERANCE:g} rad (grid_points "
             f"{grid_points} too few for this path's curvature: give more)", field=("path",))
-    law = HermiteLaw(t, joint_samples, joint_samples)
+    law = HermiteLaw(t, joint_samples, joint_samples, pieces=coefficients)  # the checked pieces themselves
     return SmoothTiming(law, coefficients, float(t[-1]), path, stretch, ratio, deviation, solved)
