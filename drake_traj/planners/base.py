@@ -8,9 +8,11 @@ Every planner is a LeafSystem with
   relaxation (eq. 18 of Pająk 2024), a group ``finish`` = [the time the task finished, NaN
   before] that subclasses record from their own update events, plus planner-specific discrete
   groups declared by subclasses;
-- output ports ``desired_state`` [q; qd], ``desired_acceleration`` qdd, ``scaling`` c and
-  ``acceleration_and_scaling`` [qdd; c] (both from one Python call per evaluation: the station
-  splits it with a C++ ``Demultiplexer`` for the plant and the loggers);
+- output ports ``desired_state`` [q; qd] (the continuous state; a :class:`TimeLawPlanner`'s qd
+  is its law's), ``desired_acceleration`` qdd, ``scaling`` c,
+  ``acceleration_and_scaling`` [qdd; c] and ``reference_and_scaling`` [q; qd; qdd; c] (all from
+  one Python call per evaluation: the station splits the last with a C++ ``Demultiplexer`` for
+  the plant and the loggers);
 - an optional input port ``speed_override`` (a value in [0, 1]; unconnected means 1).
 
 At the simulator's initialization a planner in a station checks that its plan was accepted by
@@ -92,10 +94,11 @@ class PlannerSystem(LeafSystem):
         )
         self.finish_state_index = self.DeclareDiscreteState(np.array([np.nan]))
         self.speed_override_port = self.DeclareVectorInputPort("speed_override", 1)
-        self.DeclareStateOutputPort("desired_state", ContinuousStateIndex(0))  # [q; q̇], no Python call
+        self._declare_desired_state()
         self.DeclareVectorOutputPort("desired_acceleration", n, self._calc_desired_acceleration)
         self.DeclareVectorOutputPort("scaling", 1, self._calc_scaling_output)
         self.DeclareVectorOutputPort("acceleration_and_scaling", n + 1, self._calc_acceleration_and_scaling)
+        self.DeclareVectorOutputPort("reference_and_scaling", 3 * n + 1, self._calc_reference_and_scaling)
         self._evaluation = self.DeclareCacheEntry(
             "reference acceleration and scaling [qdd; c]",
             ValueProducer(allocate=AbstractValue.Make(BasicVector(n + 1)).Clone, calc=self._calc_evaluation),
@@ -223,6 +226,11 @@ class PlannerSystem(LeafSystem):
         """The scaling coefficient c at the context's time (cached :meth:`evaluate`)."""
         return float(self._evaluation.Eval(context).get_value()[self.num_joints])
 
+    def _declare_desired_state(self) -> None:
+        """The ``desired_state`` output port: the continuous state [q; q̇] (a state output port, no
+        Python call)."""
+        self.DeclareStateOutputPort("desired_state", ContinuousStateIndex(0))
+
     def _calc_evaluation(self, context, value):
         acceleration, scaling = self.evaluate(context)
         vector = value.get_mutable_value()
@@ -241,11 +249,16 @@ class PlannerSystem(LeafSystem):
     def _calc_acceleration_and_scaling(self, context, output):
         output.SetFromVector(self._evaluation.Eval(context).get_value())
 
+    def _calc_reference_and_scaling(self, context, output):
+        output.SetFromVector(np.concatenate((self.reference_state(context), self._evaluation.Eval(context).get_value())))
+
 
 class _Rates(NamedTuple):
     """A time-law planner's rates at one instant (views of one read-only array)."""
 
     derivatives: np.ndarray  # d/dt [q; q̇] = [q_law'(tau) c; q̈], (2n,)
+    velocity: np.ndarray  # q̇ = q_law'(tau) c [rad/s], (n,): the reference's (``desired_state``)
+    velocity_acceleration_and_scaling: np.ndarray  # [q̇; q̈; c], (2n + 1,): all of the values
     acceleration: np.ndarray  # q̈ = q_law'' c² + q_law' ċ [rad/s²], (n,)
     acceleration_and_scaling: np.ndarray  # [q̈; c], (n + 1,)
     scaling: float  # c
@@ -267,15 +280,23 @@ class TimeLawPlanner(PlannerSystem):
     :mod:`drake_traj.planners.laws.scaling`), and never faster than the joint acceleration limits
     allow at that point of the law (checked at both ends of the period).
 
-    The Simulator integrates the reference [q; qd] from the law's rates, q' = q_law'(tau) c and
+    The Simulator integrates the state [q; qd] from the law's rates, q' = q_law'(tau) c and
     qd' = qdd (so q follows the law's own velocity, not the integrated one). Where the law's
     acceleration jumps (its ``acceleration_jumps``, law times; None: anywhere), a fixed step
     integrates the jump with an error that would stay: the update after it sets the reference
     back on the law, (q_law(tau), q_law'(tau) c), as does every update that changes the clock,
     and the one that records the exact finish time (so the motion ends exactly at the law's end). While c is at its goal and nothing jumps, the update changes
     nothing. The rates depend on the time and the clock only, and the last ones are kept by that
-    key (:meth:`_rates`): the derivatives, both outputs and the update of one step share one law
+    key (:meth:`_rates`): the derivatives, the outputs and the update of one step share one law
     evaluation.
+
+    The ``desired_state`` output (and :meth:`reference_state`) is [q; q_law'(tau) c]: q the
+    integrated state, q̇ the law's own velocity on the clock (the one q integrates), not the
+    integrated q̇. A logger samples the output at the end of an integrator step, before the
+    update at that time (Drake publishes before it updates), so an integrated q̇ would carry the
+    step's error into the log and the plant: up to h |Δq̈| / 2 after a jump of q̈ (MoveJ's ramps),
+    h²/8 per jump of the jerk (Ruckig's phases), past the velocity limit where the law runs at
+    it. The law's q̇ keeps the limits the planner promises at every sample, as q̈ (the law's) does.
 
     The ``scaling`` output is c, or c_law(tau) × c for a law with a scaling of its own
     (``law.scaling_at(tau)``, the Pająk plan's coefficient of eq. 17-18).
@@ -363,8 +384,24 @@ class TimeLawPlanner(PlannerSystem):
             values = np.concatenate((qd_law * c, qdd_law * c**2 + qd_law * c_rate, (scaling,)))
             values.flags.writeable = False
             n = self.num_joints
-            self._kept = (key, _Rates(values[: 2 * n], values[n : 2 * n], values[n:], scaling))
+            self._kept = (key, _Rates(values[: 2 * n], values[:n], values, values[n : 2 * n], values[n:], scaling))
         return self._kept[1]
+
+    def _declare_desired_state(self) -> None:
+        """``desired_state`` [q; q_law'(tau) c]: q the integrated state, q̇ the law's (class docstring)."""
+        self.DeclareVectorOutputPort("desired_state", 2 * self.num_joints, self._calc_desired_state)
+
+    def _integrated_positions(self, context) -> np.ndarray:
+        """q [rad] of the continuous state, (n,)."""
+        return context.get_continuous_state_vector().CopyToVector()[: self.num_joints]
+
+    def reference_state(self, context) -> np.ndarray:
+        """[q [rad]; q̇ [rad/s]] of the reference, shape (2n,): the integrated q and the law's
+        q̇ = q_law'(tau) c (the ``desired_state`` output)."""
+        return np.concatenate((self._integrated_positions(context), self._rates(context).velocity))
+
+    def _calc_desired_state(self, context, output):
+        output.SetFromVector(self.reference_state(context))
 
     def evaluate(self, context) -> tuple[np.ndarray, float]:
         rates = self._rates(context)
@@ -387,6 +424,10 @@ class TimeLawPlanner(PlannerSystem):
 
     def _calc_acceleration_and_scaling(self, context, output):
         output.SetFromVector(self._rates(context).acceleration_and_scaling)
+
+    def _calc_reference_and_scaling(self, context, output):
+        rates = self._rates(context).velocity_acceleration_and_scaling
+        output.SetFromVector(np.concatenate((self._integrated_positions(context), rates)))
 
     def finished(self, context) -> bool:
         return self._clock(context)[0] >= self._finish_tau()

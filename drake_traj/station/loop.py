@@ -19,9 +19,9 @@ dynamics M(q) q̈_ref + C(q, q̇) q̇ - τ_g(q) (Drake's ``InverseDynamics``). O
 Python system in the per-step path; the TCP pose is an output computed when asked for, and the
 result computes it from the logged states after the run.
 
-Subsystems by name: ``planner``, ``plant``, ``scene_graph``, ``acceleration_and_scaling`` (a
-``Demultiplexer`` of the planner's [q̈; c] port: one Python call per step serves the plant, the
-loggers and the exported ports), ``lookahead_mux`` and ``lookahead`` (the one-step lookahead),
+Subsystems by name: ``planner``, ``plant``, ``scene_graph``, ``reference_and_scaling`` (a
+``Demultiplexer`` of the planner's [q; q̇; q̈; c] port: one Python call per step serves the plant,
+the loggers and the exported ports), ``lookahead_mux`` and ``lookahead`` (the one-step lookahead),
 ``feedforward`` (inverse dynamics), ``tcp_pose``, the loggers of
 :data:`drake_traj.results.result.LOGGERS` and, with Meshcat, ``visualizer``. The station's exported ports
 are declared in :func:`build_station`'s docstring.
@@ -193,10 +193,11 @@ def add_robot_plant(builder: DiagramBuilder, planner: PlannerSystem, config: Sta
 
 
 def add_planner_with_lookahead(builder: DiagramBuilder, planner: PlannerSystem, plant: MultibodyPlant, instance,
-                               time_step: float) -> tuple[OutputPort, OutputPort]:
-    """The planner, named ``planner``, its [q̈; c] split (one Python call per step, split in C++
-    for the plant and the loggers) and its reference one plant step ``time_step`` [s] ahead on the
-    plant's desired-state input. Returns the split's q̈ [rad/s²] and c ports."""
+                               time_step: float) -> tuple[OutputPort, OutputPort, OutputPort]:
+    """The planner, named ``planner``, its [q; q̇; q̈; c] split (one Python call per step, split in
+    C++ for the plant and the loggers) and its reference one plant step ``time_step`` [s] ahead on
+    the plant's desired-state input. Returns the split's [q; q̇] [rad, rad/s], q̈ [rad/s²] and c
+    ports."""
     n = planner.num_joints
     planner.set_name("planner")
     builder.AddSystem(planner)
@@ -205,14 +206,14 @@ def add_planner_with_lookahead(builder: DiagramBuilder, planner: PlannerSystem, 
     zero = np.zeros((n, n))
     lookahead = builder.AddNamedSystem("lookahead", MatrixGain(np.block([[eye, h * eye, 0.5 * h * h * eye],
                                                                            [zero, eye, h * eye]])))
-    split = builder.AddNamedSystem("acceleration_and_scaling", Demultiplexer([n, 1]))
-    builder.Connect(planner.GetOutputPort("acceleration_and_scaling"), split.get_input_port())
-    acceleration, scaling = split.get_output_port(0), split.get_output_port(1)
-    builder.Connect(planner.GetOutputPort("desired_state"), mux.get_input_port(0))
+    split = builder.AddNamedSystem("reference_and_scaling", Demultiplexer([2 * n, n, 1]))
+    builder.Connect(planner.GetOutputPort("reference_and_scaling"), split.get_input_port())
+    reference, acceleration, scaling = (split.get_output_port(k) for k in range(3))
+    builder.Connect(reference, mux.get_input_port(0))
     builder.Connect(acceleration, mux.get_input_port(1))
     builder.Connect(mux.get_output_port(), lookahead.get_input_port())
     builder.Connect(lookahead.get_output_port(), plant.get_desired_state_input_port(instance))
-    return acceleration, scaling
+    return reference, acceleration, scaling
 
 
 def add_feedforward(builder: DiagramBuilder, plant: MultibodyPlant, instance, gains: ControllerGains,
@@ -303,11 +304,11 @@ def add_station(
                             log_period=log_period, meshcat=meshcat, cell=cell, cell_directory=cell_directory,
                             before_finalize=before_finalize, check_motion=check_motion)
     plant, scene_graph, instance = add_robot_plant(builder, planner, config)
-    acceleration, scaling = add_planner_with_lookahead(builder, planner, plant, instance, config.time_step)
+    reference, acceleration, scaling = add_planner_with_lookahead(builder, planner, plant, instance, config.time_step)
     add_feedforward(builder, plant, instance, config.gains, acceleration)
     tcp = add_tcp_pose(builder, config.robot, plant, instance)
     loggers = add_loggers(builder, {
-        "reference_logger": planner.GetOutputPort("desired_state"),
+        "reference_logger": reference,
         "acceleration_logger": acceleration,
         "scaling_logger": scaling,
         "measured_logger": plant.get_state_output_port(instance),
@@ -353,10 +354,9 @@ def build_station(planner: PlannerSystem, **kwargs) -> Diagram:
     parts = add_station(builder, planner, **kwargs)
     builder.ExportInput(planner.GetInputPort("speed_override"), "speed_override")
     builder.ExportInput(parts.plant.get_applied_generalized_force_input_port(), "applied_generalized_force")
-    builder.ExportOutput(planner.GetOutputPort("desired_state"), "desired_state")
-    split = builder.GetSubsystemByName("acceleration_and_scaling")
-    builder.ExportOutput(split.get_output_port(0), "desired_acceleration")
-    builder.ExportOutput(split.get_output_port(1), "scaling")
+    split = builder.GetSubsystemByName("reference_and_scaling")
+    for k, name in enumerate(("desired_state", "desired_acceleration", "scaling")):
+        builder.ExportOutput(split.get_output_port(k), name)
     builder.ExportOutput(parts.plant.get_state_output_port(parts.instance), "measured_state")
     builder.ExportOutput(parts.plant.get_net_actuation_output_port(parts.instance), "torque")
     builder.ExportOutput(parts.tcp_pose.get_output_port(), "tcp_pose")
