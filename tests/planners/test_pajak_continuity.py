@@ -14,7 +14,10 @@ import pytest
 
 from drake_traj.bench import pajak_walk_tasks
 from drake_traj.planners import pajak as P
-from drake_traj.planners.pajak.system import coming_to_rest
+from drake_traj.bench.soak_tasks import draw_task
+from drake_traj.planners.pajak.system import coming_to_rest, stop_duration
+from drake_traj.planners.laws.hermite import quintic_hermite_coefficients
+from drake_traj.scenario import make_planner, preflight
 
 Q0 = P.paper_initial_configuration()
 DENSE = 1e-4  # [s] between samples of the plan
@@ -94,6 +97,56 @@ def test_coming_to_rest_keeps_the_jerk_and_acceleration_limits():
         assert np.allclose(displacement, qd * duration + qdd * duration ** 2 / 2 + c3 * duration ** 3
                            + c4 * duration ** 4, atol=1e-12)
         assert np.abs(jerk).max() <= 80.0 + 1e-9 and np.all(np.abs(acceleration) <= qdd_max + 1e-9)
+
+
+@pytest.mark.parametrize("seed, free_error", [(97, 1.19e-3), (172, 2.91e-3)])
+def test_a_wandering_law_comes_to_rest_at_the_goal(seed, free_error):
+    # soak tasks whose law wanders near a shoulder singularity (measure 0.01-0.04) at 0.1-0.3
+    # rad/s more than 4 s after its finish: the stop from there with its end free came to rest
+    # 1.19 and 2.91 mm from the last waypoint (Drake's FK; accuracy 1 mm), now within it
+    task = draw_task("ur10e", "pajak", seed)
+    planner = make_planner(task.scenario)
+    preflight(task.scenario, planner)
+    plan, law, run = planner.plan(), planner.pajak_law, planner._run
+    assert np.abs(run["qd"][-1]).max() > 0.01  # still moving where the preflight ends
+    goal, robot = law.waypoints[-1], task.scenario.robot_with_tool()
+    position, orientation = law.kinematics.pose_error(robot.tcp_pose(plan.value(plan.end_time()).ravel()), goal)
+    assert position < law.parameters.accuracy and orientation < law.parameters.orientation_accuracy
+    shortest, displacement = coming_to_rest(run["qd"][-1], run["qdd"][-1], law.parameters.jerk_limit, law.qdd_max)
+    free, _ = law.kinematics.pose_error(robot.tcp_pose(run["q"][-1] + displacement), goal)
+    assert free == pytest.approx(free_error, abs=0.01e-3)
+    # at rest there, the finish (Table 2's kind of time) as before: the tail keeps the limits
+    np.testing.assert_allclose(plan.derivative(1).value(plan.end_time()).ravel(), 0.0, atol=1e-12)
+    times = np.linspace(plan.end_time() - 2.0, plan.end_time(), 20_001)
+    within_limits(planner, plan.derivative(1).vector_values(times).T, plan.derivative(2).vector_values(times).T)
+    end = planner._rest_index() + 1
+    samples = np.stack([run[name][:end] for name in ("q", "qd", "qdd")], axis=1)
+    unslowed = planner._within_limits(run["t"][:end], samples, run["c"][:end])[3]
+    assert planner.planned_duration() == pytest.approx(run["T"] / unslowed, rel=1e-12)
+
+
+def test_a_stop_to_a_fixed_end_keeps_the_limits_and_is_the_shortest_on_its_grid():
+    rng = np.random.default_rng(1)
+    qd_max, qdd_max = np.full(6, 0.6), np.full(6, 1.4)
+    for _ in range(50):
+        qd, qdd = rng.uniform(-0.4, 0.4, 6), rng.uniform(-1.0, 1.0, 6)
+        shortest, displacement = coming_to_rest(qd, qdd, 80.0, qdd_max)
+        moved = displacement + rng.uniform(-0.05, 0.05, 6)
+        duration = stop_duration(qd, qdd, moved, shortest, 80.0, qd_max, qdd_max)
+        assert duration >= shortest
+
+        def peaks(length):
+            samples = np.stack([[np.zeros(6), qd, qdd], [moved, np.zeros(6), np.zeros(6)]])
+            c = quintic_hermite_coefficients([0.0, length], samples, samples)[0]
+            s = np.linspace(0.0, length, 4001)[:, None]
+            velocity = c[1] + 2 * c[2] * s + 3 * c[3] * s ** 2 + 4 * c[4] * s ** 3 + 5 * c[5] * s ** 4
+            acceleration = 2 * c[2] + 6 * c[3] * s + 12 * c[4] * s ** 2 + 20 * c[5] * s ** 3
+            jerk = 6 * c[3] + 24 * c[4] * s + 60 * c[5] * s ** 2
+            return np.max(np.abs(velocity) / qd_max), np.max(np.abs(acceleration) / qdd_max), np.abs(jerk).max() / 80
+
+        assert max(peaks(duration)) <= 1.0 + 1e-9
+        if duration > shortest:  # one grid step shorter passes a limit
+            assert max(peaks(duration / 1.02)) > 1.0 - 1e-3
 
 
 def test_a_seeded_set_of_moves_of_1_rad():

@@ -16,13 +16,15 @@ from drake_traj.planners.pajak.config import PajakConfig
 from drake_traj.robots import UR10E, Robot
 from drake_traj.validation import finite_array, invalid, run_duration
 
-__all__ = ["MAX_PREFLIGHT_STEPS", "PajakPlanLaw", "PajakPlanner", "coming_to_rest", "make"]
+__all__ = ["MAX_PREFLIGHT_STEPS", "PajakPlanLaw", "PajakPlanner", "coming_to_rest", "make", "stop_duration"]
 
 # The preflight's integration steps at most: its log holds Log.SIZE values a step (60: 480 MB at
 # this bound; 600 s, the longest run, at the default 1 ms update period is 6e5 steps)
 MAX_PREFLIGHT_STEPS = 1_000_000
 SETTLE_TIME = 4.0  # [s] the law integrated on after the finish, while it settles (sim 3: 1e-6 rad/s after 2.6 s)
 REST_SPEED = 1e-6  # [rad/s] the planned motion ends where every joint is slower: at rest
+GOAL_MARGIN = 0.5  # the stop after a wandering law ends within this fraction of accuracy and orientation_accuracy
+STOP_STRETCH = 1.02  # the stop's duration grows by this factor until its piece keeps the limits
 
 
 def coming_to_rest(qd: np.ndarray, qdd: np.ndarray, jerk: float, qdd_max: np.ndarray) -> tuple[float, np.ndarray]:
@@ -42,6 +44,31 @@ def coming_to_rest(qd: np.ndarray, qdd: np.ndarray, jerk: float, qdd_max: np.nda
     c4 = (qd + 0.5 * qdd * duration) / (2.0 * duration ** 3)
     c3 = -(qdd + 12.0 * c4 * duration ** 2) / (6.0 * duration)
     return duration, duration * (qd + duration * (0.5 * qdd + duration * (c3 + duration * c4)))
+
+
+def stop_duration(qd: np.ndarray, qdd: np.ndarray, displacement: np.ndarray, shortest: float, jerk: float,
+                  qd_max: np.ndarray, qdd_max: np.ndarray) -> float:
+    """The shortest T [s] >= ``shortest`` (on a grid of ratio :data:`STOP_STRETCH`) of the quintic
+    Hermite piece from (0, q̇, q̈) [rad, rad/s, rad/s²] (n,) to (``displacement``, 0, 0) [rad]
+    that keeps |q̇| <= ``qd_max``, |q̈| <= ``qdd_max`` (exact peaks, :meth:`HermiteLaw.peak_rates`)
+    and its jerk (a quadratic in time) within ``jerk`` [rad/s³]. From :func:`coming_to_rest`'s T:
+    a stop whose end is moved off that quartic's free end needs longer (0.15-0.77 s on the soak
+    tasks, up to 0.13 rad moved on a walk task that was almost at rest: 0.016 s to 0.85 s)."""
+    start = np.stack([np.zeros_like(qd), qd, qdd])
+    end = np.stack([displacement, np.zeros_like(qd), np.zeros_like(qd)])
+    duration = shortest
+    for _ in range(1000):  # T up to 4e8 times ``shortest``
+        samples = np.stack([start, end])
+        velocity_peak, acceleration_peak = HermiteLaw(np.array([0.0, duration]), samples, samples).peak_rates()
+        c = quintic_hermite_coefficients(np.array([0.0, duration]), samples, samples)[0]
+        times = [0.0, duration]
+        vertex = np.divide(-24.0 * c[4], 120.0 * c[5], out=np.full_like(c[5], -1.0), where=c[5] != 0.0)
+        jerk_peak = max(np.abs(6.0 * c[3] + 24.0 * c[4] * s + 60.0 * c[5] * s * s).max()
+                        for s in (*times, np.clip(vertex, 0.0, duration)))
+        if np.all(velocity_peak <= qd_max) and np.all(acceleration_peak <= qdd_max) and jerk_peak <= jerk:
+            return float(duration)
+        duration *= STOP_STRETCH
+    raise ValueError(f"no stop within the limits up to {duration:g} s")  # pragma: no cover - limits > 0
 
 
 class PajakPlanLaw:
@@ -177,7 +204,9 @@ class PajakPlanner(TimeLawPlanner):
         goal near a singular J, where the damped least squares leave a direction of the joints
         undamped: 2 of 250 tasks of moves of 1 rad per joint), the motion ends with a stop from
         its last sample (:func:`coming_to_rest`, within the jerk and acceleration limits), one
-        more sample: cut there, q̇ and q̈ jumped to 0 (q̈ by up to 0.2 rad/s² on those tasks)."""
+        more sample: cut there, q̇ and q̈ jumped to 0 (q̈ by up to 0.2 rad/s² on those tasks).
+        The stop ends at the goal (:meth:`_goal_configuration`): with its end free it moved on along
+        the wandering and came to rest up to 2.9 mm from the last waypoint (soak seeds 97-249)."""
         if self._planned is None:
             end = self._rest_index() + 1
             times = self._run["t"][:end]
@@ -185,13 +214,41 @@ class PajakPlanner(TimeLawPlanner):
             scaling = self._run["c"][:end]
             q, qd, qdd = samples[-1]
             if np.abs(qd).max() > REST_SPEED:
-                duration, displacement = coming_to_rest(qd, qdd, self.pajak_law.parameters.jerk_limit,
-                                                        self.pajak_law.qdd_max)
+                law = self.pajak_law
+                shortest, displacement = coming_to_rest(qd, qdd, law.parameters.jerk_limit, law.qdd_max)
+                rest = self._goal_configuration(q + displacement)
+                duration = stop_duration(qd, qdd, rest - q, shortest, law.parameters.jerk_limit,
+                                         law.qd_max if law.parameters.limit_velocity else np.full(len(q), np.inf),
+                                         law.qdd_max)
                 times = np.append(times, times[-1] + duration)
-                samples = np.concatenate([samples, [[q + displacement, np.zeros_like(q), np.zeros_like(q)]]])
+                samples = np.concatenate([samples, [[rest, np.zeros_like(q), np.zeros_like(q)]]])
                 scaling = np.append(scaling, scaling[-1])
             self._planned = self._within_limits(times, samples, scaling)
         return self._planned
+
+    def _goal_configuration(self, q: np.ndarray) -> np.ndarray:
+        """Joint positions [rad] near ``q`` where the TCP is at the last waypoint, within
+        :data:`GOAL_MARGIN` of accuracy and orientation_accuracy: Gauss-Newton steps on the pose
+        error with J of eq. 13 (undamped: its least singular value, 0.01-0.03 on the wandering
+        tasks, is the direction the error lies in, which the damping of improvement 3 would
+        hold back); ``q`` where it is there already, the nearest reached where the steps do not
+        get there."""
+        law, kinematics = self.pajak_law, self.pajak_law.kinematics
+        parameters, goal = law.parameters, law.waypoints[-1]
+        pose, jac, bias = np.empty(6), np.empty((6, 6)), np.empty(6)
+        best, best_error = q, np.inf
+        for _ in range(20):
+            kinematics.kinematics_into(kinematics.model, q, np.zeros(6), kinematics.tool, pose, jac, bias)
+            position, orientation = kinematics.pose_error(pose, goal)
+            error = max(position / parameters.accuracy, orientation / parameters.orientation_accuracy)
+            if error < best_error:
+                best, best_error = q, error
+            if error <= GOAL_MARGIN:
+                break
+            offset = pose - goal
+            offset[3:] = kinematics.wrap_angle(offset[3:])
+            q = q - np.linalg.lstsq(jac, offset, rcond=None)[0]
+        return best
 
     def _within_limits(self, times, samples, scaling) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
         """(times [s], samples, c, rate): the law's samples (t, (q, q̇, q̈) (K, 3, n), c (K,)) on a
