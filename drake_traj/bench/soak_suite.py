@@ -46,9 +46,8 @@ CLOSED_LOOP_EVERY = 50
 SOAK_COLUMNS = (
     "arm", "planner", "seed", "outcome", "silent_wrong", "wrong", "cause", "field", "diagnosis", "T_s",
     "velocity_fraction", "acceleration_fraction", "jerk_fraction", "tool_speed_fraction", "tool_acceleration_fraction",
-    "range_excess_rad", "goal_error",
-    "goal_tolerance", "least_distance_m", "clearance_m", "uncertified_intervals", "closed_loop", "planning_s",
-    "check_s", "message", "params", "rerun",
+    "range_excess_rad", "goal_error", "goal_tolerance", "least_distance_m", "clearance_m", "uncertified_intervals",
+    "closed_loop", "planning_s", "check_s", "message", "params", "rerun",
 )
 
 
@@ -172,7 +171,7 @@ def _check_plan(task, planner) -> tuple[dict, list[str]]:
     values["range_excess_rad"] = excess
     if excess > 0:
         wrongs.append(f"a joint {excess:.3g} rad past its range")
-    wrongs += _goal(task, planner, q[-1], rates[1][-1], clearance, values)
+    wrongs += _goal(task, q[-1], rates[1][-1], clearance, values)
     bound = scenario.cell.clearance / 2
     along = clearance.along(times, q, bound)
     values |= {"least_distance_m": along["least"], "clearance_m": scenario.cell.clearance,
@@ -197,7 +196,7 @@ def _tool_limits(scenario, robot, clearance, rates, values) -> list[str]:
     return wrongs
 
 
-def _goal(task, planner, q_end, qd_end, clearance, values) -> list[str]:
+def _goal(task, q_end, qd_end, clearance, values) -> list[str]:
     """The goal's check: the error and its tolerance in ``values``; what is wrong."""
     config = task.scenario.planner
     if task.planner in ("pajak", "pajak_retimed"):

@@ -6,7 +6,8 @@
     drake-traj robots
     drake-traj show [SCENARIO] [--variant NAME] [--where]
     drake-traj export RUN_DIR --format csv|urscript|ros2 [--period 0.002] [--out FILE]
-    drake-traj bench [--out DIR] [--overwrite] [--count N] [--seed S] [--repeats R]
+    drake-traj bench [--suite planners|free|soak] [--out DIR] [--overwrite] [--count N] [--seed S] [--repeats R]
+                     [--workers W | --scheduler ADDRESS] [--arms ARM ...] [--planners PLANNER ...] [--merge DIR ...]
 
 ``run`` writes DIR/result.npz, metrics.json, *.png, meshcat.html and run.json (the manifest);
 SCENARIO is a YAML file or the name of a shipped scenario (``drake-traj list``: the shipped
@@ -16,7 +17,9 @@ scenarios under their files, with their robots; ``-v``: which copy of the files 
 file of one scenario, to copy. ``export``
 writes a run's reference for a robot or another tool (drake_traj.results.exports). ``bench`` runs
 every planner and baseline on Pająk 2024's task and N seeded tasks and writes DIR/bench.csv,
-bench.md and bench.png.
+bench.md and bench.png; ``--suite free`` the free-motion planner on seeded scenes; ``--suite soak``
+N seeded random tasks of every planner on every shipped arm, each plan checked independently
+(DIR/soak.csv, soak.md, soak.png; exit 1 if any is wrong).
 
 Exit codes: 0 success; 1 the run failed (its log is kept in the output folder), or its files could
 not be written (disk full, a permission lost: the message names the file; the folder's earlier
