@@ -229,11 +229,13 @@ def plan_peaks(plan, velocity_limit, acceleration_limit, step=1e-4):
             float(np.max(np.abs(qdd) / np.reshape(acceleration_limit, (-1, 1)))))
 
 
-# Soak tasks whose blends broke a limit (paper peak |q̈| / limit, or |q̇| for 28) and one that did not (23).
-SOAK_SEEDS = {1: 1.46, 2: 1.65, 5: 1.31, 7: 1.98, 8: 1.51, 20: 1.59, 26: 1.95, 28: 1.0, 23: 1.0}
+# Soak tasks with blends (drake_traj.bench.soak_tasks.draw_task("ur10e", "movej", seed)): with the
+# controller's superposed blends (keep_limits=False) every one of them breaks the acceleration limit,
+# by 1.07-2.0 times, when drawn as the soak draws them now
+SOAK_SEEDS = (1, 2, 5, 7, 8, 20, 23, 26, 28)
 
 
-@pytest.mark.parametrize("seed", sorted(SOAK_SEEDS))
+@pytest.mark.parametrize("seed", SOAK_SEEDS)
 def test_soak_tasks_keep_both_limits(seed):
     task = draw_task("ur10e", "movej", seed)
     assert task.scenario.planner.blend_radius > 0.0
@@ -241,13 +243,11 @@ def test_soak_tasks_keep_both_limits(seed):
     velocity, acceleration = plan_peaks(planner.plan(), planner.velocity_limit, planner.acceleration_limit)
     assert velocity <= 1 + 1e-6
     assert acceleration <= 1 + 1e-6
-    # the same task with the controller's superposed blends: the violation the soak found
+    # the same task with the controller's superposed blends: the violation the soak found, in less time
     paper = make_planner(replace(task.scenario, planner=replace(task.scenario.planner, keep_limits=False)))
     paper_velocity, paper_acceleration = plan_peaks(paper.plan(), paper.velocity_limit, paper.acceleration_limit)
-    assert paper_acceleration == pytest.approx(max(SOAK_SEEDS[seed], 1.0), abs=0.01)
-    assert paper.law.duration <= planner.law.duration + 1e-12
-    if seed == 28:
-        assert paper_velocity > 1.02  # the overlap ran past the ramps: a cruise plus a start
+    assert paper_acceleration > 1.05
+    assert paper.law.duration < planner.law.duration
 
 
 def unit_tcp(q):
