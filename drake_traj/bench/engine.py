@@ -95,12 +95,14 @@ class _Progress:
     """Runs done, failed and the time left: a tqdm bar on a terminal; on another stream (a log
     file, CI) a line at the first run to end :data:`LOG_INTERVAL` after the last line (a run
     takes seconds: a log is never silent much longer); nothing when the stream is None. A first
-    line says how many runs there are and where they run. ``unit`` names a run and ``bad`` what a
-    row that did not succeed is (the soak: "task", "wrong")."""
+    line says how many runs there are and where they run. ``unit`` names a run, ``bad`` what a row
+    that did not succeed is, and ``failed(row)`` tells one (the soak: "task", "wrong", a wrong row;
+    the free suite: a query not solved)."""
 
-    def __init__(self, total: int, stream, where: str, unit: str = "run", bad: str = "failed"):
+    def __init__(self, total: int, stream, where: str, unit: str = "run", bad: str = "failed",
+                 failed=lambda row: not row["succeeded"]):
         self._stream = stream
-        self._unit, self._bad = unit, bad
+        self._unit, self._bad, self._failed = unit, bad, failed
         terminal = stream is not None and getattr(stream, "isatty", lambda: False)()
         self._lines = stream is not None and not terminal
         if stream is not None:
@@ -113,7 +115,7 @@ class _Progress:
     def done(self, row) -> dict:
         """Count ``row``'s run; returns the row."""
         self.count += 1
-        self.failed += not row["succeeded"]
+        self.failed += bool(self._failed(row))
         self._bar.set_postfix({self._bad: self.failed}, refresh=False)
         self._bar.update()
         if self._lines and time.monotonic() - self._said >= LOG_INTERVAL and self.count < self.total:

@@ -219,7 +219,7 @@ def free_bench(out_dir, *, count: int = 5, seed: int = 0, workers: int | None = 
     work = [(kind, seed + k) for kind in kinds for k in range(count)]
     with _claim_output_directory(out_dir, overwrite, command) as claimed:
         with _engine(workers, scheduler) as client:
-            bar = _Progress(len(work), progress, where(workers, scheduler))
+            bar = _Progress(len(work), progress, where(workers, scheduler), failed=lambda row: not row["solved"])
             try:
                 by_query = _run(client, work, planning_time, bar)
             finally:
@@ -236,20 +236,8 @@ def free_bench(out_dir, *, count: int = 5, seed: int = 0, workers: int | None = 
 
 def _run(client, work, planning_time, bar) -> dict:
     """{(kind, scene seed): row} of every unit of ``work``: in this process (``client`` None) or on
-    Dask; a query not solved counts as failed on the progress ``bar``."""
-    counted = _Solved(bar)
+    Dask, each counted by the progress ``bar``."""
     if client is None:
-        return {unit: counted.done(run_free_query(*unit, planning_time)) for unit in work}
+        return {unit: bar.done(run_free_query(*unit, planning_time)) for unit in work}
     futures = {client.submit(run_free_query, *unit, planning_time, pure=False): unit for unit in work}
-    return _collect(futures, counted, lambda row: row, lambda unit, reason: _failed(*unit, reason))
-
-
-class _Solved:
-    """The progress ``bar`` of the queries: a row counts as failed where it was not solved."""
-
-    def __init__(self, bar):
-        self._bar = bar
-
-    def done(self, row) -> dict:
-        self._bar.done({"succeeded": row["solved"]})
-        return row
+    return _collect(futures, bar, lambda row: row, lambda unit, reason: _failed(*unit, reason))

@@ -28,11 +28,11 @@ Units: rad, rad/s, rad/s², rad/s³, m, s.
 """
 
 import numpy as np
-from pydrake.geometry import Box, Capsule, Convex, Cylinder, Ellipsoid, Mesh, Sphere
 from pydrake.math import RollPitchYaw
 from pydrake.multibody.tree import JacobianWrtVariable
 
 from drake_traj.bench.free_suite import ClearanceProbe
+from drake_traj.cell import shape_radius
 
 __all__ = ["ClearanceCheck", "LIMIT_TOLERANCE", "axis_reach", "dense_rates", "diagnose", "piece_coefficients", "pose_error",
            "rate_peaks", "tool_rates"]
@@ -137,24 +137,6 @@ def dense_rates(trajectory, period: float = DENSE_PERIOD, pieces=None) -> tuple[
     return times, values
 
 
-def _shape_radius(shape) -> float:
-    """The radius [m] about the shape's frame origin of a sphere holding it (a mesh: its hull)."""
-    if isinstance(shape, Sphere):
-        return shape.radius()
-    if isinstance(shape, Box):
-        return float(np.linalg.norm(shape.size())) / 2
-    if isinstance(shape, Cylinder):
-        return float(np.hypot(shape.radius(), shape.length() / 2))
-    if isinstance(shape, Capsule):
-        return shape.radius() + shape.length() / 2
-    if isinstance(shape, Ellipsoid):
-        return max(shape.a(), shape.b(), shape.c())
-    if isinstance(shape, (Mesh, Convex)):
-        hull = shape.GetConvexHull()
-        return max(float(np.linalg.norm(hull.vertex(k))) for k in range(hull.num_vertices()))
-    raise TypeError(f"the soak's clearance check has no radius for a {type(shape).__name__}")
-
-
 def axis_reach(checker, joint_names) -> np.ndarray:
     """R_j [m] per revolute joint of the arm in the cell check ``checker``'s plant: a bound on
     the distance from joint j's origin (on its axis) of any collision geometry on its child link,
@@ -172,7 +154,7 @@ def axis_reach(checker, joint_names) -> np.ndarray:
             X_OB = origins[j].InvertAndCompose(body.body_frame().CalcPoseInWorld(context))
             for geometry in plant.GetCollisionGeometriesForBody(body):
                 X_OG = X_OB @ inspector.GetPoseInFrame(geometry)
-                extent[j] = max(extent[j], np.linalg.norm(X_OG.translation()) + _shape_radius(inspector.GetShape(geometry)))
+                extent[j] = max(extent[j], np.linalg.norm(X_OG.translation()) + shape_radius(inspector.GetShape(geometry)))
     offsets = [np.linalg.norm(origins[j + 1].translation() - origins[j].translation()) for j in range(len(joints) - 1)]
     reach = np.zeros(len(joints))
     for j in range(len(joints)):
@@ -191,12 +173,9 @@ class ClearanceCheck:
     def __init__(self, robot, cell):
         self.probe = ClearanceProbe(robot, cell)
         self.reach = axis_reach(self.probe.checker, robot.joint_names)
-        self.queries = 0
-        self._cache = {}
 
     def distance(self, q) -> float:
         """SceneGraph's least signed distance [m] at ``q`` (a pair farther than 0.15 m reads as 0.15)."""
-        self.queries += 1
         return self.probe.distance(q, QUERY_WITHIN)
 
     def along(self, times, q, bound: float) -> dict:

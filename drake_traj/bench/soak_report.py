@@ -237,7 +237,8 @@ def soak_bench(out_dir, *, count: int = 10, seed: int = 0, arms=SOAK_ARMS, plann
     work = [(arm, planner, seed + k) for arm in arms for planner in planners for k in range(count)]
     with _claim_output_directory(out_dir, overwrite, command) as claimed:
         began = time.monotonic()
-        bar = _Progress(len(work), progress, where(workers, scheduler), unit="task", bad="wrong")
+        bar = _Progress(len(work), progress, where(workers, scheduler), unit="task", bad="wrong",
+                        failed=lambda row: row["wrong"])
         by_task = {}
         try:
             # a local cluster is made afresh for every LOCAL_CHUNK tasks (what pydrake leaks: _release)
@@ -272,20 +273,8 @@ def _failed(unit, reason: str) -> dict:
 
 def _run(client, work, bar) -> dict:
     """{(arm, planner, seed): row} of every task of ``work``, in this process (``client`` None) or
-    on Dask; a wrong row counts as failed on the progress ``bar``."""
-    counted = _Wrong(bar)
+    on Dask, each counted by the progress ``bar``."""
     if client is None:
-        return {unit: counted.done(run_soak_task(*unit)) for unit in work}
+        return {unit: bar.done(run_soak_task(*unit)) for unit in work}
     futures = {client.submit(run_soak_task, *unit, pure=False): unit for unit in work}
-    return _collect(futures, counted, lambda row: row, _failed)
-
-
-class _Wrong:
-    """The progress ``bar`` of the soak: a wrong row counts as failed."""
-
-    def __init__(self, bar):
-        self._bar = bar
-
-    def done(self, row) -> dict:
-        self._bar.done({"succeeded": not row["wrong"]})
-        return row
+    return _collect(futures, bar, lambda row: row, _failed)

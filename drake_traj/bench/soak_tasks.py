@@ -238,10 +238,6 @@ def _pajak_config(rng, arm, robot, start, clear) -> tuple[PajakConfig, dict]:
     return config, {"goals": len(walk) - 1, "blend": blend} | limits
 
 
-def _pajak(rng, arm, robot, start, clear):
-    return _pajak_config(rng, arm, robot, start, clear)
-
-
 def _pajak_retimed(rng, arm, robot, start, clear):
     pajak, params = _pajak_config(rng, arm, robot, start, clear)
     jerk, jerk_params = _jerk(rng, np.full(robot.num_joints, pajak.acceleration_limit))
@@ -301,7 +297,7 @@ def _free(rng, arm, robot, start, clear, seed):
 
 
 DRAWS = {  # soak planner -> its draw (rng, arm, robot with the tool, start, clear) -> (config, params)
-    "quintic": _quintic, "pajak": _pajak, "boryga": _boryga, "li": _li, "smooth_waypoints": _smooth,
+    "quintic": _quintic, "pajak": _pajak_config, "boryga": _boryga, "li": _li, "smooth_waypoints": _smooth,
     "pajak_retimed": _pajak_retimed, "free_motion": _free, "movej": _movej, "ruckig": _ruckig, "toppra": _toppra,
 }
 OBSTACLES = {"free_motion": (2, 6)}  # the planners whose cells have more obstacles than (0, 4)
