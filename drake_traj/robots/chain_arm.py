@@ -14,7 +14,7 @@ import numpy as np
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
-from drake_traj.errors import DrakeTrajError, SingularConfigurationError, joint_label
+from drake_traj.errors import DrakeTrajError, joint_label
 from drake_traj.robots.inertia_estimate import DEFAULT_DENSITY
 from drake_traj.robots.model_files import add_model_file, joint_efforts
 from drake_traj.robots.model_setup import ModelSetup, drake_reason, read_model
@@ -23,7 +23,7 @@ from drake_traj.robots.base import Robot, TaskKinematics, format_point, joint_ac
 from drake_traj.robots.chain import SerialChain, plant_chain, plant_frame
 from drake_traj.robots.chain_kinematics import (NUM_JOINTS, chain_reach, chain_singularity_factors,
                                                 inverse_kinematics_all, inverse_kinematics_near)
-from drake_traj.robots.compiled_kinematics import task_kinematics as arm_kinematics, task_kinematics_into
+from drake_traj.robots.compiled_kinematics import point_motion_rates, task_kinematics as arm_kinematics, task_kinematics_into
 from drake_traj.robots.self_contact import srdf_file
 from drake_traj.robots.task_space import orientation_error, pose_error, wrap_angle, wrapped
 from drake_traj.robots.urdf_writer import dh_table_urdf
@@ -388,16 +388,10 @@ class ChainArm(Robot):
         return min(candidates, key=lambda q: float(np.sum((q - start) ** 2)))
 
     def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
-        """qd = J⁻¹ [v; 0], qdd = J⁻¹ ([a; 0] - J̇q̇) with the TCP's analytic Jacobian (one q);
-        SingularConfigurationError at the Euler angles' gimbal lock."""
-        q = finite_array(q, "q", "rad", shape=(NUM_JOINTS,))
-        _, jacobian, _, cos_pitch, _ = self._kinematics(q, np.zeros(NUM_JOINTS))
-        if cos_pitch < 1e-6:
-            raise SingularConfigurationError(f"Z-Y-X Euler angles are singular at q={np.round(q, 6).tolist()}: "
-                                             "phi_Y is at +-pi/2 (gimbal lock)")
-        qd = np.linalg.solve(jacobian, np.concatenate([v, np.zeros(3)]))
-        bias = self._kinematics(q, qd)[2]
-        return qd, np.linalg.solve(jacobian, np.concatenate([a, np.zeros(3)]) - bias)
+        """qd = J⁻¹ [v; 0], qdd = J⁻¹ ([a; 0] - J̇q̇) with the TCP's analytic Jacobian: q (..., 6),
+        v and a (..., 3) broadcast (:func:`~drake_traj.robots.compiled_kinematics.point_motion_rates`);
+        :class:`~drake_traj.errors.SingularConfigurationError` at the Euler angles' gimbal lock."""
+        return point_motion_rates(self.model, self.tcp_offset, q, v, a)
 
     def task_kinematics(self) -> TaskKinematics:
         """The compiled kinematics of the chain

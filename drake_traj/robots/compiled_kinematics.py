@@ -18,13 +18,15 @@ import math
 import numpy as np
 
 from drake_traj.compiled import compiled, sources_digest
+from drake_traj.errors import SingularConfigurationError
 from drake_traj.robots import chain_kinematics, task_space, ur_closed_form
 from drake_traj.robots.base import FLANGE
 from drake_traj.robots.chain_kinematics import CHAIN, chain_kinematics_into
 from drake_traj.robots.ur_closed_form import UR_CLOSED_FORM
 from drake_traj.robots.ur_closed_form import kinematics_into as ur_kinematics_into
+from drake_traj.validation import finite_array, invalid
 
-__all__ = ["SOURCES", "kinematics_many", "task_kinematics", "task_kinematics_into"]
+__all__ = ["SOURCES", "kinematics_many", "point_motion_rates", "task_kinematics", "task_kinematics_into"]
 
 # The source files of the compiled code behind task_kinematics_into: it and its compiled callers
 # (the Pająk kernel) close over their digest, numba's cache key (drake_traj.compiled).
@@ -95,3 +97,34 @@ def task_kinematics(model, q, qd, tool=FLANGE):
     lead = shape[:-1]
     return (pose.reshape(lead + (6,)), jac.reshape(lead + (6, 6)), bias.reshape(lead + (6,)), cos_pitch.reshape(lead),
             measure.reshape(lead))
+
+
+def point_motion_rates(model, tool, q, v, a) -> tuple[np.ndarray, np.ndarray]:
+    """(q̇ [rad/s], q̈ [rad/s²]) that move the TCP ``tool`` (X_FT) of the arm ``model`` with
+    velocity ``v`` [m/s] and acceleration ``a`` [m/s²] (base frame) at q [rad], its Z-Y-X Euler
+    angles held: q̇ = J⁻¹ [v; 0], q̈ = J⁻¹ ([a; 0] - J̇q̇) with the analytic Jacobian
+    (:func:`task_kinematics`). q (..., 6), v and a (..., 3), broadcast together; each result
+    their shape (..., 6).
+
+    Raises:
+        ValueError: q, v or a not finite or of the wrong shape, named.
+        SingularConfigurationError: φ_Y at ±π/2 (cos φ_Y < 1e-6, gimbal lock) at some q, named.
+    """
+    q, v, a = finite_array(q, "q", "rad"), finite_array(v, "v", "m/s"), finite_array(a, "a", "m/s^2")
+    for name, value, width in (("q", q, 6), ("v", v, 3), ("a", a, 3)):
+        if value.shape[-1:] != (width,):
+            raise invalid(name, f"{name} must have shape (..., {width}), got {value.shape}")
+    lead = np.broadcast_shapes(q.shape[:-1], v.shape[:-1], a.shape[:-1])
+    q = np.broadcast_to(q, lead + (6,))
+    _, jacobian, _, cos_pitch, _ = task_kinematics(model, q, np.zeros_like(q), tool)
+    locked = np.flatnonzero(np.reshape(cos_pitch, -1) < 1e-6)
+    if locked.size:
+        at = np.reshape(q, (-1, 6))[locked[0]]
+        raise SingularConfigurationError(f"Z-Y-X Euler angles are singular at q={np.round(at, 6).tolist()}: "
+                                         "phi_Y is at +-pi/2 (gimbal lock), B(phi) has no inverse")
+    zeros = np.zeros(lead + (3,))
+    twist = np.concatenate([np.broadcast_to(v, lead + (3,)), zeros], axis=-1)
+    qd = np.linalg.solve(jacobian, twist[..., None])[..., 0]
+    bias = task_kinematics(model, q, qd, tool)[2]
+    rate = np.concatenate([np.broadcast_to(a, lead + (3,)), zeros], axis=-1) - bias
+    return qd, np.linalg.solve(jacobian, rate[..., None])[..., 0]

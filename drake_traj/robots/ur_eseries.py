@@ -29,17 +29,17 @@ import numpy as np
 
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError, joint_label
 from drake_traj.robots.base import FLANGE, Robot, TaskKinematics
-from drake_traj.robots.compiled_kinematics import task_kinematics, task_kinematics_into
-from drake_traj.robots.task_space import (is_flange, orientation_error, pose_error, wrap_angle, wrapped,
+from drake_traj.robots.compiled_kinematics import point_motion_rates, task_kinematics, task_kinematics_into
+from drake_traj.robots.task_space import (is_flange, orientation_error, pose_error, rotation_from_zyx_euler, wrap_angle, wrapped,
                                           zyx_euler_from_rotation)
 from drake_traj.robots.ur_closed_form import singularity_measure_many
 from drake_traj.robots.ur_data import (BASE_FRAME, DEFAULT_JOINT_MOVE_ACCELERATION, DEFAULT_JOINT_MOVE_VELOCITY,
                                        DH_ALPHA, FLANGE_FRAME, HOME, JOINT_NAMES, NUM_JOINTS, UR3E_DATA, UR5E_DATA,
                                        UR10E_DATA, UR10E_EFFORT_LIMIT, UR10E_KD, UR10E_KP, UR16E_DATA, UR20_DATA,
                                        UR30_DATA, URData)
-from drake_traj.robots.ur_ik import (IK_BRANCHES, IK_PATH_MAX_STEP, IK_SINGULAR_TOLERANCE, branch_solutions,
+from drake_traj.robots.ur_ik import (IK_BRANCHES, IK_PATH_MAX_STEP, IK_SINGULAR_TOLERANCE, branch_ik_many, branch_solutions,
                                      describe_pose, flange_goal, raise_wrist_singular, unique_rows)
-from drake_traj.validation import invalid, real_array
+from drake_traj.validation import finite_array, invalid, real_array
 
 __all__ = ["UR3E", "UR5E", "UR10E", "UR16E", "UR20", "UR30", "UR_ARMS", "URArm"]
 
@@ -407,23 +407,30 @@ class URArm(Robot):
                 np.einsum("...ij,...j->...i", jacobian[..., :3, :], qdd) + bias[..., :3])
 
     def point_ik(self, points, reference) -> np.ndarray:
-        """IK of TCP positions at the TCP orientation of ``reference``, on its IK branch, each
-        joint within 2 pi of ``reference`` (:meth:`inverse_kinematics`)."""
+        """IK of TCP positions (N, 3) [m] at the TCP orientation of ``reference``, on its IK
+        branch, each joint within 2 pi of ``reference`` (:meth:`inverse_kinematics` of each point:
+        the branch's closed form compiled over the points, :func:`~drake_traj.robots.ur_ik.branch_ik_many`;
+        a point it does not solve goes through :meth:`inverse_kinematics`, which names why)."""
         reference = _as_joint_vector(reference, "reference")
         orientation = self.task_pose(reference, self.tcp_offset)[3:]
         branch = self.ik_branch(reference)
-        points = np.asarray(points, dtype=float).reshape(-1, 3)
-        return np.array([self.inverse_kinematics(np.concatenate([point, orientation]), branch=branch, near=reference,
-                                                 tool=self.tcp_offset)
-                         for point in points]).reshape(-1, NUM_JOINTS)
+        points = finite_array(points, "points", "m").reshape(-1, 3)
+        tcp = np.eye(4)
+        tcp[:3, :3] = rotation_from_zyx_euler(orientation)
+        flange = flange_goal(tcp, self.tcp_offset)  # X_BF = X_BT X_FT⁻¹ of a TCP at the origin
+        positions = np.ascontiguousarray(points + flange[:3, 3])  # the flange positions [m]
+        solutions = np.empty((len(points), NUM_JOINTS))
+        status = branch_ik_many(self.model, np.ascontiguousarray(flange[:3, :3]), positions, *map(float, branch),
+                                IK_SINGULAR_TOLERANCE, solutions) if 0 not in branch else np.ones(len(points))
+        for k in np.flatnonzero(status):
+            solutions[k] = self.inverse_kinematics(np.concatenate([points[k], orientation]), branch=branch,
+                                                   tool=self.tcp_offset)
+        return self._nearest_equivalent(solutions, reference)
 
     def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
-        """qd = J^-1 [v; 0], qdd = J^-1 ([a; 0] - dJ/dt qd) with the TCP's analytic Jacobian (one q)."""
-        jacobian = self.analytic_jacobian(q, tool=self.tcp_offset)
-        qd = np.linalg.solve(jacobian, np.concatenate([v, np.zeros(3)]))
-        _, bias = self.analytic_jacobian_and_bias(q, qd, tool=self.tcp_offset)
-        qdd = np.linalg.solve(jacobian, np.concatenate([a, np.zeros(3)]) - bias)
-        return qd, qdd
+        """qd = J⁻¹ [v; 0], qdd = J⁻¹ ([a; 0] - J̇q̇) with the TCP's analytic Jacobian: q (..., 6),
+        v and a (..., 3) broadcast (:func:`~drake_traj.robots.compiled_kinematics.point_motion_rates`)."""
+        return point_motion_rates(self.model, self.tcp_offset, q, v, a)
 
     def task_kinematics(self) -> TaskKinematics:
         """The compiled k(q), analytic Jacobian and J̇q̇ (:func:`kinematics_into` through

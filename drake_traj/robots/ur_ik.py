@@ -14,12 +14,14 @@ import math
 
 import numpy as np
 
+from drake_traj.compiled import compiled, sources_digest
 from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
-from drake_traj.robots.task_space import is_flange, rotation_from_zyx_euler, wrap_angle, zyx_euler_from_rotation
+from drake_traj.robots import task_space
+from drake_traj.robots.task_space import is_flange, rotation_from_zyx_euler, wrap_angle, wrapped, zyx_euler_from_rotation
 from drake_traj.robots.ur_data import NUM_JOINTS
 from drake_traj.validation import invalid
 
-__all__ = ["IK_BRANCHES", "IK_PATH_MAX_STEP", "IK_SINGULAR_TOLERANCE", "branch_solutions", "describe_pose",
+__all__ = ["IK_BRANCHES", "IK_PATH_MAX_STEP", "IK_SINGULAR_TOLERANCE", "branch_ik_many", "branch_solutions", "describe_pose",
            "flange_goal", "raise_wrist_singular", "unique_rows"]
 
 
@@ -200,3 +202,62 @@ def _beyond_the_elbow(distance: str, a2: float, a3: float, title: str) -> str:
     shoulder joint, outside what the upper arm ``a2`` and forearm ``a3`` [m] span."""
     return (f"the wrist-1 joint would be {distance} from the shoulder joint, outside the reach "
             f"[{abs(abs(a2) - abs(a3)):.6g}, {abs(a2) + abs(a3):.6g}] m of the {title}'s upper arm and forearm")
+
+
+def _branch_ik_many_with(dependencies):
+    @compiled
+    def branch_ik_many(model, rotation, positions, shoulder, elbow, wrist, tol, out):
+        """The solution on the branch (``shoulder``, ``elbow``, ``wrist``) (each +1 or -1) of the
+        flange poses of rotation ``rotation`` (3, 3) at ``positions`` (N, 3) [m], into the rows of
+        ``out`` (N, 6) [rad, wrapped]: :func:`branch_solutions`' closed form for one branch,
+        compiled, for a path of poses. Returns a row's status in an (N,) array: 0 solved; 1 out of
+        reach of the shoulder offset, 2 shoulder, 3 wrist or 5 elbow singular, 4 beyond the elbow
+        (the row of ``out`` then undefined: :func:`branch_solutions` says why)."""
+        dependencies  # noqa: B018 (numba's cache key: drake_traj.compiled.sources_digest)
+        d1, a2, a3, d4, d5, d6 = model[1], model[2], model[3], model[4], model[5], model[6]
+        reach = abs(a2) + abs(a3)
+        z6 = rotation[:, 2]
+        status = np.zeros(positions.shape[0], dtype=np.int64)
+        for k in range(positions.shape[0]):
+            o5 = positions[k] - d6 * z6
+            r = math.hypot(o5[0], o5[1])
+            h_sq = r * r - d4 * d4
+            h_abs = math.sqrt(max(h_sq, 0.0))
+            if h_sq < -(tol * reach) ** 2 or h_abs < tol * reach:
+                status[k] = 1 if h_sq < -(tol * reach) ** 2 else 2
+                continue
+            q1 = math.atan2(o5[1], o5[0]) + math.atan2(d4, shoulder * h_abs)
+            c1, s1 = math.cos(q1), math.sin(q1)
+            c5 = z6[0] * s1 - z6[1] * c1  # z6 . z1, z1 = (s1, -c1, 0)
+            s5c6 = rotation[0, 0] * s1 - rotation[1, 0] * c1  # x6 . z1 = s5 c6
+            ms5s6 = rotation[0, 1] * s1 - rotation[1, 1] * c1  # y6 . z1 = -s5 s6
+            s5_abs = math.hypot(s5c6, ms5s6)
+            if s5_abs < tol:
+                status[k] = 3
+                continue
+            s5 = wrist * s5_abs
+            x4 = (c5 * np.array([s1, -c1, 0.0]) - z6) / s5
+            q234 = math.atan2(x4[2], c1 * x4[0] + s1 * x4[1])
+            c234, s234 = math.cos(q234), math.sin(q234)
+            u = c1 * (o5[0] - d5 * c1 * s234) + s1 * (o5[1] - d5 * s1 * s234)  # o4 = o5 - d5 z4
+            v = o5[2] + d5 * c234 - d1
+            dist = math.hypot(u, v)
+            c3 = (dist * dist - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
+            if abs(c3) > 1.0 + tol:
+                status[k] = 4
+                continue
+            c3 = min(1.0, max(-1.0, c3))
+            s3_abs = math.sqrt(1.0 - c3 * c3)
+            if s3_abs < tol:
+                status[k] = 5
+                continue
+            q3 = math.atan2(elbow * s3_abs, c3)
+            q2 = math.atan2(v, u) - math.atan2(a3 * elbow * s3_abs, a2 + a3 * c3)
+            row = np.array([q1, q2, q3, q234 - q2 - q3, math.atan2(s5, c5), math.atan2(-ms5s6 / s5, s5c6 / s5)])
+            out[k] = wrapped(row)
+        return status
+
+    return branch_ik_many
+
+
+branch_ik_many = _branch_ik_many_with(sources_digest(task_space.__file__))

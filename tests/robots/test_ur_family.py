@@ -110,6 +110,40 @@ def test_inverse_kinematics_round_trips(name):
 
 
 @pytest.mark.parametrize("name", ARMS)
+def test_point_ik_equals_inverse_kinematics_point_by_point(name):
+    """point_ik (the branch's closed form compiled over the points) gives what
+    inverse_kinematics gives for each point on the reference's branch and near it, with and
+    without a TCP: the solutions to 1e-12 rad, and a path it cannot solve refused with the same
+    error as the first point inverse_kinematics refuses (out of reach and singular points)."""
+    rng = np.random.default_rng(sum(map(ord, name)))
+    solved = refused = 0
+    for trial in range(24):
+        arm = ARMS[name].with_tcp(rng.uniform(-0.1, 0.2, 3), rng.uniform(-1, 1, 3)) if trial % 2 else ARMS[name]
+        reference = rng.uniform(-3, 3, 6)
+        orientation = arm.task_pose(reference, arm.tcp_offset)[3:]
+        reach = np.abs(arm.data.a).sum()
+        points = arm.tool_position(reference) + rng.normal(scale=0.01 if trial % 3 else 0.5 * reach, size=(100, 3))
+        expected, reason = [], None
+        for point in points:
+            try:
+                expected.append(arm.inverse_kinematics(np.concatenate([point, orientation]),
+                                                       branch=arm.ik_branch(reference), near=reference,
+                                                       tool=arm.tcp_offset))
+            except ValueError as error:
+                reason = str(error)
+                break
+        if reason is None:
+            np.testing.assert_allclose(arm.point_ik(points, reference), expected, atol=1e-12, rtol=0)
+            solved += 1
+        else:
+            with pytest.raises(ValueError) as raised:
+                arm.point_ik(points, reference)
+            assert str(raised.value) == reason
+            refused += 1
+    assert solved >= 5 and refused >= 4, (solved, refused)
+
+
+@pytest.mark.parametrize("name", ARMS)
 def test_urdf_masses_centres_of_mass_and_inertias_equal_the_table(name):
     arm = ARMS[name]
     plant, instance, context, _ = plant_of(name)

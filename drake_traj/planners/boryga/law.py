@@ -48,10 +48,21 @@ class RobotLoopLaw(HermiteLaw):
             raise
         knots = np.union1d(np.linspace(0.0, plan.duration, int(np.ceil(plan.duration / knot_step)) + 1),
                            plan.breakpoints)
-        right = np.array([self.exact(tau, "right") for tau in knots])
-        left = np.array([self.exact(tau, "left") if np.isin(tau, plan.breakpoints) else row
-                         for tau, row in zip(knots, right)])
+        junctions = np.flatnonzero(np.isin(knots, plan.breakpoints))
+        right = self._exact_along(knots, "right")
+        left = right.copy()
+        left[junctions] = self._exact_along(knots[junctions], "left", right[junctions, 0])
         super().__init__(knots, right, left, acceleration_jumps=plan.breakpoints)
+
+    def _exact_along(self, taus: np.ndarray, side: str, q=None) -> np.ndarray:
+        """(q, q̇, q̈) at the law times ``taus`` [s] in order, (N, 3, n) (:meth:`exact` at each):
+        the path sampled and solved in one call each, so the robot's IK follows the path from
+        point to point (:meth:`Robot.point_ik`); ``q`` (N, n), where already known, skips the IK."""
+        position, velocity, acceleration = self.plan.sample(taus, side=side)[:3]
+        if q is None:
+            q = self.robot.point_ik(position, self.reference)
+        qd, qdd = self.robot.joint_rates(q, velocity, acceleration)
+        return np.stack([q, qd, qdd], axis=1)
 
     def exact(self, tau: float, side: str = "right") -> np.ndarray:
         """(q, q̇, q̈) at law time tau [s], (3, n): the tool on the path, moving along it (at a
