@@ -104,6 +104,45 @@ def test_law_pieces_are_the_law_on_the_clock():
     np.testing.assert_allclose(values(plan.derivative(2), times), c * c * law[:, 2 * n:], atol=1e-9)
 
 
+class _OneTimeAtATime:
+    """A law seen without its batched ``rates_along``: law_pieces asks it one time at a time."""
+
+    def __init__(self, law):
+        self.law = law
+        self.q_start, self.duration, self.polynomial_breaks = law.q_start, law.duration, law.polynomial_breaks
+        self.rates_at, self.sample = law.rates_at, law.sample
+
+
+@pytest.mark.parametrize("name", ["boryga_loop_ur10e", "toppra"])
+def test_a_batched_law_gives_what_it_gives_one_time_at_a_time(name):
+    """rates_along and an array sample (HermiteLaw's, ToppraLaw's) equal rates_at and sample at
+    each time, inside, at the ends and outside the law; law_pieces from them equals law_pieces
+    asking one time at a time (to round-off: q̈'s, amplified by 1/h³ in the jerk)."""
+    if name == "toppra":
+        _, planner = quintic_task_planner(ToppraConfig)
+    else:
+        _, planner = shipped(name)
+    law = planner.law
+    taus = np.concatenate([np.random.default_rng(1).uniform(-0.1, law.duration + 0.1, 400),
+                           law.polynomial_breaks, [0.0, law.duration]])
+    batched = law.rates_along(np.clip(taus, 0.0, law.duration)), law.sample(taus)
+    for k, tau in enumerate(taus):
+        for mine, theirs in zip((*batched[0], *batched[1]), (*law.rates_at(min(max(tau, 0.0), law.duration)),
+                                                                *law.sample(tau))):
+            np.testing.assert_allclose(mine[k], theirs, rtol=1e-14, atol=1e-14 * (1 + np.max(np.abs(theirs))))
+    breaks, coefficients = law_pieces(law)
+    one_at_a_time = law_pieces(_OneTimeAtATime(law))
+    np.testing.assert_array_equal(breaks, one_at_a_time[0])
+    times = np.linspace(0.0, 1.0, 7)[:, None] * np.diff(breaks)[None, :]  # (7, K) within each piece
+    for order in range(4):
+        mine, theirs = coefficients, one_at_a_time[1]
+        for _ in range(order):
+            mine, theirs = (c[:, 1:] * np.arange(1, c.shape[1])[None, :, None] for c in (mine, theirs))
+        at = [sum(c[:, i] * times[..., None] ** i for i in range(c.shape[1])) for c in (mine, theirs)]
+        scale = np.max(np.abs(at[1]))
+        assert np.max(np.abs(at[0] - at[1])) <= (1e-12 if order < 3 else 1e-9) * scale, order
+
+
 def test_merged_breaks_keep_the_ends():
     np.testing.assert_array_equal(merged_breaks([0.5, 0.5 + 1e-12, 1.0 - 1e-12], 1.0), [0.0, 0.5, 1.0])
     np.testing.assert_array_equal(merged_breaks([2.0], 1.0), [0.0, 1.0])

@@ -411,33 +411,40 @@ class ToppraLaw:
         displacement[1:] = np.cumsum(h * (velocity[:-1] + step / 2), axis=0)
         swept = np.zeros_like(velocity)
         swept[1:] = np.cumsum(h * (displacement[:-1] + h * (velocity[:-1] / 2 + step / 6)), axis=0)
-        self._velocity, self._step, self._displacement, self._swept = velocity, step, displacement, swept
+        # the velocity's step over each cell, and 0 past the last node (at rest)
+        self._velocity, self._step = velocity, np.append(step, np.zeros((1, self.num_joints)), axis=0)
+        self._displacement, self._swept = displacement, swept
         # the table's nodes [s]: q is one cubic between them (tau and tau - h cross nodes together)
         self.polynomial_breaks = np.arange(last + 2) * h
         self._zero = np.zeros(self.num_joints)
 
-    def _table(self, u: float):
-        """(V, Q, R) at table time u [s]: V interpolated, Q and R its first and second integrals."""
-        if u <= 0.0:
-            return self._zero, self._zero, self._zero
-        h = self.sample_period
-        x = u / h
-        k = int(x)
-        last = len(self._step)
-        if k >= last:  # at rest from the last node on
-            return self._zero, self._displacement[-1], self._swept[-1] + self._displacement[-1] * (u - last * h)
-        w = x - k
+    def _table(self, u):
+        """(V, Q, R) at table times ``u`` [s], each u.shape + (n,): V interpolated, Q and R its
+        first and second integrals; zero before 0, at rest from the last node on."""
+        u = np.asarray(u, dtype=float)[..., None]
+        h, last = self.sample_period, len(self._step) - 1
+        x = np.maximum(u / h, 0.0)
+        k = np.minimum(x.astype(int), last)[..., 0]
+        w = np.where(k[..., None] < last, x - k[..., None], 0.0)  # at rest from the last node on
         v, dv, q = self._velocity[k], self._step[k], self._displacement[k]
-        return (v + w * dv, q + h * (w * v + w * w / 2 * dv),
-                self._swept[k] + h * (w * q + h * (w * w / 2 * v + w**3 / 6 * dv)))
+        resting = np.where(k[..., None] < last, 0.0, u - last * h)
+        before = u <= 0.0
+        return (np.where(before, 0.0, v + w * dv),
+                np.where(before, 0.0, q + h * (w * v + w * w / 2 * dv)),
+                np.where(before, 0.0, self._swept[k] + h * (w * q + h * (w * w / 2 * v + w**3 / 6 * dv)) + q * resting))
 
     def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
         """(qd [rad/s], qdd [rad/s^2]) of the law at law time ``tau`` [s] (rest outside)."""
         if not 0.0 <= tau <= self.duration:
             return self._zero.copy(), self._zero.copy()
+        return self.rates_along(tau)
+
+    def rates_along(self, taus) -> tuple[np.ndarray, np.ndarray]:
+        """(qd [rad/s], qdd [rad/s^2]) at law times ``taus`` [s] in [0, duration], each
+        taus.shape + (n,): :meth:`rates_at` at many times in one call."""
         h = self.sample_period
-        v1, q1, _ = self._table(tau)
-        v0, q0, _ = self._table(tau - h)
+        v1, q1, _ = self._table(taus)
+        v0, q0, _ = self._table(np.asarray(taus) - h)
         return (q1 - q0) / h, (v1 - v0) / h
 
     def sample(self, t):
@@ -448,15 +455,9 @@ class ToppraLaw:
         """
         t_arr = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
         h = self.sample_period
-        q, qd, qdd = [], [], []
-        for tau in t_arr.ravel():
-            v1, q1, r1 = self._table(tau)
-            v0, q0, r0 = self._table(tau - h)
-            q.append(self.q_start + (r1 - r0) / h)
-            qd.append((q1 - q0) / h)
-            qdd.append((v1 - v0) / h)
-        shape = t_arr.shape + (self.num_joints,)
-        return tuple(np.reshape(x, shape) for x in (q, qd, qdd))
+        v1, q1, r1 = self._table(t_arr)
+        v0, q0, r0 = self._table(t_arr - h)
+        return self.q_start + (r1 - r0) / h, (q1 - q0) / h, (v1 - v0) / h
 
 
 class ToppraPlanner(TimeLawPlanner):

@@ -7,6 +7,11 @@ prismatic joints), rates per second of law time. The planner runs the law on a s
 is a :class:`typing.Protocol` (structural, no base class to inherit), checked at run time by
 :func:`missing_members` with ``isinstance``. Every class in the package that satisfies it is
 named ``...Law``.
+
+A law may also be batched over law times (not a member of the contract): ``rates_along(taus)``
+gives ``rates_at`` at an array of law times in [0, duration], each taus.shape + (n,), and its
+``sample`` then takes an array too. :func:`~drake_traj.planners.laws.pieces.law_pieces` uses both
+where ``rates_along`` is present.
 """
 
 from __future__ import annotations

@@ -125,17 +125,24 @@ class HermiteLaw:
         k = min(max(bisect_right(self.knots, tau) - 1, 0), len(self.knots) - 2)
         return k, tau - self.knots[k]
 
-    def sample(self, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(q, q̇, q̈) at law time ``tau`` [s]; at rest at the ends outside [0, duration]."""
-        if tau >= self.duration:
-            return self._end[0].copy(), np.zeros_like(self._end[0]), np.zeros_like(self._end[0])
-        k, s = self._interval(max(tau, 0.0))
-        c = self._coefficients[k]
-        powers = s ** np.arange(6)
-        q = powers @ c
-        if tau < 0.0:
-            return q, np.zeros_like(q), np.zeros_like(q)
-        return q, (np.arange(1, 6) * powers[:5]) @ c[1:], (np.array([2, 6, 12, 20]) * powers[:4]) @ c[2:]
+    def sample(self, tau) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q, q̇, q̈) at law time ``tau`` [s], a float or an array, each tau.shape + (n,); at rest
+        at the ends outside [0, duration]."""
+        taus = np.asarray(tau, dtype=float)
+        k, s = self._intervals(np.clip(taus, 0.0, self.duration))
+        c = self._coefficients[k]  # (..., 6, n)
+        powers = s[..., None] ** np.arange(6)
+        q = np.einsum("...p,...pn->...n", powers, c)
+        moving = ((taus >= 0.0) & (taus < self.duration))[..., None]
+        q = np.where(taus[..., None] >= self.duration, self._end[0], q)
+        qd = np.einsum("...p,...pn->...n", np.arange(1, 6) * powers[..., :5], c[..., 1:, :])
+        qdd = np.einsum("...p,...pn->...n", np.array([2, 6, 12, 20]) * powers[..., :4], c[..., 2:, :])
+        return q, np.where(moving, qd, 0.0), np.where(moving, qdd, 0.0)
+
+    def _intervals(self, taus: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(the knot interval of each law time in ``taus`` [s], the time since its knot [s])."""
+        k = np.clip(np.searchsorted(self.knots, taus, side="right") - 1, 0, len(self.knots) - 2)
+        return k, taus - self.knots[k]
 
     def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
         """(q̇, q̈) at law time ``tau`` [s] (the planner's hot path: one 5 × 2n product)."""
@@ -146,6 +153,18 @@ class HermiteLaw:
         s2 = s * s
         rates = np.array((1.0, s, s2, s2 * s, s2 * s2)) @ self._rate_coefficients[k]
         return rates[:n], rates[n:]
+
+    def rates_along(self, taus) -> tuple[np.ndarray, np.ndarray]:
+        """(q̇, q̈) at law times ``taus`` [s], each taus.shape + (n,): :meth:`rates_at` at many
+        times in one call (zero outside [0, duration])."""
+        taus = np.asarray(taus, dtype=float)
+        n = self._end.shape[1]
+        k, s = self._intervals(taus)
+        s2 = s * s
+        powers = np.stack([np.ones_like(s), s, s2, s2 * s, s2 * s2], axis=-1)
+        rates = np.einsum("...p,...pm->...m", powers, self._rate_coefficients[k])
+        rates = np.where(((taus >= 0.0) & (taus < self.duration))[..., None], rates, 0.0)
+        return rates[..., :n], rates[..., n:]
 
 
 def joint_speed_cap(law: HermiteLaw, velocity_limit, acceleration_limit) -> tuple[float, dict]:

@@ -4,8 +4,8 @@ reference of a :class:`~drake_traj.planners.base.TimeLawPlanner` before its run.
 Every law in the package is a polynomial of degree <= 5 between its ``polynomial_breaks``
 (quintic moves, quintic Hermite tables, a quintic B-spline, trapezoids, Ruckig's cubics, Toppra's
 averaged table). On each piece q̈ at four interior points (Chebyshev nodes, the law's
-``rates_at``) fixes the cubic q̈, and q̇ and q at the first node (``sample``) fix the two
-integration constants. For
+``rates_at``, or its batched ``rates_along`` where the law has one) fixes the cubic q̈, and q̇ and
+q at the first node (``sample``) fix the two integration constants. For
 a law of degree <= 5 this is the law's own polynomial, to round-off, whatever the piece's length:
 no difference of two positions enters (a fit through q at both ends loses eps |q| / h² in q̈).
 Joint positions in rad (m for prismatic joints), times in s.
@@ -69,8 +69,12 @@ def law_pieces(law, rate: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     breaks = merged_breaks(law.polynomial_breaks, duration)
     lengths = np.diff(breaks)  # h, law time [s]
     nodes = breaks[:-1, None] + lengths[:, None] * _NODES  # (K, 4) law times [s]
-    acceleration = np.array([[law.rates_at(tau)[1] for tau in row] for row in nodes])  # (K, 4, n): the hot path
-    anchor = np.array([law.sample(tau)[:2] for tau in nodes[:, 0]])  # (K, q/q̇, n)
+    if hasattr(law, "rates_along"):  # a law batched over law times (the contract's module docstring)
+        acceleration = law.rates_along(nodes)[1]  # (K, 4, n)
+        anchor = np.stack(law.sample(nodes[:, 0])[:2], axis=1)  # (K, q/q̇, n)
+    else:
+        acceleration = np.array([[law.rates_at(tau)[1] for tau in row] for row in nodes])
+        anchor = np.array([law.sample(tau)[:2] for tau in nodes[:, 0]])
     h = lengths[:, None]
     # in sigma = (tau - break) / h: Q'' = h² q̈_law (a cubic), Q' = h q̇_law, Q = q_law
     second = np.einsum("ik,pin->kpn", _VANDERMONDE_INVERSE.T, acceleration * h[:, None] ** 2)
