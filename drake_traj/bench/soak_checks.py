@@ -122,8 +122,9 @@ def dense_rates(trajectory, period: float = DENSE_PERIOD, pieces=None) -> tuple[
     index = np.clip(np.searchsorted(breaks, times, side="right") - 1, 0, len(breaks) - 2)
     local = (times - breaks[index])[:, None]
     values = [trajectory.vector_values(times).T]
-    rows = coefficients[index]  # (N, P, n): each sample's piece
+    derivative = coefficients  # the pieces' derivative of the order below
     for order in range(4):
+        rows = derivative[index]  # (N, P, n): each sample's piece
         value = np.zeros((len(times), coefficients.shape[2]))
         for i in reversed(range(rows.shape[1])):
             value = value * local + rows[:, i, :]
@@ -133,7 +134,7 @@ def dense_rates(trajectory, period: float = DENSE_PERIOD, pieces=None) -> tuple[
                 raise ValueError(f"the plan's pieces read back {misread:.3g} from Drake's evaluation of it")
         else:
             values.append(value)
-        rows = _derivative(rows)
+        derivative = _derivative(derivative)
     return times, values
 
 
