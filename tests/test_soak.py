@@ -9,6 +9,7 @@ import pytest
 from pydrake.polynomial import Polynomial
 from pydrake.trajectories import PiecewisePolynomial
 
+import drake_traj.bench.soak_report as soak_report
 from drake_traj import cli
 from drake_traj.bench import SOAK_ARMS, SOAK_PLANNERS, run_soak_task
 from drake_traj.bench.soak_checks import ClearanceCheck, dense_rates, diagnose, piece_coefficients, pose_error, rate_peaks
@@ -202,6 +203,25 @@ def test_a_local_soak_makes_its_cluster_afresh_every_chunk(tmp_path, monkeypatch
                              progress=None)
     assert made == [2, 2] and [row["seed"] for row in rows] == [0, 1, 2]
     assert [row["params"] for row in rows] == [run_soak_task("ur10e", "quintic", seed)["params"] for seed in range(3)]
+
+
+def test_an_interrupted_soak_writes_the_tasks_it_finished(tmp_path, monkeypatch):
+    """Ctrl-C (a KeyboardInterrupt; SIGTERM arrives as one) on the third task: the two tasks done
+    are written as a part (soak.md says how far it got) and the interrupt goes on, noted."""
+    def interrupted_on_the_third(arm, planner, seed):
+        if seed == 2:
+            raise KeyboardInterrupt
+        return run_soak_task(arm, planner, seed)
+
+    monkeypatch.setattr(soak_report, "run_soak_task", interrupted_on_the_third)
+    with pytest.raises(KeyboardInterrupt) as stop:
+        soak_report.soak_bench(tmp_path / "soak", count=4, arms=("ur10e",), planners=("quintic",), workers=1,
+                               progress=None)
+    assert any("stopped after 2 of 4 tasks" in note for note in stop.value.__notes__)
+    with open(tmp_path / "soak" / "soak.csv") as handle:
+        assert [row["seed"] for row in csv.DictReader(handle)] == ["0", "1"]
+    assert "2 tasks, seeds 0-1" in (tmp_path / "soak" / "soak.md").read_text()
+    assert "stopped after 2 of 4 tasks" in (tmp_path / "soak" / "soak.md").read_text()
 
 
 def test_bad_arguments_are_refused_before_any_task(tmp_path, capsys):

@@ -75,11 +75,12 @@ def run_on(client, work, builders, toppra, bar) -> dict:
     return {(task.label, name): row for (task, name), row in rows.items()}
 
 
-def _collect(runs: dict, bar, row_of, failed) -> dict:
+def _collect(runs: dict, bar, row_of, failed, rows: dict | None = None) -> dict:
     """{unit: row} of the Dask futures ``runs`` ({future: unit}) as they complete: ``row_of`` of
     each one's output, counted by the progress ``bar``; a unit whose worker died or could not load
-    it is ``failed(unit, reason)``."""
-    rows = {}
+    it is ``failed(unit, reason)``. Rows go into ``rows`` (a new dict if None) as they come, so a
+    caller's dict keeps those done when an interrupt stops the collection."""
+    rows = {} if rows is None else rows
     for future in as_completed(runs):
         unit = runs.pop(future)
         try:

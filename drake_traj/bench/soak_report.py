@@ -101,10 +101,11 @@ def _seeds(rows) -> str:
     return ", ".join(ranges)
 
 
-def markdown(rows, table, wall: float | None) -> str:
-    """soak.md: the summary per arm and planner, then the wrong rows with their rerun commands."""
+def markdown(rows, table, wall: float | None, stopped: str | None = None) -> str:
+    """soak.md: the summary per arm and planner, then the wrong rows with their rerun commands;
+    ``stopped`` (an interrupted soak's "stopped after N of M tasks") in the title."""
     wrong = [row for row in rows if row["wrong"]]
-    took = f"{wall:.0f} s wall" if wall is not None else "merged from parts"
+    took = (f"{wall:.0f} s wall" if wall is not None else "merged from parts") + (f", {stopped}" if stopped else "")
     lines = [f"## Soak: {len(rows)} tasks, seeds {_seeds(rows)}, {took}\n",
              "| " + " | ".join(SUMMARY_HEADER) + " |", "|" + "---|" * len(SUMMARY_HEADER)]
     lines += ["| " + " | ".join(_cell(value) for value in entry.values()) + " |" for entry in table]
@@ -245,7 +246,14 @@ def soak_bench(out_dir, *, count: int = 10, seed: int = 0, arms=SOAK_ARMS, plann
             size = len(work) if scheduler is not None else LOCAL_CHUNK
             for first in range(0, len(work), size):
                 with _engine(workers, scheduler) as client:
-                    by_task |= _run(client, work[first:first + size], bar)
+                    _run(client, work[first:first + size], bar, by_task)
+        except KeyboardInterrupt as stop:  # Ctrl-C or SIGTERM: the tasks done are written, then it goes on
+            bar.close()
+            rows = [by_task[unit] for unit in work if unit in by_task]
+            stopped = f"stopped after {len(rows)} of {len(work)} tasks"
+            _write(claimed, out_dir, rows, time.monotonic() - began, progress, stopped=stopped)
+            stop.add_note(f"the soak {stopped}: their rows are in {Path(out_dir)} (a part for --merge)")
+            raise
         finally:
             bar.close()
         rows = [by_task[unit] for unit in work]
@@ -253,10 +261,11 @@ def soak_bench(out_dir, *, count: int = 10, seed: int = 0, arms=SOAK_ARMS, plann
     return rows
 
 
-def _write(claimed, out_dir, rows, wall: float | None, progress) -> None:
+def _write(claimed, out_dir, rows, wall: float | None, progress, stopped: str | None = None) -> None:
     """soak.csv, soak.md and soak.png of ``rows`` into the ``claimed`` folder; the summary and the
-    files written on ``progress``. ``wall`` [s]: how long the tasks took (None: merged parts)."""
-    text = markdown(rows, soak_summary(rows), wall)
+    files written on ``progress``. ``wall`` [s]: how long the tasks took (None: merged parts);
+    ``stopped``: how far an interrupted soak got, said in soak.md's title."""
+    text = markdown(rows, soak_summary(rows), wall, stopped)
     with claimed.replace() as staging:
         staging.write(SOAK_FILES[0], functools.partial(_write_csv, rows))
         staging.write(SOAK_FILES[1], lambda path: path.write_text(text))
@@ -271,10 +280,13 @@ def _failed(unit, reason: str) -> dict:
     return soak_row(unit, outcome="error", wrong=True, message=reason)
 
 
-def _run(client, work, bar) -> dict:
-    """{(arm, planner, seed): row} of every task of ``work``, in this process (``client`` None) or
-    on Dask, each counted by the progress ``bar``."""
+def _run(client, work, bar, rows: dict) -> None:
+    """Each task of ``work`` run, in this process (``client`` None) or on Dask, its row put in
+    ``rows`` {(arm, planner, seed): row} as it ends (an interrupt keeps those) and counted by the
+    progress ``bar``."""
     if client is None:
-        return {unit: bar.done(run_soak_task(*unit)) for unit in work}
+        for unit in work:
+            rows[unit] = bar.done(run_soak_task(*unit))
+        return
     futures = {client.submit(run_soak_task, *unit, pure=False): unit for unit in work}
-    return _collect(futures, bar, lambda row: row, _failed)
+    _collect(futures, bar, lambda row: row, _failed, rows)
