@@ -54,8 +54,10 @@ def piecewise_trajectory(breaks, coefficients) -> PiecewisePolynomial:
     (t - breaks[k])^j on [breaks[k], breaks[k + 1]] (breaks [s] (K + 1,), coefficients (K, P, n)),
     an n x 1 column per time."""
     coefficients = np.asarray(coefficients, dtype=float)
-    pieces = [np.array([[Polynomial(piece[:, j])] for j in range(piece.shape[1])]) for piece in coefficients]
-    return PiecewisePolynomial(pieces, np.asarray(breaks, dtype=float).tolist())
+    count, size, rows = coefficients.shape
+    polynomials = np.empty(count * rows, dtype=object)  # each piece's column, one object array for all
+    polynomials[:] = [Polynomial(c) for c in coefficients.transpose(0, 2, 1).reshape(-1, size)]
+    return PiecewisePolynomial(list(polynomials.reshape(count, rows, 1)), np.asarray(breaks, dtype=float).tolist())
 
 
 class PlannerSystem(LeafSystem):
