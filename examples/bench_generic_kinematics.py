@@ -15,9 +15,10 @@ one after the other within each repeat:
    evaluations a step), per step;
 4. the reach check before a run (``PajakLaw.reach_failure``: every IK solution of the four
    waypoints; closed form against the chain's numerical IK), per waypoint;
-5. point IK as Boryga's loop law calls it (``point_ik`` of one point, the reference's
-   orientation and branch) at 200 points of a smooth path near the home configuration: the
-   closed form against the chain's IK warm-started from the reference, per point.
+5. point IK as Boryga's loop law calls it (``point_ik`` of a whole path in one call, the
+   reference's orientation and branch) at 200 points of a smooth path near the home
+   configuration: the closed form (compiled over the points) against the chain's IK, each point
+   warm-started from the one before, per point.
 
 Prints the times and the ratios chain / closed form (our bound: at most 2 for the law),
 and the two motions' finish times. A benchmark, not a test: numbers depend on the machine.
@@ -80,10 +81,9 @@ def reach_seconds(law: PajakLaw, q0) -> float:
 
 
 def point_ik_seconds(robot, points, reference) -> float:
-    """Wall time per point [s] of ``robot.point_ik`` called once per point."""
+    """Wall time per point [s] of ``robot.point_ik`` of all ``points`` in one call."""
     start = time.perf_counter()
-    for point in points:
-        robot.point_ik(point[None], reference)
+    robot.point_ik(points, reference)
     return (time.perf_counter() - start) / len(points)
 
 

@@ -408,9 +408,11 @@ class URArm(Robot):
 
     def point_ik(self, points, reference) -> np.ndarray:
         """IK of TCP positions (N, 3) [m] at the TCP orientation of ``reference``, on its IK
-        branch, each joint within 2 pi of ``reference`` (:meth:`inverse_kinematics` of each point:
-        the branch's closed form compiled over the points, :func:`~drake_traj.robots.ur_ik.branch_ik_many`;
-        a point it does not solve goes through :meth:`inverse_kinematics`, which names why)."""
+        branch (:meth:`inverse_kinematics` of each point: the branch's closed form compiled over
+        the points, :func:`~drake_traj.robots.ur_ik.branch_ik_many`; a point it does not solve goes
+        through :meth:`inverse_kinematics`, which names why). Each joint is continued from the
+        point before by whole turns (the first point's from ``reference``), so points along a path
+        in order give a continuous q; a joint past its position limit is turned back inside it."""
         reference = _as_joint_vector(reference, "reference")
         orientation = self.task_pose(reference, self.tcp_offset)[3:]
         branch = self.ik_branch(reference)
@@ -425,7 +427,10 @@ class URArm(Robot):
         for k in np.flatnonzero(status):
             solutions[k] = self.inverse_kinematics(np.concatenate([points[k], orientation]), branch=branch,
                                                    tool=self.tcp_offset)
-        return self._nearest_equivalent(solutions, reference)
+        continued = np.unwrap(np.vstack([reference, solutions]), axis=0)[1:]  # each from the one before
+        outside = np.abs(continued) > self._position_limit
+        continued[outside] -= 2 * np.pi * np.sign(continued[outside])
+        return continued
 
     def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
         """qd = J⁻¹ [v; 0], qdd = J⁻¹ ([a; 0] - J̇q̇) with the TCP's analytic Jacobian: q (..., 6),

@@ -143,6 +143,22 @@ def test_point_ik_equals_inverse_kinematics_point_by_point(name):
     assert solved >= 5 and refused >= 4, (solved, refused)
 
 
+def test_point_ik_along_a_path_continues_each_joint_past_half_a_turn_from_the_reference():
+    """Points on an arc of 1.6 pi about the base axis, at the TCP orientation of the reference:
+    joint 1 turns 1.6 pi with them. point_ik continues every joint from the point before (whole
+    turns), so q is continuous (each step < 0.05 rad), every point is reached to 1e-9 m, and joint
+    1 ends about 1.6 pi from where it began (the nearest-to-the-reference rule jumped by 2 pi)."""
+    reference = np.array([0.3, -1.2, 1.4, -1.8, -1.5, 0.4])
+    start = UR10E.tool_position(reference)
+    radius, angle0 = np.hypot(*start[:2]), np.arctan2(start[1], start[0])
+    angles = angle0 + np.linspace(0.0, 1.6 * np.pi, 801)
+    points = np.column_stack([radius * np.cos(angles), radius * np.sin(angles), np.full_like(angles, start[2])])
+    q = UR10E.point_ik(points, reference)
+    assert np.max(np.abs(np.diff(q, axis=0))) < 0.05
+    np.testing.assert_allclose(UR10E.tool_position(q), points, atol=1e-9, rtol=0)
+    assert abs(q[-1, 0] - q[0, 0] - 1.6 * np.pi) < 0.01  # the wrist centre's arc is off the base axis by d6
+
+
 @pytest.mark.parametrize("name", ARMS)
 def test_urdf_masses_centres_of_mass_and_inertias_equal_the_table(name):
     arm = ARMS[name]
