@@ -3,6 +3,8 @@
 import numpy as np
 import pytest
 
+from drake_traj.bench.soak_tasks import draw_task
+from drake_traj.errors import DrakeTrajError, SingularConfigurationError
 from drake_traj.robots import UR10E, boryga_robots
 from drake_traj.robots import ur10e as robot
 from drake_traj.station import simulate
@@ -79,6 +81,51 @@ def test_speed_cap_is_one_when_the_law_is_within_limits():
     law = RobotLoopLaw(plan, UR10E, q0)
     cap, peaks = joint_speed_cap(law, [3.0] * 6, [50.0] * 6)
     assert cap == 1.0 and peaks["qd"].max() < 3.0
+
+
+def test_a_loop_through_a_singularity_is_refused_where_the_ik_jumps():
+    """Soak task puma560 / boryga / 3: the loop passes the PUMA's elbow singularity, where its IK
+    flips branch (joint 3 jumps 2.94 rad between two knots 2 ms apart). It was planned at
+    1.39e4 s (the interpolation across the jump slowed to the limits) and refused as too long;
+    now refused as singular, naming the law times and the joint."""
+    scenario = draw_task("puma560", "boryga", 3).scenario
+    with pytest.raises(SingularConfigurationError, match=r"between law times 1.376 and 1.378 s .* joint 3 jumps by "
+                                                        r"-2.94 rad .* singularity of the puma560"):
+        make_planner(scenario)
+
+
+def test_a_loop_whose_joint_passes_half_a_turn_from_the_start_follows_it():
+    """Soak task ur3e / boryga / 39: joint 4 passes half a turn from its start. The UR's IK of each
+    knot was the solution nearest the start, so joint 4 jumped a whole turn (planned at 2.6e4 s,
+    refused as too long); each knot now continues from the one before: every step between knots
+    < 0.05 rad, the plan 21.3 s long."""
+    planner = make_planner(draw_task("ur3e", "boryga", 39).scenario)
+    q = planner.law.sample(planner.law.knots)[0]
+    assert np.max(np.abs(np.diff(q, axis=0))) < 0.05
+    assert np.max(np.abs(q[:, 3] - q[0, 3])) > np.pi and 21.0 < planner.planned_duration() < 21.5
+
+
+class _TurnedBack(type(UR10E)):
+    """The UR10e with its wrist 3 turned back by a whole turn where the tool is past x = ``beyond``
+    [m] (as an IK keeping a joint in its range would): the law sees a joint jump of 2 pi."""
+
+    beyond = 0.0
+
+    def point_ik(self, points, reference):
+        q = super().point_ik(points, reference)
+        q[np.asarray(points).reshape(-1, 3)[:, 0] > self.beyond, 5] -= 2 * np.pi
+        return q
+
+
+def test_a_loop_whose_joint_is_turned_back_a_whole_turn_is_refused_for_its_range():
+    q0 = np.asarray(robot.HOME)
+    start = UR10E.tool_position(q0)
+    plan = plan_loop_path(start, start + [0.08, 0.03, 0], start + [0.08, 0, 0], 0.05, delta=0.02)
+    turned = _TurnedBack()
+    turned.beyond = start[0] + 0.04
+    with pytest.raises(DrakeTrajError, match="joint 6 jumps by -6.28 rad .* more than the joint's range") as refused:
+        RobotLoopLaw(plan, turned, q0)
+    assert refused.value.cause == "joint range"
 
 
 def test_bad_loop_scenarios_name_the_reason(tmp_path):
