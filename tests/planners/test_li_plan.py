@@ -1,6 +1,6 @@
 """Li et al. 2019 end to end on the closed path, on the paper's 4-DOF robot and on the UR10e: every
-limit at every 1 ms sample and at the exact peaks, and the efficiency bound (issue: executed time
-at most 1.25 times the Cartesian stage). The closed loop is in test_li_diagram.py.
+limit at every 1 ms sample and at the exact peaks, and the efficiency bound (the executed time at
+most 1.25 times the Cartesian stage's). The closed loop is in test_li_diagram.py.
 
 Independent computations: the tool's velocity and acceleration also by central differences of the
 forward kinematics (no Jacobian), the path deviation by the distance to the polyline, the time

@@ -215,7 +215,7 @@ def test_the_infeasible_causes():
     assert error.value.cause == "infeasible" and error.value.field == ("path", 1)
 
 
-# --- every input (issue: smooth timing on every input) ---------------------------------------------
+# --- smooth timing on every input -----------------------------------------------------------------
 @settings(max_examples=25, deadline=None, derandomize=True)
 @given(spacing=st.floats(1e-3, 0.4), count=st.integers(2, 8), decimals=st.integers(3, 12))
 def test_collinear_evenly_spaced_goals_never_end_the_process(spacing, count, decimals):
@@ -412,7 +412,7 @@ def test_the_timing_prints_nothing_and_its_module_imports_beside_the_planners(ca
     assert timing_module.time_path is time_path
 
 
-# --- timing at the search's speed (issue 39) ----------------------------------------------------------
+# --- timing at the search's speed -----------------------------------------------------------------------
 def test_path_values_are_drakes_to_round_off():
     """q(s) and its first three derivatives by Horner on the pieces' Taylor coefficients (a cubic
     spline, a straight segment, quintic pieces) are Drake's to round-off; any other trajectory is
