@@ -419,19 +419,29 @@ class ToppraLaw:
         self._zero = np.zeros(self.num_joints)
 
     def _table(self, u):
-        """(V, Q, R) at table times ``u`` [s], each u.shape + (n,): V interpolated, Q and R its
-        first and second integrals; zero before 0, at rest from the last node on."""
-        u = np.asarray(u, dtype=float)[..., None]
+        """(V, Q, R) at table time ``u`` [s], a float (the simulator's hot path, no array
+        arithmetic) or an array (each u.shape + (n,)): V interpolated, Q and R its first and
+        second integrals; zero before 0, at rest from the last node on."""
         h, last = self.sample_period, len(self._step) - 1
+        if np.ndim(u) == 0:
+            if u <= 0.0:
+                return self._zero, self._zero, self._zero
+            k = min(int(u / h), last)
+            return self._cell(k, u / h - k)
+        u = np.asarray(u, dtype=float)
         x = np.maximum(u / h, 0.0)
-        k = np.minimum(x.astype(int), last)[..., 0]
-        w = np.where(k[..., None] < last, x - k[..., None], 0.0)  # at rest from the last node on
+        k = np.minimum(x.astype(int), last)
+        before = (u <= 0.0)[..., None]
+        return tuple(np.where(before, 0.0, value) for value in self._cell(k, (x - k)[..., None]))
+
+    def _cell(self, k, w):
+        """(V, Q, R) a fraction ``w`` of the sample period into table cell ``k`` (an int and a
+        float, or arrays k (...) and w (..., 1)); from the last node on (k = last: V and its step
+        zero) the law rests, Q constant and R growing by Q h w."""
+        h = self.sample_period
         v, dv, q = self._velocity[k], self._step[k], self._displacement[k]
-        resting = np.where(k[..., None] < last, 0.0, u - last * h)
-        before = u <= 0.0
-        return (np.where(before, 0.0, v + w * dv),
-                np.where(before, 0.0, q + h * (w * v + w * w / 2 * dv)),
-                np.where(before, 0.0, self._swept[k] + h * (w * q + h * (w * w / 2 * v + w**3 / 6 * dv)) + q * resting))
+        return (v + w * dv, q + h * (w * v + w * w / 2 * dv),
+                self._swept[k] + h * (w * q + h * (w * w / 2 * v + w**3 / 6 * dv)))
 
     def rates_at(self, tau: float) -> tuple[np.ndarray, np.ndarray]:
         """(qd [rad/s], qdd [rad/s^2]) of the law at law time ``tau`` [s] (rest outside)."""
@@ -440,11 +450,12 @@ class ToppraLaw:
         return self.rates_along(tau)
 
     def rates_along(self, taus) -> tuple[np.ndarray, np.ndarray]:
-        """(qd [rad/s], qdd [rad/s^2]) at law times ``taus`` [s] in [0, duration], each
-        taus.shape + (n,): :meth:`rates_at` at many times in one call."""
+        """(qd [rad/s], qdd [rad/s^2]) at law times ``taus`` [s] in [0, duration], a float or an
+        array (each taus.shape + (n,)): :meth:`rates_at` at many times in one call."""
         h = self.sample_period
+        taus = taus if np.ndim(taus) == 0 else np.asarray(taus, dtype=float)
         v1, q1, _ = self._table(taus)
-        v0, q0, _ = self._table(np.asarray(taus) - h)
+        v0, q0, _ = self._table(taus - h)
         return (q1 - q0) / h, (v1 - v0) / h
 
     def sample(self, t):
