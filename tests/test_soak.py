@@ -222,6 +222,11 @@ def test_an_interrupted_soak_writes_the_tasks_it_finished(tmp_path, monkeypatch)
         assert [row["seed"] for row in csv.DictReader(handle)] == ["0", "1"]
     assert "2 tasks, seeds 0-1" in (tmp_path / "soak" / "soak.md").read_text()
     assert "stopped after 2 of 4 tasks" in (tmp_path / "soak" / "soak.md").read_text()
+    with pytest.raises(KeyboardInterrupt) as stop:  # before any task ended: nothing to write
+        soak_report.soak_bench(tmp_path / "none", count=4, seed=2, arms=("ur10e",), planners=("quintic",), workers=1,
+                               progress=None)
+    assert any("stopped after 0 of 4 tasks, nothing written" in note for note in stop.value.__notes__)
+    assert not (tmp_path / "none" / "soak.csv").exists()
 
 
 def test_bad_arguments_are_refused_before_any_task(tmp_path, capsys):

@@ -102,7 +102,7 @@ class _Progress:
 
     def __init__(self, total: int, stream, where: str, unit: str = "run", bad: str = "failed",
                  failed=lambda row: not row["succeeded"]):
-        self._stream = stream
+        self._stream, self._closed = stream, False
         self._unit, self._bad, self._failed = unit, bad, failed
         terminal = stream is not None and getattr(stream, "isatty", lambda: False)()
         self._lines = stream is not None and not terminal
@@ -137,6 +137,10 @@ class _Progress:
         self._said = time.monotonic()
 
     def close(self):
+        """The bar closed and, on a log, the last line; once (a second call does nothing)."""
+        if self._closed:
+            return
+        self._closed = True
         self._bar.close()
         if self._lines:
             self._say(f"bench: {self.count}/{self.total} {self._unit}s in "

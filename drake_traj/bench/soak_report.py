@@ -251,8 +251,10 @@ def soak_bench(out_dir, *, count: int = 10, seed: int = 0, arms=SOAK_ARMS, plann
             bar.close()
             rows = [by_task[unit] for unit in work if unit in by_task]
             stopped = f"stopped after {len(rows)} of {len(work)} tasks"
-            _write(claimed, out_dir, rows, time.monotonic() - began, progress, stopped=stopped)
-            stop.add_note(f"the soak {stopped}: their rows are in {Path(out_dir)} (a part for --merge)")
+            if rows:
+                _write(claimed, out_dir, rows, time.monotonic() - began, progress, stopped=stopped)
+            stop.add_note(f"the soak {stopped}" + (f": their rows are in {Path(out_dir)} (a part for --merge)"
+                                                   if rows else ", nothing written"))
             raise
         finally:
             bar.close()
