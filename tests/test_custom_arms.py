@@ -568,16 +568,18 @@ def test_actuators_out_of_the_joints_order_are_refused(tmp_path):
 
 
 def test_boryga_loop_on_the_puma_is_the_seeded_ik_nearest_the_reference():
-    """The loop law's knots (warm-started IK, each from the reference) are the seeded search's
-    solutions nearest the reference (the branch of the start), to 1e-9 rad."""
+    """The loop law's knots (warm-started IK, each from the knot before) are the seeded search's
+    solutions nearest the reference (the branch of the start, on this loop that never flips), to
+    1e-9 rad, and put the TCP on the path between them to 1e-6 m."""
     from drake_traj.planners.boryga import BorygaConfig, make
 
     arm = load_scenario(PUMA, "quintic").base_robot()
     reference = np.array([0.2, 0.6, -2.5, 0.2, -0.9, 0.1])
     law = make(BorygaConfig(), arm, reference).law
     orientation = arm.tcp_pose(reference)[3:]
-    for tau in np.linspace(0.0, law.plan.duration, 15):
-        position = law.plan.sample(tau)[0].reshape(3)
+    for knot in law.knots[np.linspace(0, len(law.knots) - 2, 15).astype(int)]:
+        position = law.plan.sample(knot)[0].reshape(3)
         expected = arm._nearest_solution(np.concatenate([position, orientation]), reference)
-        np.testing.assert_allclose(law.exact(tau)[0], expected, atol=1e-9, rtol=0)
-        np.testing.assert_allclose(arm.tcp_pose(law.sample(tau)[0])[:3], position, atol=1e-6)
+        np.testing.assert_allclose(law.sample(knot)[0], expected, atol=1e-9, rtol=0)
+    for tau in np.linspace(0.0, law.plan.duration, 15):
+        np.testing.assert_allclose(arm.tcp_pose(law.sample(tau)[0])[:3], law.plan.sample(tau)[0].reshape(3), atol=1e-6)

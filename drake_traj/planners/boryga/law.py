@@ -23,17 +23,24 @@ class RobotLoopLaw(HermiteLaw):
 
     q(tau) is the robot's inverse kinematics of the path point (:meth:`Robot.point_ik`: the
     closed-form IK of Boryga's robots, eq. 15-32; the UR10e's keeps the flange orientation and IK
-    branch of ``reference``) and the rates come from its Jacobian (:meth:`Robot.joint_rates`):
-    :meth:`exact`. That is computed at knots every ``knot_step`` [s] of law time and at the path's
-    junctions (both sides: the acceleration jumps by v²/R where the arc begins and ends) and
-    interpolated between them (:class:`HermiteLaw`), so the planner's hot path costs microseconds,
-    not an IK.
+    branch of ``reference``; every knot continued from the one before) and the rates come from its
+    Jacobian (:meth:`Robot.joint_rates`). That is computed at knots every ``knot_step`` [s] of law
+    time and at the path's junctions (both sides: the acceleration jumps by v²/R where the arc
+    begins and ends) and interpolated between them (:class:`HermiteLaw`), so the planner's hot
+    path costs microseconds, not an IK.
 
     Args:
         plan: the loop path (:func:`plan_loop_path`), in the robot's base frame.
         robot: the robot.
         reference: a configuration of the robot giving the tool orientation and IK branch.
         knot_step: the largest law-time step between knots [s].
+
+    Raises:
+        ValueError: the path leaves the robot's reach (the law time and point named).
+        SingularConfigurationError: the path passes at or near a singularity, where the IK jumps
+            between two knots (:data:`FOLLOW_TOLERANCE`; the law times and joint named).
+        DrakeTrajError: of cause "joint range", where the robot's IK turns a joint back by whole
+            turns into its range between two knots.
     """
 
     def __init__(self, plan: LoopPath, robot: Robot, reference, *, knot_step: float = 2e-3):
@@ -71,9 +78,11 @@ class RobotLoopLaw(HermiteLaw):
         middle = (self.knots[:-1] + self.knots[1:]) / 2
         ik = self.robot.point_ik(self.plan.sample(middle)[0].reshape(-1, 3), self.reference)
         error = np.abs(self.sample(middle)[0] - ik)
-        k, joint = np.unravel_index(np.argmax(error), error.shape)
-        if error[k, joint] <= FOLLOW_TOLERANCE:
+        beyond = np.flatnonzero(error.max(axis=1) > FOLLOW_TOLERANCE)
+        if not beyond.size:
             return
+        k = beyond[0]  # the first interval the joints do not follow
+        joint = int(np.argmax(error[k]))
         step = self.sample(self.knots[k + 1])[0][joint] - self.sample(self.knots[k])[0][joint]
         where = (f"the loop path between law times {self.knots[k]:.4g} and {self.knots[k + 1]:.4g} s of "
                  f"{self.duration:.4g} s, near {format_point(self.plan.sample(middle[k])[0])} m: {joint_label(joint)} jumps "
@@ -82,20 +91,16 @@ class RobotLoopLaw(HermiteLaw):
         if abs(step) > np.pi and abs(step - 2 * np.pi * np.round(step / (2 * np.pi))) < 0.1:  # a whole turn
             raise DrakeTrajError(f"{where} (the path needs more than the joint's range: it is turned back by a whole "
                                  "turn)", cause=Cause.JOINT_RANGE)
-        raise SingularConfigurationError(f"{where} (the path passes through a singularity of the {self.robot.name}, "
+        raise SingularConfigurationError(f"{where} (the path passes at or near a singularity of the {self.robot.name}, "
                                          "where its inverse kinematics flips branch)")
 
     def _exact_along(self, taus: np.ndarray, side: str, q=None) -> np.ndarray:
-        """(q, q̇, q̈) at the law times ``taus`` [s] in order, (N, 3, n) (:meth:`exact` at each):
-        the path sampled and solved in one call each, so the robot's IK follows the path from
-        point to point (:meth:`Robot.point_ik`); ``q`` (N, n), where already known, skips the IK."""
+        """(q, q̇, q̈) at the law times ``taus`` [s] in order, (N, 3, n): the tool on the path,
+        moving along it (at a junction, the value on ``side``), the path sampled and solved in one
+        call each, so the robot's IK follows the path from point to point (:meth:`Robot.point_ik`);
+        ``q`` (N, n), where already known, skips the IK."""
         position, velocity, acceleration = self.plan.sample(taus, side=side)[:3]
         if q is None:
             q = self.robot.point_ik(position, self.reference)
         qd, qdd = self.robot.joint_rates(q, velocity, acceleration)
         return np.stack([q, qd, qdd], axis=1)
-
-    def exact(self, tau: float, side: str = "right") -> np.ndarray:
-        """(q, q̇, q̈) at law time tau [s], (3, n): the tool on the path, moving along it (at a
-        junction, the value on ``side``)."""
-        return self._exact_along(np.array([float(tau)]), side)[0]
