@@ -20,7 +20,8 @@ function that calls compiled code of another module would go on running the old 
 edit of that module. Such a function is made in a closure over :func:`sources_digest` of the
 modules it reaches (numba hashes a function's closure into its cache key): the pattern of
 ``drake_traj.planners.pajak.kernel``, ``drake_traj.robots.compiled_kinematics``,
-``drake_traj.robots.ur_closed_form`` and ``drake_traj.robots.chain_kinematics``.
+``drake_traj.robots.ur_closed_form``, ``drake_traj.robots.chain_kinematics`` and
+``drake_traj.robots.ur_ik``.
 """
 
 import hashlib

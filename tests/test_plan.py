@@ -116,7 +116,8 @@ class _OneTimeAtATime:
 @pytest.mark.parametrize("name", ["boryga_loop_ur10e", "toppra"])
 def test_a_batched_law_gives_what_it_gives_one_time_at_a_time(name):
     """rates_along and an array sample (HermiteLaw's, ToppraLaw's) equal rates_at and sample at
-    each time, inside, at the ends and outside the law; law_pieces from them equals law_pieces
+    each time: rates_along within the law and at its ends (what it promises), sample outside it
+    too; law_pieces from them equals law_pieces
     asking one time at a time (to round-off: q̈'s, amplified by 1/h³ in the jerk)."""
     if name == "toppra":
         _, planner = quintic_task_planner(ToppraConfig)

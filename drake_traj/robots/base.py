@@ -238,8 +238,10 @@ class Robot:
         """Joint configurations (N, n) placing the tool point at ``points`` (N, 3) [m].
 
         A robot whose tool has an orientation keeps that of the configuration ``reference`` and
-        its inverse-kinematics branch. Raises ValueError naming the point and the reason when a
-        point is out of reach.
+        its inverse-kinematics branch. Points along a path, in order, give a continuous q where
+        the path allows one: each point's solution is the one nearest the point before (the first
+        point's, nearest ``reference``), up to a joint's range. Raises ValueError naming the point
+        and the reason when a point is out of reach.
         """
         raise NotImplementedError
 

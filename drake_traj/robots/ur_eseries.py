@@ -428,9 +428,8 @@ class URArm(Robot):
             solutions[k] = self.inverse_kinematics(np.concatenate([points[k], orientation]), branch=branch,
                                                    tool=self.tcp_offset)
         continued = np.unwrap(np.vstack([reference, solutions]), axis=0)[1:]  # each from the one before
-        outside = np.abs(continued) > self._position_limit
-        continued[outside] -= 2 * np.pi * np.sign(continued[outside])
-        return continued
+        turns = np.ceil(np.maximum(np.abs(continued) - self._position_limit, 0.0) / (2 * np.pi))
+        return continued - 2 * np.pi * np.sign(continued) * turns  # back inside the range by whole turns
 
     def joint_rates(self, q, v, a) -> tuple[np.ndarray, np.ndarray]:
         """qd = J⁻¹ [v; 0], qdd = J⁻¹ ([a; 0] - J̇q̇) with the TCP's analytic Jacobian: q (..., 6),

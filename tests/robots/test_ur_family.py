@@ -157,6 +157,39 @@ def test_point_ik_along_a_path_continues_each_joint_past_half_a_turn_from_the_re
     assert np.max(np.abs(np.diff(q, axis=0))) < 0.05
     np.testing.assert_allclose(UR10E.tool_position(q), points, atol=1e-9, rtol=0)
     assert abs(q[-1, 0] - q[0, 0] - 1.6 * np.pi) < 0.01  # the wrist centre's arc is off the base axis by d6
+    # from joint 1 at 5 rad, 3.2 pi on: past its limit (2 pi), it is turned back inside by whole turns
+    reference[0] = 5.0
+    start = UR10E.tool_position(reference)
+    angles = np.arctan2(start[1], start[0]) + np.linspace(0.0, 3.2 * np.pi, 1601)
+    points = np.column_stack([radius * np.cos(angles), radius * np.sin(angles), np.full_like(angles, start[2])])
+    q = UR10E.point_ik(points, reference)
+    np.testing.assert_allclose(UR10E.tool_position(q), points, atol=1e-9, rtol=0)
+    assert np.all(np.abs(q) <= UR10E.upper_limits) and abs(q[0, 0] - 5.0) < 0.05
+    assert sorted(np.round(np.diff(q[:, 0])[np.abs(np.diff(q[:, 0])) > 1] / (2 * np.pi))) == [-1.0, -1.0]
+
+
+def test_joint_rates_are_batched_over_states():
+    """joint_rates of (N, 6) states with one tool velocity (3,) and N accelerations: each row what
+    one state gives, and the TCP moves with v and a (tool_motion); a wrong shape, or a state at
+    the Euler angles' gimbal lock anywhere in the batch, is refused naming it."""
+    rng = np.random.default_rng(5)
+    q = rng.uniform(-2.5, 2.5, (20, 6))
+    q = q[np.abs(np.sin(q[:, 2])) > 0.2][:10]
+    v, a = rng.normal(size=3) * 0.2, rng.normal(size=(len(q), 3))
+    qd, qdd = UR10E.joint_rates(q, v, a)
+    for k in range(len(q)):
+        one = UR10E.joint_rates(q[k], v, a[k])
+        np.testing.assert_allclose(qd[k], one[0], rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(qdd[k], one[1], rtol=1e-12, atol=1e-12)
+    velocity, acceleration = UR10E.tool_motion(q, qd, qdd)
+    np.testing.assert_allclose(velocity, np.broadcast_to(v, velocity.shape), atol=1e-9)
+    np.testing.assert_allclose(acceleration, a, atol=1e-8)
+    with pytest.raises(ValueError, match=r"v must have shape \(\.\.\., 3\)"):
+        UR10E.joint_rates(q, np.zeros(2), a)
+    locked = UR10E.inverse_kinematics_all([0.6, 0.2, 0.5, 0.0, np.pi / 2, 0.0])[0]
+    with pytest.raises(DrakeTrajError, match="gimbal lock") as refused:
+        UR10E.joint_rates(np.vstack([q[:2], locked]), v, a[:3])
+    assert refused.value.cause == "singular"
 
 
 @pytest.mark.parametrize("name", ARMS)
