@@ -21,7 +21,9 @@ from drake_traj.robots.task_space import is_flange, rotation_from_zyx_euler, wra
 from drake_traj.robots.ur_data import NUM_JOINTS
 from drake_traj.validation import invalid
 
-__all__ = ["IK_BRANCHES", "IK_PATH_MAX_STEP", "IK_SINGULAR_TOLERANCE", "branch_ik_many", "branch_solutions", "describe_pose",
+__all__ = ["BEYOND_THE_ELBOW", "ELBOW_SINGULAR", "IK_BRANCHES", "IK_PATH_MAX_STEP", "IK_SINGULAR_TOLERANCE",
+           "OFF_THE_SHOULDER", "SHOULDER_SINGULAR", "WRIST_SINGULAR", "branch_ik_into", "branch_ik_many",
+           "branch_solutions", "describe_pose",
            "flange_goal", "raise_wrist_singular", "unique_rows"]
 
 
@@ -120,74 +122,43 @@ def unique_rows(solutions, atol: float = 1e-12) -> np.ndarray:
 def branch_solutions(model, title: str, pose: np.ndarray, tol: float):
     """All branch solutions of the 4x4 flange pose X_BF (base frame, m) of the e-Series arm
     ``title`` whose closed-form data is ``model`` = [UR_CLOSED_FORM, d1, a2, a3, d4, d5, d6] [m];
-    ``tol`` is the singularity tolerance (:data:`IK_SINGULAR_TOLERANCE`).
+    ``tol`` is the singularity tolerance (:data:`IK_SINGULAR_TOLERANCE`). Each branch is
+    :func:`branch_ik_into`'s.
 
     Returns (solutions, failures, flags): solutions maps branch -> q (wrapped) [rad]; failures maps branch
     -> reason for branches without a real solution; flags = dict(shoulder=bool, wrist=set of shoulder
     signs, elbow=set of branches) marking singular factors. Raises ValueError when the pose is out of
     reach (no branch has a solution and none is wrist-singular).
     """
-    rot, p = pose[:3, :3], pose[:3, 3]
+    model = np.ascontiguousarray(model, dtype=float)
+    rotation, position = np.ascontiguousarray(pose[:3, :3]), np.ascontiguousarray(pose[:3, 3])
     d1, a2, a3, d4, d5, d6 = (float(v) for v in model[1:])
-    z6 = rot[:, 2]
-    o5 = p - d6 * z6
+    o5 = position - d6 * rotation[:, 2]
     r = math.hypot(o5[0], o5[1])
-    h_sq = r * r - d4 * d4
-    reach = abs(a2) + abs(a3)
-    if h_sq < -(tol * reach) ** 2:
-        raise DrakeTrajError(
-            f"{describe_pose(pose)} is out of reach: the wrist centre (flange - d6 z) is "
-            f"{r:.6g} m from the joint-1 axis, closer than the {title}'s shoulder offset d4 = {d4} m", cause=Cause.UNREACHABLE
-        )
-    h_abs = math.sqrt(max(h_sq, 0.0))
-    shoulder_singular = h_abs < tol * reach
-    psi = math.atan2(o5[1], o5[0])
     solutions, failures = {}, {}
     unreached = []  # [m] the wrist-1 joint's distances from the shoulder joint that no elbow reaches
-    elbow_singular = set()
-    wrist_singular = set()
-    for shoulder in (1, -1):
-        q1 = psi + math.atan2(d4, shoulder * h_abs)
-        c1, s1 = math.cos(q1), math.sin(q1)
-        z1 = np.array([s1, -c1, 0.0])
-        c5 = float(z6 @ z1)
-        s5c6 = float(rot[:, 0] @ z1)  # x6 . z1 = s5 c6
-        ms5s6 = float(rot[:, 1] @ z1)  # y6 . z1 = -s5 s6
-        s5_abs = math.hypot(s5c6, ms5s6)
-        if s5_abs < tol:
-            wrist_singular.add(shoulder)
-            continue
-        for wrist in (1, -1):
-            s5 = wrist * s5_abs
-            q5 = math.atan2(s5, c5)
-            q6 = math.atan2(-ms5s6 / s5, s5c6 / s5)
-            x4 = (c5 * z1 - z6) / s5
-            q234 = math.atan2(x4[2], c1 * x4[0] + s1 * x4[1])
-            c234, s234 = math.cos(q234), math.sin(q234)
-            o4 = o5 - d5 * np.array([c1 * s234, s1 * s234, -c234])
-            u = c1 * o4[0] + s1 * o4[1]
-            v = o4[2] - d1
-            dist = math.hypot(u, v)
-            c3 = (dist * dist - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
-            if abs(c3) > 1.0 + tol:
-                unreached.append(dist)
-                for elbow in (1, -1):
-                    failures[(shoulder, elbow, wrist)] = _beyond_the_elbow(f"{dist:.6g} m", a2, a3, title)
-                continue
-            c3 = min(1.0, max(-1.0, c3))
-            s3_abs = math.sqrt(1.0 - c3 * c3)
-            for elbow in (1, -1):
-                if s3_abs < tol:
-                    elbow_singular.add((shoulder, elbow, wrist))
-                q3 = math.atan2(elbow * s3_abs, c3)
-                q2 = math.atan2(v, u) - math.atan2(a3 * elbow * s3_abs, a2 + a3 * c3)
-                q4 = q234 - q2 - q3
-                q = wrap_angle(np.array([q1, q2, q3, q4, q5, q6]))
-                solutions[(shoulder, elbow, wrist)] = q
-    flags = dict(shoulder=shoulder_singular, wrist=wrist_singular, elbow=elbow_singular)
-    if not solutions and not wrist_singular:
+    flags = dict(shoulder=False, wrist=set(), elbow=set())
+    q = np.empty(NUM_JOINTS)
+    for branch in IK_BRANCHES:
+        status, distance = branch_ik_into(model, rotation, position, *map(float, branch), tol, q)
+        if status & OFF_THE_SHOULDER:
+            raise DrakeTrajError(
+                f"{describe_pose(pose)} is out of reach: the wrist centre (flange - d6 z) is "
+                f"{r:.6g} m from the joint-1 axis, closer than the {title}'s shoulder offset d4 = {d4} m",
+                cause=Cause.UNREACHABLE)
+        flags["shoulder"] = bool(status & SHOULDER_SINGULAR)
+        if status & WRIST_SINGULAR:
+            flags["wrist"].add(branch[0])
+        elif status & BEYOND_THE_ELBOW:
+            unreached.append(distance)
+            failures[branch] = _beyond_the_elbow(f"{distance:.6g} m", a2, a3, title)
+        else:
+            if status & ELBOW_SINGULAR:
+                flags["elbow"].add(branch)
+            solutions[branch] = q.copy()
+    if not solutions and not flags["wrist"]:
         centre = math.hypot(r, o5[2] - d1)
-        max_centre = math.hypot(reach + d5, d4)
+        max_centre = math.hypot(abs(a2) + abs(a3) + d5, d4)
         near, far = min(unreached), max(unreached)  # one per shoulder and wrist branch
         distance = f"{near:.6g} m" if f"{near:.6g}" == f"{far:.6g}" else f"{near:.6g} to {far:.6g} m (by IK branch)"
         raise DrakeTrajError(
@@ -204,60 +175,71 @@ def _beyond_the_elbow(distance: str, a2: float, a3: float, title: str) -> str:
             f"[{abs(abs(a2) - abs(a3)):.6g}, {abs(a2) + abs(a3):.6g}] m of the {title}'s upper arm and forearm")
 
 
-def _branch_ik_many_with(dependencies):
+# branch_ik_into's status bits: no solution (off the shoulder, wrist singular, beyond the elbow), or a
+# solution at a singular factor (shoulder, elbow)
+OFF_THE_SHOULDER, SHOULDER_SINGULAR, WRIST_SINGULAR, BEYOND_THE_ELBOW, ELBOW_SINGULAR = 1, 2, 4, 8, 16
+
+
+def _branch_ik_with(dependencies):
     @compiled
-    def branch_ik_many(model, rotation, positions, shoulder, elbow, wrist, tol, out):
-        """The solution on the branch (``shoulder``, ``elbow``, ``wrist``) (each +1 or -1) of the
-        flange poses of rotation ``rotation`` (3, 3) at ``positions`` (N, 3) [m], into the rows of
-        ``out`` (N, 6) [rad, wrapped]: :func:`branch_solutions`' closed form for one branch,
-        compiled, for a path of poses. Returns a row's status in an (N,) array: 0 solved; 1 out of
-        reach of the shoulder offset, 2 shoulder, 3 wrist or 5 elbow singular, 4 beyond the elbow
-        (the row of ``out`` then undefined: :func:`branch_solutions` says why)."""
+    def branch_ik_into(model, rotation, position, shoulder, elbow, wrist, tol, out):
+        """The closed form (the derivation above) on one branch: the solution of the flange pose
+        of rotation ``rotation`` (3, 3) at ``position`` (3,) [m] on branch (``shoulder``,
+        ``elbow``, ``wrist``) (each +1.0 or -1.0) into ``out`` (6,) [rad, wrapped]. Returns
+        (status, distance): status the bits :data:`OFF_THE_SHOULDER`, :data:`WRIST_SINGULAR`,
+        :data:`BEYOND_THE_ELBOW` (``out`` not written; ``distance`` [m] the wrist-1 joint's from
+        the shoulder joint, beyond the elbow's reach) and :data:`SHOULDER_SINGULAR`,
+        :data:`ELBOW_SINGULAR` (a solution, at that singular factor)."""
         dependencies  # noqa: B018 (numba's cache key: drake_traj.compiled.sources_digest)
         d1, a2, a3, d4, d5, d6 = model[1], model[2], model[3], model[4], model[5], model[6]
-        reach = abs(a2) + abs(a3)
         z6 = rotation[:, 2]
+        o5 = position - d6 * z6
+        r = math.hypot(o5[0], o5[1])
+        h_sq = r * r - d4 * d4
+        reach = abs(a2) + abs(a3)
+        if h_sq < -(tol * reach) ** 2:
+            return OFF_THE_SHOULDER, 0.0
+        h_abs = math.sqrt(max(h_sq, 0.0))
+        status = SHOULDER_SINGULAR if h_abs < tol * reach else 0
+        q1 = math.atan2(o5[1], o5[0]) + math.atan2(d4, shoulder * h_abs)
+        c1, s1 = math.cos(q1), math.sin(q1)
+        z1 = np.array([s1, -c1, 0.0])
+        c5 = z6[0] * z1[0] + z6[1] * z1[1]  # z6 . z1
+        s5c6 = rotation[0, 0] * z1[0] + rotation[1, 0] * z1[1]  # x6 . z1 = s5 c6
+        ms5s6 = rotation[0, 1] * z1[0] + rotation[1, 1] * z1[1]  # y6 . z1 = -s5 s6
+        s5_abs = math.hypot(s5c6, ms5s6)
+        if s5_abs < tol:
+            return status | WRIST_SINGULAR, 0.0
+        s5 = wrist * s5_abs
+        x4 = (c5 * z1 - z6) / s5
+        q234 = math.atan2(x4[2], c1 * x4[0] + s1 * x4[1])
+        c234, s234 = math.cos(q234), math.sin(q234)
+        o4 = o5 - d5 * np.array([c1 * s234, s1 * s234, -c234])
+        u = c1 * o4[0] + s1 * o4[1]
+        v = o4[2] - d1
+        distance = math.hypot(u, v)
+        c3 = (distance * distance - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
+        if abs(c3) > 1.0 + tol:
+            return status | BEYOND_THE_ELBOW, distance
+        c3 = min(1.0, max(-1.0, c3))
+        s3_abs = math.sqrt(1.0 - c3 * c3)
+        if s3_abs < tol:
+            status |= ELBOW_SINGULAR
+        q3 = math.atan2(elbow * s3_abs, c3)
+        q2 = math.atan2(v, u) - math.atan2(a3 * elbow * s3_abs, a2 + a3 * c3)
+        out[:] = wrapped(np.array([q1, q2, q3, q234 - q2 - q3, math.atan2(s5, c5), math.atan2(-ms5s6 / s5, s5c6 / s5)]))
+        return status, distance
+
+    @compiled
+    def branch_ik_many(model, rotation, positions, shoulder, elbow, wrist, tol, out):
+        """:func:`branch_ik_into` at each row of ``positions`` (N, 3) [m] into the rows of
+        ``out`` (N, 6), for a path of poses of one rotation; returns the statuses (N,)."""
         status = np.zeros(positions.shape[0], dtype=np.int64)
         for k in range(positions.shape[0]):
-            o5 = positions[k] - d6 * z6
-            r = math.hypot(o5[0], o5[1])
-            h_sq = r * r - d4 * d4
-            h_abs = math.sqrt(max(h_sq, 0.0))
-            if h_sq < -(tol * reach) ** 2 or h_abs < tol * reach:
-                status[k] = 1 if h_sq < -(tol * reach) ** 2 else 2
-                continue
-            q1 = math.atan2(o5[1], o5[0]) + math.atan2(d4, shoulder * h_abs)
-            c1, s1 = math.cos(q1), math.sin(q1)
-            c5 = z6[0] * s1 - z6[1] * c1  # z6 . z1, z1 = (s1, -c1, 0)
-            s5c6 = rotation[0, 0] * s1 - rotation[1, 0] * c1  # x6 . z1 = s5 c6
-            ms5s6 = rotation[0, 1] * s1 - rotation[1, 1] * c1  # y6 . z1 = -s5 s6
-            s5_abs = math.hypot(s5c6, ms5s6)
-            if s5_abs < tol:
-                status[k] = 3
-                continue
-            s5 = wrist * s5_abs
-            x4 = (c5 * np.array([s1, -c1, 0.0]) - z6) / s5
-            q234 = math.atan2(x4[2], c1 * x4[0] + s1 * x4[1])
-            c234, s234 = math.cos(q234), math.sin(q234)
-            u = c1 * (o5[0] - d5 * c1 * s234) + s1 * (o5[1] - d5 * s1 * s234)  # o4 = o5 - d5 z4
-            v = o5[2] + d5 * c234 - d1
-            dist = math.hypot(u, v)
-            c3 = (dist * dist - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
-            if abs(c3) > 1.0 + tol:
-                status[k] = 4
-                continue
-            c3 = min(1.0, max(-1.0, c3))
-            s3_abs = math.sqrt(1.0 - c3 * c3)
-            if s3_abs < tol:
-                status[k] = 5
-                continue
-            q3 = math.atan2(elbow * s3_abs, c3)
-            q2 = math.atan2(v, u) - math.atan2(a3 * elbow * s3_abs, a2 + a3 * c3)
-            row = np.array([q1, q2, q3, q234 - q2 - q3, math.atan2(s5, c5), math.atan2(-ms5s6 / s5, s5c6 / s5)])
-            out[k] = wrapped(row)
+            status[k] = branch_ik_into(model, rotation, positions[k], shoulder, elbow, wrist, tol, out[k])[0]
         return status
 
-    return branch_ik_many
+    return branch_ik_into, branch_ik_many
 
 
-branch_ik_many = _branch_ik_many_with(sources_digest(task_space.__file__))
+branch_ik_into, branch_ik_many = _branch_ik_with(sources_digest(task_space.__file__))
