@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = [
-    "Cause", "DrakeTrajError", "Failure", "Field", "PlanningError", "SingularConfigurationError", "did_you_mean",
-    "field_text", "joint_label",
+    "Cause", "DrakeTrajError", "Failure", "Field", "PlanningError", "SingularConfigurationError", "UnreachablePoseError",
+    "did_you_mean", "field_text", "joint_label",
 ]
 
 Field = tuple  # tuple[str | int, ...]: field names and list indices, outermost first
@@ -130,6 +130,22 @@ class SingularConfigurationError(DrakeTrajError):
     Euler-angle gimbal lock, an IK branch that does not exist there)."""
 
     default_cause = Cause.SINGULAR
+
+
+class UnreachablePoseError(DrakeTrajError):
+    """A pose no joint solution within the joint ranges takes (any IK branch): the arm's reach, its
+    shoulder offset or its joint ranges rule it out.
+
+    Attributes:
+        pose: X_BF (4, 4), the flange pose asked for, in the arm's base frame [m]: what an
+            independent check of the refusal solves for (the soak's, with Drake's InverseKinematics).
+    """
+
+    default_cause = Cause.UNREACHABLE
+
+    def __init__(self, message: str, *, pose, field: Field = ()):
+        super().__init__(message, field=field)
+        self.pose = np.array(pose, dtype=float)
 
 
 class PlanningError(DrakeTrajError):

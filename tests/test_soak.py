@@ -10,12 +10,15 @@ from pydrake.polynomial import Polynomial
 from pydrake.trajectories import PiecewisePolynomial
 
 import drake_traj.bench.soak_report as soak_report
+from pydrake.math import RollPitchYaw, RotationMatrix
 from drake_traj import cli
 from drake_traj.bench import SOAK_ARMS, SOAK_PLANNERS, run_soak_task
-from drake_traj.bench.soak_checks import ClearanceCheck, dense_rates, diagnose, piece_coefficients, pose_error, rate_peaks
+from drake_traj.bench.soak_checks import (ClearanceCheck, dense_rates, diagnose, piece_coefficients, pose_error, rate_peaks,
+                                          reach_diagnosis)
 from drake_traj.bench.soak_suite import CLOSED_LOOP_EVERY, _check_plan
 from drake_traj.bench.soak_tasks import draw_task
 from drake_traj.cell import Box, Cell, CellChecker, CollisionError
+from drake_traj.errors import Cause, DrakeTrajError, UnreachablePoseError
 from drake_traj.robots import UR10E
 from drake_traj.scenario.checks import preflight
 from drake_traj.scenario.scenario import make_planner
@@ -142,6 +145,50 @@ def test_a_refusal_is_diagnosed_independently():
     beyond = check.distance(clear) - 0.0005
     assert diagnose(CollisionError("refused", configuration=clear, time=0.0, **made), robot, check,
                     beyond).startswith("borderline: SceneGraph puts it 0.500 mm beyond")
+
+
+def _flange_pose(check, robot, q) -> np.ndarray:
+    """X_WF (4, 4) of ``robot``'s flange at ``q`` by Drake, in ``check``'s plant."""
+    plant, checker = check.probe.checker.plant, check.probe.checker
+    context = plant.CreateDefaultContext()
+    plant.SetPositions(context, checker.instance, q)
+    return plant.GetFrameByName(robot.tool_frame, checker.instance).CalcPoseInWorld(context).GetAsMatrix4()
+
+
+@pytest.mark.parametrize("arm", ["ur10e", "puma560"])
+def test_an_unreachable_pose_is_diagnosed_by_drakes_inverse_kinematics(arm):
+    task = draw_task(arm, "li", 3)
+    robot = task.scenario.robot_with_tool()
+    check = ClearanceCheck(robot, task.scenario.cell)
+    q = np.clip([0.4, -1.2, 1.3, -1.0, 1.1, 0.3], robot.lower_limits + 0.1, robot.upper_limits - 0.1)
+    reached = _flange_pose(check, robot, q)
+    far = reached.copy()
+    far[:3, 3] *= 4  # several metres out: beyond either arm's reach
+    with pytest.raises(UnreachablePoseError) as refused:  # the arm's own IK (UR: the flange's pose, PUMA: the TCP's)
+        robot.inverse_kinematics_all(far if arm == "ur10e" else _task_pose(far @ robot.tcp_offset))
+    assert refused.value.cause is Cause.UNREACHABLE
+    np.testing.assert_allclose(refused.value.pose, far, atol=1e-9)  # the flange pose, in the plant's world
+    moved = refused.value.relocated(("planner", "points", 3), "moved")  # as a planner passes it on
+    assert diagnose(moved, robot, check, 0.01).startswith("supported: Drake's InverseKinematics, from 32 starts")
+    # a pose the arm takes at q, refused by a made-up error: contradicted, with a solution that takes it
+    wrong = UnreachablePoseError("made up", pose=reached)
+    verdict = diagnose(wrong, robot, check, 0.01)
+    assert verdict.startswith("contradicted: Drake's InverseKinematics takes the flange to")
+    solution = np.array(verdict.split("q = ")[1].split("]")[0].strip("[").split(","), dtype=float)
+    np.testing.assert_allclose(_flange_pose(check, robot, solution), reached, atol=1e-6)
+    if arm == "ur10e":  # just beyond the edge of the reach (the arm straight up, 3 µm higher): borderline
+        edge = _flange_pose(check, robot, np.array([0.0, -np.pi / 2, 0.0, -np.pi / 2, 0.0, 0.0]))
+        edge[2, 3] += 3e-6
+        verdict = reach_diagnosis(check.probe.checker, robot, edge)
+        assert verdict.startswith("borderline: Drake's InverseKinematics takes the flange to ")
+        assert float(verdict.split(" to ")[1].split(" mm")[0]) == pytest.approx(0.003, abs=2e-5)
+    # an unreachable refusal without its pose (a branch's reach) is not diagnosed
+    assert diagnose(DrakeTrajError("branch", cause=Cause.UNREACHABLE), robot, check, 0.01) == "not diagnosed"
+
+
+def _task_pose(X) -> np.ndarray:
+    """[x, y, z, φ_X, φ_Y, φ_Z] of the 4x4 pose ``X`` (Z-Y-X Euler angles, Drake's RollPitchYaw)."""
+    return np.concatenate([X[:3, 3], RollPitchYaw(RotationMatrix(X[:3, :3])).vector()])
 
 
 def test_tasks_are_drawn_from_their_seed_alone():

@@ -21,21 +21,26 @@ refusal.
 - **Tool limits** (Li et al. 2019's, :func:`tool_rates`): the TCP's speed and acceleration by
   Drake's Jacobian and bias acceleration at every millisecond of the plan.
 - **Refusals** (:func:`diagnose`): a collision refusal's configuration is closer than the
-  clearance by the same SceneGraph query; a joint-range refusal's joint is past its range; others
-  are counted by cause without a diagnosis.
+  clearance by the same SceneGraph query; a joint-range refusal's joint is past its range; an
+  unreachable pose (:class:`~drake_traj.errors.UnreachablePoseError`) is one Drake's
+  InverseKinematics does not reach within the joint ranges from :data:`IK_STARTS` seeded starts
+  (:func:`reach_diagnosis`); others are counted by cause without a diagnosis.
 
 Units: rad, rad/s, rad/s², rad/s³, m, s.
 """
 
 import numpy as np
-from pydrake.math import RollPitchYaw
+from pydrake.math import RollPitchYaw, RotationMatrix
+from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.multibody.tree import JacobianWrtVariable
+from pydrake.solvers import IpoptSolver, SnoptSolver, Solve, SolverOptions
 
 from drake_traj.bench.free_suite import ClearanceProbe
 from drake_traj.cell import shape_radius
+from drake_traj.errors import UnreachablePoseError
 
 __all__ = ["ClearanceCheck", "LIMIT_TOLERANCE", "axis_reach", "dense_rates", "diagnose", "piece_coefficients", "pose_error",
-           "rate_peaks", "tool_rates"]
+           "rate_peaks", "reach_diagnosis", "tool_rates"]
 
 DENSE_PERIOD = 1e-4  # [s] between two samples of the limits' check
 CLEARANCE_PERIOD = 1e-3  # [s] the finest interval the clearance check halves to
@@ -43,6 +48,12 @@ COARSE_STEPS = 64  # clearance samples every 64 ms first
 LIMIT_TOLERANCE = 1e-6  # relative: a peak up to (1 + 1e-6) times its limit is within it (round-off)
 BORDERLINE = 1e-3  # [m] a collision refusal SceneGraph puts this little beyond the clearance is borderline, not wrong
 QUERY_WITHIN = 0.15  # [m] SceneGraph's distances are asked up to this (a farther pair reads as 0.15)
+IK_STARTS = 32  # seeded starts of Drake's InverseKinematics for an unreachable pose
+IK_REACHED = 1e-9  # [m] and [rad]: a flange pose Drake's solution takes this closely is reached
+IK_NEAR = 1e-5  # [m] and [rad]: one it takes this closely only is on the edge of the reach
+_IK_OPTIONS = SolverOptions()
+_IK_OPTIONS.SetOption(SnoptSolver().solver_id(), "Major optimality tolerance", 1e-12)
+_IK_OPTIONS.SetOption(IpoptSolver().solver_id(), "tol", 1e-12)
 
 
 def piece_coefficients(trajectory) -> tuple[np.ndarray, np.ndarray]:
@@ -252,13 +263,15 @@ def tool_rates(checker, robot, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
 
 def diagnose(error, robot, clearance: ClearanceCheck, cell_clearance: float) -> str:
     """Whether a refusal ``error`` (a DrakeTrajError) of a task on ``robot`` agrees with an
-    independent diagnosis: "confirmed", "borderline: <why>", "contradicted: <why>" or "not
-    diagnosed" (a cause, or a refusal without the configuration, that the soak does not diagnose).
+    independent diagnosis: "confirmed", "borderline: <why>", "supported: <why>", "contradicted:
+    <why>" or "not diagnosed" (a cause, or a refusal without the configuration or pose, that the
+    soak does not diagnose).
     A collision: SceneGraph (``clearance``'s query) puts the refused configuration closer than
     ``cell_clearance`` [m] (confirmed), within :data:`BORDERLINE` beyond it (borderline: the cell
     check refuses on the smaller of SceneGraph's distance and a certified lower bound, and
     SceneGraph's distance of cylinders and boxes can be millimetres above the true one), or further
-    (contradicted). A joint range: the joint is past its range in the refused configuration."""
+    (contradicted). A joint range: the joint is past its range in the refused configuration. An
+    unreachable pose: :func:`reach_diagnosis` (supported or contradicted)."""
     cause = str(getattr(error, "cause", ""))
     if cause == "collision" and getattr(error, "configuration", None) is not None:
         distance = clearance.distance(error.configuration)
@@ -274,4 +287,62 @@ def diagnose(error, robot, clearance: ClearanceCheck, cell_clearance: float) -> 
         if value < robot.lower_limits[j] or value > robot.upper_limits[j]:
             return "confirmed"
         return f"contradicted: joint {j + 1} at {value:.6f} is inside [{robot.lower_limits[j]:.6f}, {robot.upper_limits[j]:.6f}]"
+    if cause == "unreachable":
+        pose = _refused_pose(error)
+        return "not diagnosed" if pose is None else reach_diagnosis(clearance.probe.checker, robot, pose)
     return "not diagnosed"
+
+
+def _refused_pose(error):
+    """The flange pose (4, 4) of the :class:`~drake_traj.errors.UnreachablePoseError` that is
+    ``error`` or caused it, or None."""
+    while error is not None:
+        if isinstance(error, UnreachablePoseError):
+            return error.pose
+        error = error.__cause__ or error.__context__
+    return None
+
+
+def reach_diagnosis(checker, robot, pose, starts: int = IK_STARTS) -> str:
+    """Whether the flange pose X_WF ``pose`` (4, 4) [m], refused as out of reach, is out of reach of
+    Drake's InverseKinematics in the cell check ``checker``'s plant: the flange frame's position
+    and orientation costs minimised within the plant's joint limits (SNOPT, or IPOPT, to an
+    optimality tolerance of 1e-12) from ``starts`` seeded uniform starts within the robot's ranges,
+    each result measured by forward kinematics. "contradicted: ..." where a solution within the
+    ranges takes the pose to within :data:`IK_REACHED`; "borderline: ..." where the closest comes
+    within :data:`IK_NEAR` only (a pose on the edge of the reach, where the solver converges
+    slowly); "supported: ..." otherwise (evidence, not proof: a local solver)."""
+    plant = checker.plant
+    flange, world = plant.GetFrameByName(robot.tool_frame, checker.instance), plant.world_frame()
+    pose = np.asarray(pose, dtype=float)
+    target = RotationMatrix(pose[:3, :3])
+    lower, upper = np.maximum(robot.lower_limits, -2 * np.pi), np.minimum(robot.upper_limits, 2 * np.pi)
+    context = plant.CreateDefaultContext()
+    full = plant.GetPositions(context)
+    random = np.random.default_rng(0)
+    closest = (np.inf, np.inf, None)  # (position error [m], orientation error [rad], q)
+    for _ in range(starts):
+        ik = InverseKinematics(plant, with_joint_limits=True)
+        ik.AddPositionCost(world, pose[:3, 3], flange, np.zeros(3), np.eye(3))
+        ik.AddOrientationCost(world, target, flange, RotationMatrix(), 1.0)
+        plant.SetPositionsInArray(checker.instance, random.uniform(lower, upper), full)
+        result = Solve(ik.prog(), full, _IK_OPTIONS)
+        q = np.clip(plant.GetPositionsFromArray(checker.instance, result.GetSolution(ik.q())),
+                    robot.lower_limits, robot.upper_limits)
+        plant.SetPositions(context, checker.instance, q)
+        X_WF = flange.CalcPoseInWorld(context).GetAsMatrix4()
+        position = float(np.linalg.norm(X_WF[:3, 3] - pose[:3, 3]))
+        turn = float(np.arccos(np.clip((np.trace(pose[:3, :3].T @ X_WF[:3, :3]) - 1) / 2, -1.0, 1.0)))
+        if max(position, turn) < max(closest[:2]):
+            closest = (position, turn, q)
+        if max(position, turn) <= IK_REACHED:
+            break
+    position, turn, q = closest
+    closest_text = f"{position * 1e3:.3g} mm and {turn:.3g} rad from the refused pose"
+    if max(position, turn) <= IK_REACHED:
+        return (f"contradicted: Drake's InverseKinematics takes the flange to {closest_text} at "
+                f"q = {np.round(q, 6).tolist()}, within the joint ranges")
+    if max(position, turn) <= IK_NEAR:
+        return f"borderline: Drake's InverseKinematics takes the flange to {closest_text}, within the joint ranges"
+    return (f"supported: Drake's InverseKinematics, from {starts} starts within the joint ranges, comes no closer "
+            f"than {closest_text}")

@@ -123,7 +123,7 @@ def _refused(task, key, error, began) -> dict:
     field = field_text(error.field) if isinstance(error, DrakeTrajError) and error.field else ""
     robot = task.scenario.robot_with_tool()
     diagnosis = "not diagnosed"
-    if cause in ("collision", "joint range"):
+    if cause in ("collision", "joint range", "unreachable"):
         diagnosis = diagnose(error, robot, ClearanceCheck(robot, task.scenario.cell), task.scenario.cell.clearance)
     return soak_row(key, outcome="refused", cause=cause, field=field, diagnosis=diagnosis,
                     wrong=diagnosis.startswith("contradicted"), planning_s=time.perf_counter() - began,

@@ -35,7 +35,7 @@ import math
 import numpy as np
 
 from drake_traj.compiled import compiled, sources_digest
-from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError, joint_label
+from drake_traj.errors import SingularConfigurationError, UnreachablePoseError, joint_label
 from drake_traj.robots.base import FLANGE, format_point
 from drake_traj.robots import task_space
 from drake_traj.robots.task_space import rotation_from_zyx_euler, tcp_rows_into, velocity_product_terms, wrap_angle
@@ -381,9 +381,10 @@ def inverse_kinematics_all(model, pose, tool=FLANGE, lower=None, upper=None) -> 
     than the seeds find would miss some: the tests check the UR10e's eight.
 
     Raises:
-        DrakeTrajError: a pose not six finite numbers (field ``pose``); cause UNREACHABLE when no
-            seed reaches the pose (the message gives the flange's distance from joint 1's origin
-            and the arm's reach bound) or every solution is beyond the limits (naming the joint).
+        DrakeTrajError: a pose not six finite numbers (field ``pose``).
+        UnreachablePoseError: no seed reaches the pose (the message gives the flange's distance
+            from joint 1's origin and the arm's reach bound), or every solution is beyond the
+            limits (naming the joint); its ``pose`` is the flange pose asked for.
         SingularConfigurationError: the pose is reached only at singular configurations.
 
     Singular solutions (measure below :data:`IK_SINGULAR_TOLERANCE`: a continuum, such as the
@@ -410,17 +411,17 @@ def inverse_kinematics_all(model, pose, tool=FLANGE, lower=None, upper=None) -> 
             found.append(inside)
     where = f"pose [x, y, z, phi_X, phi_Y, phi_Z] = {format_point(pose)} (m, rad)"
     if not found:
+        flange_goal = goal @ np.linalg.inv(tool)
         if beyond is not None:
             j = int(np.argmax((wrap_angle(beyond) < lower) | (wrap_angle(beyond) > upper)))
-            raise DrakeTrajError(f"{where} is reached only beyond the joint limits: {joint_label(j)} at "
-                                 f"{wrap_angle(beyond)[j]:.6g} rad, limits [{lower[j]:.6g}, {upper[j]:.6g}] rad",
-                                 cause=Cause.UNREACHABLE)
-        flange_goal = goal @ np.linalg.inv(tool)
+            raise UnreachablePoseError(f"{where} is reached only beyond the joint limits: {joint_label(j)} at "
+                                       f"{wrap_angle(beyond)[j]:.6g} rad, limits [{lower[j]:.6g}, {upper[j]:.6g}] "
+                                       f"rad", pose=flange_goal)
         first = model[_TRANSFORMS + 9:_TRANSFORMS + 12]
         distance = float(np.linalg.norm(flange_goal[:3, 3] - first))
-        raise DrakeTrajError(f"{where} is out of reach: the flange would be {distance:.6g} m from joint 1's origin, "
-                             f"the arm reaches at most {chain_reach(model):.6g} m from it, and no solution was found "
-                             f"from {len(seeds)} starts", cause=Cause.UNREACHABLE)
+        raise UnreachablePoseError(f"{where} is out of reach: the flange would be {distance:.6g} m from joint 1's "
+                                   f"origin, the arm reaches at most {chain_reach(model):.6g} m from it, and no "
+                                   f"solution was found from {len(seeds)} starts", pose=flange_goal)
     found.sort(key=tuple)
     measures = [_measure(model, q, tool) for q in found]
     regular = [q for q, measure in zip(found, measures) if measure >= IK_SINGULAR_TOLERANCE]

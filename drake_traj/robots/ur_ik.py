@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from drake_traj.compiled import compiled, sources_digest
-from drake_traj.errors import Cause, DrakeTrajError, SingularConfigurationError
+from drake_traj.errors import SingularConfigurationError, UnreachablePoseError
 from drake_traj.robots import task_space
 from drake_traj.robots.task_space import is_flange, rotation_from_zyx_euler, wrap_angle, wrapped, zyx_euler_from_rotation
 from drake_traj.robots.ur_data import NUM_JOINTS
@@ -127,8 +127,8 @@ def branch_solutions(model, title: str, pose: np.ndarray, tol: float):
 
     Returns (solutions, failures, flags): solutions maps branch -> q (wrapped) [rad]; failures maps branch
     -> reason for branches without a real solution; flags = dict(shoulder=bool, wrist=set of shoulder
-    signs, elbow=set of branches) marking singular factors. Raises ValueError when the pose is out of
-    reach (no branch has a solution and none is wrist-singular).
+    signs, elbow=set of branches) marking singular factors. Raises UnreachablePoseError (its ``pose`` the flange pose) when the
+    pose is out of reach (no branch has a solution and none is wrist-singular).
     """
     model = np.ascontiguousarray(model, dtype=float)
     rotation, position = np.ascontiguousarray(pose[:3, :3]), np.ascontiguousarray(pose[:3, 3])
@@ -142,10 +142,9 @@ def branch_solutions(model, title: str, pose: np.ndarray, tol: float):
     for branch in IK_BRANCHES:
         status, distance = branch_ik_into(model, rotation, position, *map(float, branch), tol, q)
         if status & OFF_THE_SHOULDER:
-            raise DrakeTrajError(
+            raise UnreachablePoseError(
                 f"{describe_pose(pose)} is out of reach: the wrist centre (flange - d6 z) is "
-                f"{r:.6g} m from the joint-1 axis, closer than the {title}'s shoulder offset d4 = {d4} m",
-                cause=Cause.UNREACHABLE)
+                f"{r:.6g} m from the joint-1 axis, closer than the {title}'s shoulder offset d4 = {d4} m", pose=pose)
         flags["shoulder"] = bool(status & SHOULDER_SINGULAR)
         if status & WRIST_SINGULAR:
             flags["wrist"].add(branch[0])
@@ -161,10 +160,10 @@ def branch_solutions(model, title: str, pose: np.ndarray, tol: float):
         max_centre = math.hypot(abs(a2) + abs(a3) + d5, d4)
         near, far = min(unreached), max(unreached)  # one per shoulder and wrist branch
         distance = f"{near:.6g} m" if f"{near:.6g}" == f"{far:.6g}" else f"{near:.6g} to {far:.6g} m (by IK branch)"
-        raise DrakeTrajError(
+        raise UnreachablePoseError(
             f"{describe_pose(pose)} is out of reach: the wrist centre (flange - d6 z) is {centre:.6g} m "
             f"from the shoulder point (0, 0, d1) (the {title} reaches at most {max_centre:.6g} m); "
-            f"{_beyond_the_elbow(distance, a2, a3, title)}", cause=Cause.UNREACHABLE)
+            f"{_beyond_the_elbow(distance, a2, a3, title)}", pose=pose)
     return solutions, failures, flags
 
 
