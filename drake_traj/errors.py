@@ -23,7 +23,7 @@ import numpy as np
 
 __all__ = [
     "Cause", "DrakeTrajError", "Failure", "Field", "PlanningError", "SingularConfigurationError", "UnreachablePoseError",
-    "did_you_mean", "field_text", "joint_label",
+    "did_you_mean", "field_text", "interrupt_in", "joint_label", "reraise_interrupt",
 ]
 
 Field = tuple  # tuple[str | int, ...]: field names and list indices, outermost first
@@ -86,6 +86,29 @@ def did_you_mean(word, known, *, tags: bool = False) -> str:
     if not close:
         return ""
     return f"did you mean {close[0] if len(close) == 1 else ', '.join(close[:-1]) + ' or ' + close[-1]}?"
+
+
+def interrupt_in(error: BaseException) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt (Ctrl-C, or SIGTERM as the command line raises it) that is ``error``
+    or lies behind it, else None. A signal handled as compiled code returns to Python (numba's
+    dispatcher) surfaces as a SystemError ("returned a result with an exception set") whose cause
+    or context is the KeyboardInterrupt: whatever catches ``Exception`` to keep a failure as a
+    result re-raises this instead, so that the stop stops."""
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
+
+
+def reraise_interrupt(error: BaseException) -> None:
+    """Raise the KeyboardInterrupt behind ``error`` (:func:`interrupt_in`), if there is one: the
+    first line of an ``except Exception`` that turns a failure into a result."""
+    stop = interrupt_in(error)
+    if stop is not None:
+        raise stop from None
 
 
 def _restore(cls, message: str, state: dict):

@@ -21,7 +21,7 @@ from pydrake.systems.analysis import Simulator
 
 from drake_traj import catalogue, cli
 from drake_traj.cli import commands, progress
-from drake_traj.errors import Cause, Failure, did_you_mean
+from drake_traj.errors import Cause, Failure, did_you_mean, interrupt_in, reraise_interrupt
 from drake_traj.planners.quintic import QuinticPtpPlanner, plan_synchronized_quintic
 from drake_traj.results import SimulationResult
 from drake_traj.robots import UR10E, get_robot
@@ -266,6 +266,38 @@ def test_ctrl_c_in_run_station_raises_with_the_failure_and_the_log_in_the_logger
     assert not hasattr(caught.value, "result") and caught.value.failure.cause is Cause.INTERRUPTED
     result = SimulationResult.from_station(station, simulator.get_context(), failure=caught.value.failure)
     assert result.t[-1] == pytest.approx(caught.value.failure.time, abs=2e-3)
+
+
+def interrupt_inside_compiled_code():
+    """The SystemError that a Ctrl-C or SIGTERM handled as numba's compiled code returns raises:
+    "returned a result with an exception set", its cause the KeyboardInterrupt."""
+    try:
+        raise KeyboardInterrupt
+    except KeyboardInterrupt as stop:
+        raise SystemError("CPUDispatcher(<function kernel>) returned a result with an exception set") from stop
+
+
+def test_an_interrupt_that_came_as_compiled_code_returned_is_found_and_raised():
+    with pytest.raises(SystemError) as caught:
+        interrupt_inside_compiled_code()
+    stop = interrupt_in(caught.value)
+    assert type(stop) is KeyboardInterrupt and stop is caught.value.__cause__
+    with pytest.raises(KeyboardInterrupt):
+        reraise_interrupt(caught.value)
+    plain = RuntimeError("a planner's own failure")
+    assert interrupt_in(plain) is None and reraise_interrupt(plain) is None
+
+
+def test_an_interrupt_that_came_as_compiled_code_returned_stops_the_run_as_ctrl_c_does():
+    def progress_hook(t):
+        if t >= 0.2:
+            interrupt_inside_compiled_code()
+    station = build_station(short_quintic())
+    with pytest.raises(KeyboardInterrupt) as caught:  # not a failed run with a SystemError: the stop stops
+        run_station(Simulator(station), station, settle_time=0.1, progress=progress_hook)
+    assert caught.value.failure.cause is Cause.INTERRUPTED and 0.2 <= caught.value.failure.time < 0.211
+    with pytest.raises(KeyboardInterrupt):
+        simulate(short_quintic(), progress=progress_hook, settle_time=0.1)
 
 
 SCRIPT = """

@@ -10,6 +10,7 @@ from pydrake.polynomial import Polynomial
 from pydrake.trajectories import PiecewisePolynomial
 
 import drake_traj.bench.soak_report as soak_report
+import drake_traj.bench.soak_suite as soak_suite
 from pydrake.math import RollPitchYaw, RotationMatrix
 from drake_traj import cli
 from drake_traj.bench import SOAK_ARMS, SOAK_PLANNERS, run_soak_task
@@ -189,6 +190,22 @@ def test_an_unreachable_pose_is_diagnosed_by_drakes_inverse_kinematics(arm):
 def _task_pose(X) -> np.ndarray:
     """[x, y, z, φ_X, φ_Y, φ_Z] of the 4x4 pose ``X`` (Z-Y-X Euler angles, Drake's RollPitchYaw)."""
     return np.concatenate([X[:3, 3], RollPitchYaw(RotationMatrix(X[:3, :3])).vector()])
+
+
+def test_a_stop_inside_a_task_stops_the_soak(monkeypatch):
+    """Ctrl-C or SIGTERM while a task runs compiled code (Pająk's integration) surfaces as a
+    SystemError: the soak stops on it (and writes what it finished), never takes it for a task's error."""
+    def preflight_interrupted(scenario, planner):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as stop:
+            raise SystemError("CPUDispatcher(<function integrate_kernel>) returned a result with an exception set") from stop
+    monkeypatch.setattr(soak_suite, "preflight", preflight_interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_soak_task("ur10e", "quintic", 3)
+    monkeypatch.setattr(soak_suite, "preflight", lambda scenario, planner: 1 / 0)  # a bug of its own: a wrong row
+    row = run_soak_task("ur10e", "quintic", 3)
+    assert row["outcome"] == "error" and row["wrong"] and row["message"].startswith("ZeroDivisionError")
 
 
 def test_tasks_are_drawn_from_their_seed_alone():

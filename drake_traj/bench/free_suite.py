@@ -33,6 +33,7 @@ from drake_traj.bench.report import _format
 from drake_traj.bench.run import _check_where, _claim_output_directory, _whole_number
 from drake_traj.bench.units import failure_reason
 from drake_traj.cell import CellChecker
+from drake_traj.errors import reraise_interrupt
 from drake_traj.planners import make_planner
 
 __all__ = ["ClearanceProbe", "FREE_COLUMNS", "FREE_FILES", "free_bench", "run_free_query", "summary"]
@@ -81,6 +82,7 @@ def run_free_query(kind: str, scene_seed: int, planning_time: float = PLANNING_T
     try:
         scene = generate(kind, scene_seed)
     except Exception as error:  # a unit's failure is a row, not a lost run
+        reraise_interrupt(error)
         return _failed(kind, scene_seed, failure_reason(error))
     query = scene.queries[0]
     probe = ClearanceProbe(scene.robot, scene.cell)
@@ -92,6 +94,7 @@ def run_free_query(kind: str, scene_seed: int, planning_time: float = PLANNING_T
         planner = make_planner(query.config(planning_time=planning_time), scene.robot, query.start)
         checker.check_planner(planner)  # what the preflight's cell check calls: plan_in(checker)
     except Exception as error:  # refused: the planner's message
+        reraise_interrupt(error)
         return _failed(kind, scene_seed, failure_reason(error), wall_s=time.perf_counter() - wall,
                        cpu_s=time.process_time() - cpu, **known)
     known |= {"wall_s": time.perf_counter() - wall, "cpu_s": time.process_time() - cpu}

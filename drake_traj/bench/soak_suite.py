@@ -34,7 +34,7 @@ from drake_traj.bench.soak_checks import (DENSE_PERIOD, LIMIT_TOLERANCE, Clearan
                                           piece_coefficients, pose_error, rate_peaks, tool_rates)
 from drake_traj.bench.soak_tasks import draw_task
 from drake_traj.bench.units import failure_reason
-from drake_traj.errors import DrakeTrajError, field_text
+from drake_traj.errors import DrakeTrajError, field_text, reraise_interrupt
 from drake_traj.scenario import check_planned_duration, make_planner, preflight
 from drake_traj.station import simulate
 
@@ -71,11 +71,13 @@ def run_soak_task(arm: str, planner: str, seed: int) -> dict:
     try:
         task = draw_task(arm, planner, seed)
     except Exception as error:  # the draw itself failed: a bug of the soak, a wrong row
+        reraise_interrupt(error)
         return soak_row(key, outcome="error", wrong=True, message=f"drawing the task: {failure_reason(error)}")
     began = time.perf_counter()
     try:
         return _planned(task, began)
     except Exception as error:  # anything the checks did not expect
+        reraise_interrupt(error)
         return soak_row(key, outcome="error", wrong=True, params=json.dumps(task.params),
                     message=f"{failure_reason(error)} | {traceback.format_exc(limit=-3)!r:.400}")
 

@@ -33,6 +33,7 @@ import numpy as np
 
 from drake_traj.bench.optimum import optimal_duration
 from drake_traj.bench.task_sets import Task, default_cell_checker, joint_waypoints
+from drake_traj.errors import reraise_interrupt
 from drake_traj.station import simulate
 from drake_traj.planners import (
     MovejConfig,
@@ -113,6 +114,7 @@ def run_planner(task: Task, name: str, build, keep_path: bool = False) -> dict:
     try:
         config = build(task.poses, joint_waypoints(task.q0, task.poses))
     except Exception as error:  # a run's failure is a row, not a lost task
+        reraise_interrupt(error)
         return {"row": failed_row(task.label, name, failure_reason(error)), "path": None}
     return _run(task.label, name, config, task.q0, task.repeats, keep_path)
 
@@ -141,6 +143,7 @@ def _run(label, name, config, q0, repeats, keep_path) -> dict:
         result = simulate(planner, name=name, settle_time=SETTLE_TIME, max_duration=MAX_DURATION, preflight=False)
         row = _row(label, name, result, planning, _optimal_duration(result))
     except Exception as error:  # a run's failure is a row, not a lost task
+        reraise_interrupt(error)
         return {"row": failed_row(label, name, failure_reason(error)), "path": None}
     path = result.q_ref[: np.searchsorted(result.t, result.duration) + 1] if keep_path and result.succeeded else None
     return {"row": row, "path": path}

@@ -8,7 +8,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import Diagram
 
 from drake_traj.cell.clearance import geometry_owner
-from drake_traj.errors import Cause, Failure
+from drake_traj.errors import Cause, Failure, interrupt_in
 from drake_traj.validation import callable_or_none, instance_of, invalid, run_duration, settle_duration
 
 __all__ = ["run_station"]
@@ -78,11 +78,14 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
             return None
         return Failure(Cause.TIMEOUT, f"planner did not finish within max_duration = {max_duration} s", root.get_time(),
                        tuple(planner.reference_state(planner_context)[: planner.num_joints].tolist()))
-    except KeyboardInterrupt as stop:  # the caller stops too, told where the run stopped
+    except (KeyboardInterrupt, Exception) as error:  # keep the log up to the failure; the reason goes in the result
+        stop = interrupt_in(error)
+        if stop is None:
+            return Failure.from_exception(error, root.get_time())
+        # Ctrl-C or SIGTERM (even one that came as compiled code returned): the caller stops too,
+        # told where the run stopped
         stop.failure = Failure(Cause.INTERRUPTED, f"interrupted at t = {root.get_time():.4f} s", root.get_time())
-        raise
-    except Exception as error:  # keep the log up to the failure; the reason goes in the result
-        return Failure.from_exception(error, root.get_time())
+        raise stop from None
 
 
 def contact_failure(station: Diagram, root_context) -> Failure | None:

@@ -25,7 +25,7 @@ from bisect import bisect_right
 import numpy as np
 import ruckig
 
-from drake_traj.errors import Cause, DrakeTrajError, joint_label
+from drake_traj.errors import Cause, DrakeTrajError, joint_label, reraise_interrupt
 from drake_traj.planners.base import waypoint_rows
 from drake_traj.planners.timing.limits import default_jerk_limit
 from drake_traj.validation import positive_vector
@@ -116,6 +116,7 @@ class RuckigStopLaw:
         try:
             result = otg.calculate(inp, trajectory)
         except Exception as exc:  # ruckig.RuckigError on invalid input
+            reraise_interrupt(exc)
             raise ValueError(f"Ruckig failed on {where}: {exc}") from exc
         if result not in (ruckig.Result.Working, ruckig.Result.Finished):
             raise ValueError(f"Ruckig failed on {where}: result {result}")
