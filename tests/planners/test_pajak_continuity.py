@@ -15,6 +15,7 @@ import pytest
 from drake_traj.bench import pajak_walk_tasks
 from drake_traj.planners import pajak as P
 from drake_traj.bench.soak_tasks import draw_task
+from drake_traj.errors import Cause, PlanningError
 from drake_traj.planners.pajak.system import coming_to_rest, stop_duration
 from drake_traj.planners.laws.hermite import quintic_hermite_coefficients
 from drake_traj.scenario import make_planner, preflight
@@ -123,6 +124,34 @@ def test_a_wandering_law_comes_to_rest_at_the_goal(seed, free_error):
     samples = np.stack([run[name][:end] for name in ("q", "qd", "qdd")], axis=1)
     unslowed = planner._within_limits(run["t"][:end], samples, run["c"][:end])[3]
     assert planner.planned_duration() == pytest.approx(run["T"] / unslowed, rel=1e-12)
+
+
+def test_a_law_that_wanders_far_after_its_finish_stops_back_where_it_finished():
+    # soak ur3e / pajak / 544: the law wanders 1.2 rad after its finish near a singular J; the
+    # undamped steps towards the goal led 49 rad away to another solution, and the stop there
+    # was refused as "no stop within the limits up to 8.4e8 s" (a plain ValueError). The steps
+    # are bounded now; they get within 1.5 mm (accuracy 1 mm), so the stop goes back to where the
+    # law finished, within accuracy.
+    task = draw_task("ur3e", "pajak", 544)
+    planner = make_planner(task.scenario)
+    plan, law, run = planner.plan(), planner.pajak_law, planner._run
+    q_end = plan.value(plan.end_time()).ravel()
+    finished = run["q"][np.searchsorted(run["t"], run["T"])]
+    np.testing.assert_allclose(q_end, finished, atol=1e-12)  # the plan evaluated at its end
+    assert np.abs(run["q"][planner._rest_index()] - finished).max() > 1.0  # it had wandered that far
+    position, orientation = law.kinematics.pose_error(task.scenario.robot_with_tool().tcp_pose(q_end), law.waypoints[-1])
+    assert position <= law.parameters.accuracy and orientation <= law.parameters.orientation_accuracy
+    np.testing.assert_allclose(plan.derivative(1).value(plan.end_time()).ravel(), 0.0, atol=1e-12)
+    times = np.linspace(0.0, plan.end_time(), 200_001)
+    within_limits(planner, plan.derivative(1).vector_values(times).T, plan.derivative(2).vector_values(times).T)
+
+
+def test_a_stop_that_no_duration_keeps_within_the_limits_is_refused_as_infeasible():
+    # a q̈ held against a long way to go: q̇ grows with the stop's duration, no T keeps it
+    qd, qdd = np.array([0.3, 0.0]), np.array([0.2, 0.0])
+    with pytest.raises(PlanningError, match="the stop after the finish finds no duration") as refused:
+        stop_duration(qd, qdd, np.array([-45.0, 0.0]), 1.0, 80.0, np.full(2, 0.4), np.full(2, 0.6))
+    assert refused.value.cause is Cause.INFEASIBLE
 
 
 def test_a_stop_to_a_fixed_end_keeps_the_limits_and_is_the_shortest_on_its_grid():
