@@ -126,19 +126,20 @@ def test_a_wandering_law_comes_to_rest_at_the_goal(seed, free_error):
     assert planner.planned_duration() == pytest.approx(run["T"] / unslowed, rel=1e-12)
 
 
-def test_a_law_that_wanders_far_after_its_finish_stops_back_where_it_finished():
-    # soak ur3e / pajak / 544: the law wanders 1.2 rad after its finish near a singular J; the
-    # undamped steps towards the goal led 49 rad away to another solution, and the stop there
-    # was refused as "no stop within the limits up to 8.4e8 s" (a plain ValueError). The steps
-    # are bounded now; they get within 1.5 mm (accuracy 1 mm), so the stop goes back to where the
-    # law finished, within accuracy.
-    task = draw_task("ur3e", "pajak", 544)
+@pytest.mark.parametrize("arm, seed", [("ur3e", 544), ("ur10e", 336), ("ur10e", 1400), ("ur10e", 1701)])
+def test_a_law_that_wanders_far_after_its_finish_stops_back_where_it_finished(arm, seed):
+    # soak tasks whose law wanders 0.3-1.2 rad after its finish near a singular J. The Gauss-Newton
+    # steps towards the goal from the stop's free end got no nearer than 1.66 mm (336) and 3.57
+    # mm (1400), and the plan ended there, reported good (accuracy 1 mm: silent wrong); on 544 (49
+    # rad away, to another solution) and 1701 they led so far that the stop was refused as "no stop
+    # within the limits up to 8.4e8 s" (3.7e8 s; a plain ValueError). The steps are bounded now, and where
+    # they do not get within accuracy the stop goes back to where the law finished, within it.
+    task = draw_task(arm, "pajak", seed)
     planner = make_planner(task.scenario)
     plan, law, run = planner.plan(), planner.pajak_law, planner._run
     q_end = plan.value(plan.end_time()).ravel()
     finished = run["q"][np.searchsorted(run["t"], run["T"])]
     np.testing.assert_allclose(q_end, finished, atol=1e-12)  # the plan evaluated at its end
-    assert np.abs(run["q"][planner._rest_index()] - finished).max() > 1.0  # it had wandered that far
     position, orientation = law.kinematics.pose_error(task.scenario.robot_with_tool().tcp_pose(q_end), law.waypoints[-1])
     assert position <= law.parameters.accuracy and orientation <= law.parameters.orientation_accuracy
     np.testing.assert_allclose(plan.derivative(1).value(plan.end_time()).ravel(), 0.0, atol=1e-12)
