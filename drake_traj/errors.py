@@ -23,7 +23,7 @@ import numpy as np
 
 __all__ = [
     "Cause", "DrakeTrajError", "Failure", "Field", "PlanningError", "SingularConfigurationError", "UnreachablePoseError",
-    "did_you_mean", "field_text", "interrupt_in", "joint_label", "reraise_interrupt",
+    "did_you_mean", "field_text", "in_chain", "interrupt_in", "joint_label", "reraise_interrupt",
 ]
 
 Field = tuple  # tuple[str | int, ...]: field names and list indices, outermost first
@@ -88,19 +88,26 @@ def did_you_mean(word, known, *, tags: bool = False) -> str:
     return f"did you mean {close[0] if len(close) == 1 else ', '.join(close[:-1]) + ' or ' + close[-1]}?"
 
 
-def interrupt_in(error: BaseException) -> KeyboardInterrupt | None:
-    """The KeyboardInterrupt (Ctrl-C, or SIGTERM as the command line raises it) that is ``error``
-    or lies behind it, else None. A signal handled as compiled code returns to Python (numba's
-    dispatcher) surfaces as a SystemError ("returned a result with an exception set") whose cause
-    or context is the KeyboardInterrupt: whatever catches ``Exception`` to keep a failure as a
-    result re-raises this instead, so that the stop stops."""
+def in_chain(error: BaseException | None, kind: type):
+    """The first exception of type ``kind`` among ``error`` and the errors behind it (each one's
+    ``__cause__``, else its ``__context__``, even one ``raise ... from None`` hides: a
+    :meth:`DrakeTrajError.relocated` copy raised so has the error it copies there), or None."""
     seen = set()
     while error is not None and id(error) not in seen:
-        if isinstance(error, KeyboardInterrupt):
+        if isinstance(error, kind):
             return error
         seen.add(id(error))
         error = error.__cause__ or error.__context__
     return None
+
+
+def interrupt_in(error: BaseException) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt (Ctrl-C, or SIGTERM as the command line raises it) that is ``error``
+    or lies behind it (:func:`in_chain`), else None. A signal handled as compiled code returns to
+    Python (numba's dispatcher) surfaces as a SystemError ("returned a result with an exception
+    set") whose cause is the KeyboardInterrupt: whatever catches ``Exception`` to keep a failure
+    as a result re-raises this instead, so that the stop stops."""
+    return in_chain(error, KeyboardInterrupt)
 
 
 def reraise_interrupt(error: BaseException) -> None:

@@ -32,6 +32,16 @@ def pytest_collection_modifyitems(items):
     items.sort(key=lambda item: rank.get(item.path, len(rank)))
 
 
+def interrupt_inside_compiled_code(*_):
+    """Raise what a Ctrl-C or SIGTERM handled as numba's compiled code returns raises: a
+    SystemError ("returned a result with an exception set") caused by the KeyboardInterrupt.
+    Takes and ignores any arguments, to stand in for a function."""
+    try:
+        raise KeyboardInterrupt
+    except KeyboardInterrupt as stop:
+        raise SystemError("CPUDispatcher(<function kernel>) returned a result with an exception set") from stop
+
+
 def made_once(tmp_path_factory, name: str, make) -> Path:
     """The folder ``name`` filled by ``make(folder)`` once per test session, read-only for the
     tests. The workers of a parallel run share it: the first to ask makes it while the others

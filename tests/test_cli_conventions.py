@@ -29,7 +29,7 @@ from drake_traj.robots.custom import robot_label
 from drake_traj.scenario import Scenario, load_scenario, make_planner, shipped_scenarios
 from drake_traj.station import build_station, run_station, simulate
 
-from conftest import DIAGRAMS
+from conftest import DIAGRAMS, interrupt_inside_compiled_code
 
 PROGRESS_LINE = re.compile(r"^drake-traj (run|bench): ")
 
@@ -266,15 +266,6 @@ def test_ctrl_c_in_run_station_raises_with_the_failure_and_the_log_in_the_logger
     assert not hasattr(caught.value, "result") and caught.value.failure.cause is Cause.INTERRUPTED
     result = SimulationResult.from_station(station, simulator.get_context(), failure=caught.value.failure)
     assert result.t[-1] == pytest.approx(caught.value.failure.time, abs=2e-3)
-
-
-def interrupt_inside_compiled_code():
-    """The SystemError that a Ctrl-C or SIGTERM handled as numba's compiled code returns raises:
-    "returned a result with an exception set", its cause the KeyboardInterrupt."""
-    try:
-        raise KeyboardInterrupt
-    except KeyboardInterrupt as stop:
-        raise SystemError("CPUDispatcher(<function kernel>) returned a result with an exception set") from stop
 
 
 def test_an_interrupt_that_came_as_compiled_code_returned_is_found_and_raised():

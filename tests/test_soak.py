@@ -19,8 +19,10 @@ from drake_traj.bench.soak_checks import (ClearanceCheck, dense_rates, diagnose,
 from drake_traj.bench.soak_suite import CLOSED_LOOP_EVERY, _check_plan
 from drake_traj.bench.soak_tasks import draw_task
 from drake_traj.cell import Box, Cell, CellChecker, CollisionError
-from drake_traj.errors import Cause, DrakeTrajError, UnreachablePoseError
+from drake_traj.errors import Cause, DrakeTrajError, UnreachablePoseError, in_chain
 from drake_traj.robots import UR10E
+
+from conftest import interrupt_inside_compiled_code
 from drake_traj.scenario.checks import preflight
 from drake_traj.scenario.scenario import make_planner
 
@@ -187,6 +189,33 @@ def test_an_unreachable_pose_is_diagnosed_by_drakes_inverse_kinematics(arm):
     assert diagnose(DrakeTrajError("branch", cause=Cause.UNREACHABLE), robot, check, 0.01) == "not diagnosed"
 
 
+def test_a_task_refused_as_unreachable_gets_drakes_diagnosis():
+    # soak ur3e / li / 3: the wrist centre of points[18] is 0.126 m from the joint-1 axis, inside
+    # the shoulder offset d4 = 0.131 m; Drake's IK gets no nearer than 5.46 mm
+    row = run_soak_task("ur3e", "li", 3)
+    assert row["outcome"] == "refused" and row["cause"] == "unreachable" and not row["wrong"]
+    assert row["diagnosis"].startswith("supported: Drake's InverseKinematics, from 32 starts within the joint ranges, "
+                                       "comes no closer than 5.46 mm")
+
+
+def test_the_unreachable_pose_is_found_behind_what_a_planner_made_of_it():
+    far = np.eye(4)
+    far[:3, 3] = [4.0, 0.0, 1.0]
+    try:
+        try:
+            UR10E.inverse_kinematics_all(far)
+        except DrakeTrajError as error:  # a planner's own refusal, then relocated as a scenario does
+            raise DrakeTrajError(f"pose 0 cannot be reached: {error}", field=("poses", 0),
+                                 cause=Cause.UNREACHABLE) from error
+    except DrakeTrajError as refusal:
+        try:
+            raise refusal.relocated(("planner", "poses", 0), f"planner.poses[0]: {refusal}") from None
+        except DrakeTrajError as relocated:
+            found = in_chain(relocated, UnreachablePoseError)
+    assert isinstance(found, UnreachablePoseError) and np.array_equal(found.pose, far)
+    assert in_chain(DrakeTrajError("no pose behind it", cause=Cause.UNREACHABLE), UnreachablePoseError) is None
+
+
 def _task_pose(X) -> np.ndarray:
     """[x, y, z, φ_X, φ_Y, φ_Z] of the 4x4 pose ``X`` (Z-Y-X Euler angles, Drake's RollPitchYaw)."""
     return np.concatenate([X[:3, 3], RollPitchYaw(RotationMatrix(X[:3, :3])).vector()])
@@ -194,13 +223,8 @@ def _task_pose(X) -> np.ndarray:
 
 def test_a_stop_inside_a_task_stops_the_soak(monkeypatch):
     """Ctrl-C or SIGTERM while a task runs compiled code (Pająk's integration) surfaces as a
-    SystemError: the soak stops on it (and writes what it finished), never takes it for a task's error."""
-    def preflight_interrupted(scenario, planner):
-        try:
-            raise KeyboardInterrupt
-        except KeyboardInterrupt as stop:
-            raise SystemError("CPUDispatcher(<function integrate_kernel>) returned a result with an exception set") from stop
-    monkeypatch.setattr(soak_suite, "preflight", preflight_interrupted)
+    SystemError: the task raises the interrupt (which stops the soak), never a row of a task's error."""
+    monkeypatch.setattr(soak_suite, "preflight", interrupt_inside_compiled_code)
     with pytest.raises(KeyboardInterrupt):
         run_soak_task("ur10e", "quintic", 3)
     monkeypatch.setattr(soak_suite, "preflight", lambda scenario, planner: 1 / 0)  # a bug of its own: a wrong row

@@ -37,10 +37,10 @@ from pydrake.solvers import IpoptSolver, SnoptSolver, Solve, SolverOptions
 
 from drake_traj.bench.free_suite import ClearanceProbe
 from drake_traj.cell import shape_radius
-from drake_traj.errors import UnreachablePoseError
+from drake_traj.errors import UnreachablePoseError, in_chain
 
 __all__ = ["ClearanceCheck", "LIMIT_TOLERANCE", "axis_reach", "dense_rates", "diagnose", "piece_coefficients", "pose_error",
-           "rate_peaks", "reach_diagnosis", "tool_rates"]
+           "rate_peaks", "reach_diagnosis", "rotation_angle", "tool_rates"]
 
 DENSE_PERIOD = 1e-4  # [s] between two samples of the limits' check
 CLEARANCE_PERIOD = 1e-3  # [s] the finest interval the clearance check halves to
@@ -226,6 +226,15 @@ class ClearanceCheck:
                 "queries": len(distances)}
 
 
+def rotation_angle(R_a, R_b) -> float:
+    """The angle [rad] of the rotation between the 3x3 rotation matrices ``R_a`` and ``R_b``:
+    atan2(|vee(E - Eᵀ)| / 2, (tr E - 1) / 2) with E = R_aᵀ R_b, exact to round-off at every angle
+    (arccos of the trace alone cannot tell angles below about 1.5e-8 rad from 0)."""
+    E = np.asarray(R_a).T @ np.asarray(R_b)
+    sine = 0.5 * np.linalg.norm([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]])
+    return float(np.arctan2(sine, (np.trace(E) - 1.0) / 2.0))
+
+
 def pose_error(checker, robot, q, goal) -> tuple[float, float]:
     """(position error [m], orientation error [rad]) of the TCP at ``q`` against the task pose
     ``goal`` [x, y, z, φ_X, φ_Y, φ_Z] (Z-Y-X Euler angles: Drake's RollPitchYaw(φ_X, φ_Y, φ_Z)),
@@ -237,8 +246,7 @@ def pose_error(checker, robot, q, goal) -> tuple[float, float]:
     X_WF = plant.GetFrameByName(robot.tool_frame, checker.instance).CalcPoseInWorld(context)
     X_WT = X_WF.GetAsMatrix4() @ robot.tcp_offset
     R_goal = RollPitchYaw(np.asarray(goal[3:6], dtype=float)).ToRotationMatrix().matrix()
-    turn = np.clip((np.trace(R_goal.T @ X_WT[:3, :3]) - 1) / 2, -1.0, 1.0)
-    return float(np.linalg.norm(X_WT[:3, 3] - np.asarray(goal[:3]))), float(np.arccos(turn))
+    return float(np.linalg.norm(X_WT[:3, 3] - np.asarray(goal[:3]))), rotation_angle(R_goal, X_WT[:3, :3])
 
 
 def tool_rates(checker, robot, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
@@ -271,7 +279,7 @@ def diagnose(error, robot, clearance: ClearanceCheck, cell_clearance: float) -> 
     check refuses on the smaller of SceneGraph's distance and a certified lower bound, and
     SceneGraph's distance of cylinders and boxes can be millimetres above the true one), or further
     (contradicted). A joint range: the joint is past its range in the refused configuration. An
-    unreachable pose: :func:`reach_diagnosis` (supported or contradicted)."""
+    unreachable pose: :func:`reach_diagnosis` (supported, borderline or contradicted)."""
     cause = str(getattr(error, "cause", ""))
     if cause == "collision" and getattr(error, "configuration", None) is not None:
         distance = clearance.distance(error.configuration)
@@ -288,23 +296,14 @@ def diagnose(error, robot, clearance: ClearanceCheck, cell_clearance: float) -> 
             return "confirmed"
         return f"contradicted: joint {j + 1} at {value:.6f} is inside [{robot.lower_limits[j]:.6f}, {robot.upper_limits[j]:.6f}]"
     if cause == "unreachable":
-        pose = _refused_pose(error)
-        return "not diagnosed" if pose is None else reach_diagnosis(clearance.probe.checker, robot, pose)
+        refused = in_chain(error, UnreachablePoseError)  # the arm's IK error, or what a planner made of it
+        return "not diagnosed" if refused is None else reach_diagnosis(clearance.probe.checker, robot, refused.pose)
     return "not diagnosed"
 
 
-def _refused_pose(error):
-    """The flange pose (4, 4) of the :class:`~drake_traj.errors.UnreachablePoseError` that is
-    ``error`` or caused it, or None."""
-    while error is not None:
-        if isinstance(error, UnreachablePoseError):
-            return error.pose
-        error = error.__cause__ or error.__context__
-    return None
-
-
 def reach_diagnosis(checker, robot, pose, starts: int = IK_STARTS) -> str:
-    """Whether the flange pose X_WF ``pose`` (4, 4) [m], refused as out of reach, is out of reach of
+    """Whether the flange pose X_WF ``pose`` (4, 4) [m] (the arm's base is welded at the world
+    origin, so an :class:`~drake_traj.errors.UnreachablePoseError`'s X_BF), refused as out of reach, is out of reach of
     Drake's InverseKinematics in the cell check ``checker``'s plant: the flange frame's position
     and orientation costs minimised within the plant's joint limits (SNOPT, or IPOPT, to an
     optimality tolerance of 1e-12) from ``starts`` seeded uniform starts within the robot's ranges,
@@ -332,7 +331,7 @@ def reach_diagnosis(checker, robot, pose, starts: int = IK_STARTS) -> str:
         plant.SetPositions(context, checker.instance, q)
         X_WF = flange.CalcPoseInWorld(context).GetAsMatrix4()
         position = float(np.linalg.norm(X_WF[:3, 3] - pose[:3, 3]))
-        turn = float(np.arccos(np.clip((np.trace(pose[:3, :3].T @ X_WF[:3, :3]) - 1) / 2, -1.0, 1.0)))
+        turn = rotation_angle(pose[:3, :3], X_WF[:3, :3])
         if max(position, turn) < max(closest[:2]):
             closest = (position, turn, q)
         if max(position, turn) <= IK_REACHED:

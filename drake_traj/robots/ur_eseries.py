@@ -263,8 +263,8 @@ class URArm(Robot):
         wrist) signs, see :meth:`ik_branch`); branches without a real solution are left out, and solutions that coincide
         (at a shoulder or elbow singularity) are listed once.
 
-        Raises ValueError naming the pose and the reason (distances) when no branch reaches the pose,
-        and SingularConfigurationError at a wrist singularity (sin q5 = 0: a continuum of solutions).
+        Raises UnreachablePoseError (a ValueError; its ``pose`` the flange pose) naming the pose and
+        the reason (distances) when no branch reaches the pose, and SingularConfigurationError at a wrist singularity (sin q5 = 0: a continuum of solutions).
         """
         pose = flange_goal(pose, tool)
         solutions, _, flags = branch_solutions(self.model, self.data.title, pose, singular_tol)
@@ -300,8 +300,9 @@ class URArm(Robot):
         With neither, the first branch of ``IK_BRANCHES`` (:mod:`~drake_traj.robots.ur_ik`) that has a
         solution.
 
-        Raises ValueError naming the pose and the reason (distances) when the pose (or the requested
-        branch) is out of reach; SingularConfigurationError at a wrist singularity (sin q5 = 0; for
+        Raises UnreachablePoseError (a ValueError; its ``pose`` the flange pose) naming the pose and the
+        reason (distances) when the pose is out of reach, a DrakeTrajError (cause UNREACHABLE) when
+        the requested branch is; SingularConfigurationError at a wrist singularity (sin q5 = 0; for
         ``branch``, of that shoulder branch), and at a shoulder (wrist centre on the cylinder of
         radius d4 about the joint-1 axis) or elbow (sin q3 = 0) singularity when ``branch`` asks for a
         shoulder or elbow sign, which is undefined there.

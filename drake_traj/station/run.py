@@ -8,7 +8,7 @@ from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import Diagram
 
 from drake_traj.cell.clearance import geometry_owner
-from drake_traj.errors import Cause, Failure, interrupt_in
+from drake_traj.errors import Cause, Failure, interrupt_in, reraise_interrupt
 from drake_traj.validation import callable_or_none, instance_of, invalid, run_duration, settle_duration
 
 __all__ = ["run_station"]
@@ -59,7 +59,11 @@ def run_station(simulator: Simulator, station: Diagram, *, settle_time: float = 
     guard = planner.guard
     watch = None
     if guard is not None:
-        guard.ensure_checked(planner, max_duration)  # a refusal raised before the motion
+        try:
+            guard.ensure_checked(planner, max_duration)  # a refusal raised before the motion
+        except Exception as error:
+            reraise_interrupt(error)  # a Ctrl-C during the check (e.g. Pająk's compiled integration) stops as one
+            raise
         watch = guard.watch(station.GetSubsystemByName("measured_logger"), root, planner.num_joints)
     chunk = min(0.01, max(settle_time, 1e-3))  # the finish and contact are checked between chunks
     end = max_duration

@@ -119,7 +119,7 @@ class FreeMotionPlanner(TimeLawPlanner):
                 solutions = np.atleast_2d(kinematics.inverse_kinematics_all(pose))
             except ValueError as error:
                 raise DrakeTrajError(f"pose {k} cannot be reached: {error}", field=("poses", k),
-                                     cause=Cause.UNREACHABLE) from None
+                                     cause=Cause.UNREACHABLE) from error
             yield solutions
 
     def _check_range(self, q, field_: tuple) -> None:

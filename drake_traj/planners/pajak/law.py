@@ -245,9 +245,11 @@ class PajakLaw:
             except SingularConfigurationError:
                 continue
             except ValueError as exc:
-                return PlanningError(f"waypoint {k} cannot be reached: {exc}", time=0.0,
-                                     configuration=np.array(q0, dtype=float), cause=Cause.UNREACHABLE,
-                                     field=("waypoints", k))
+                failure = PlanningError(f"waypoint {k} cannot be reached: {exc}", time=0.0,
+                                        configuration=np.array(q0, dtype=float), cause=Cause.UNREACHABLE,
+                                        field=("waypoints", k))
+                failure.__cause__ = exc  # raised later, by the caller: the IK's error stays behind it
+                return failure
         return None
 
     def finished(self, q, qd, discrete) -> bool:
