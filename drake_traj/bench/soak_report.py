@@ -242,7 +242,7 @@ def soak_bench(out_dir, *, count: int = 10, seed: int = 0, arms=SOAK_ARMS, plann
                         failed=lambda row: row["wrong"])
         by_task = {}
         try:
-            # a local cluster is made afresh for every LOCAL_CHUNK tasks (what pydrake leaks: _release)
+            # a local cluster is made afresh for every LOCAL_CHUNK tasks (what pydrake leaks: release_system)
             size = len(work) if scheduler is not None else LOCAL_CHUNK
             for first in range(0, len(work), size):
                 with _engine(workers, scheduler) as client:

@@ -35,6 +35,7 @@ from drake_traj.bench.soak_checks import (DENSE_PERIOD, LIMIT_TOLERANCE, Clearan
 from drake_traj.bench.soak_tasks import draw_task
 from drake_traj.bench.units import failure_reason
 from drake_traj.errors import DrakeTrajError, field_text, reraise_interrupt
+from drake_traj.planners import release_system
 from drake_traj.scenario import check_planned_duration, make_planner, preflight
 from drake_traj.station import simulate
 
@@ -85,7 +86,7 @@ def run_soak_task(arm: str, planner: str, seed: int) -> dict:
 def _planned(task, began) -> dict:
     """Plan ``task`` as ``drake-traj run`` does (the scenario checked, its planner made, the
     preflight, the planned duration against ``max_duration``), then check the plan or the refusal.
-    The planner is emptied afterwards (:func:`_release`)."""
+    The planner is emptied afterwards (:func:`~drake_traj.planners.release_system`)."""
     key = (task.arm, task.planner, task.seed)
     scenario = task.scenario
     planner = None
@@ -95,12 +96,12 @@ def _planned(task, began) -> dict:
         preflight(scenario, planner)
         check_planned_duration(scenario, planner)
     except ValueError as error:
-        _release(planner)
+        release_system(planner)
         return _refused(task, key, error, began)
     planning = time.perf_counter() - began
     checked = time.perf_counter()
     values, wrongs = _check_plan(task, planner)
-    _release(planner)
+    release_system(planner)
     if task.seed % CLOSED_LOOP_EVERY == 0:
         values["closed_loop"] = _closed_loop(scenario)
         if values["closed_loop"] != "succeeded":
@@ -108,15 +109,6 @@ def _planned(task, began) -> dict:
     return soak_row(key, outcome="planned", silent_wrong=bool(wrongs), wrong=bool(wrongs), message="; ".join(wrongs),
                     planning_s=planning, check_s=time.perf_counter() - checked, params=json.dumps(task.params),
                     **values)
-
-
-def _release(planner) -> None:
-    """Drop what ``planner`` holds (its law, plan, checked scenes): pydrake 1.51 never frees a
-    LeafSystem written in Python (its ports and callbacks hold it through references Python's
-    collector cannot follow), so each planner would stay in a soak worker's memory whole, 1-12 MB
-    (measured: two workers at 10 GB after 7,000 tasks); emptied, it leaves its C++ shell."""
-    if planner is not None:
-        vars(planner).clear()
 
 
 def _refused(task, key, error, began) -> dict:

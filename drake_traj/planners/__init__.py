@@ -31,7 +31,7 @@ from __future__ import annotations
 from typing import Union
 
 from drake_traj.planners import boryga, free, li, pajak, quintic, smooth
-from drake_traj.planners.base import PlannerSystem, planner_robot
+from drake_traj.planners.base import PlannerSystem, planner_robot, release_system
 from drake_traj.planners.baselines import MovejConfig, RuckigConfig, ToppraConfig, movej, ruckig, toppra
 from drake_traj.planners.boryga import BorygaConfig
 from drake_traj.planners.free import FreeMotionConfig
@@ -45,6 +45,7 @@ from drake_traj.validation import finite_array, instance_of
 __all__ = [
     "BorygaConfig", "FreeMotionConfig", "LiConfig", "MovejConfig", "PLANNER_CONFIGS", "PajakConfig", "PlannerConfig", "PlannerSystem",
     "QuinticConfig", "RetimedPajakConfig", "RuckigConfig", "SmoothWaypointsConfig", "ToppraConfig", "make_planner",
+    "release_system",
 ]
 
 # Each config type and the ``make(config, robot, q_initial)`` that builds its planner.

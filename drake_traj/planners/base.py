@@ -497,6 +497,16 @@ class TimeLawPlanner(PlannerSystem):
         return EventStatus.Succeeded()
 
 
+def release_system(system: LeafSystem | None) -> None:
+    """Drop what the Python LeafSystem ``system`` holds (its planner's law, plan, preflight log):
+    pydrake 1.51 never frees a LeafSystem written in Python (its ports and callbacks hold it
+    through references Python's collector cannot follow), so one that is done with would stay in
+    memory whole (a Pająk planner behind a re-timed path: about 50 MB); emptied, it leaves its
+    C++ shell. The system must not be used afterwards. None: nothing to do."""
+    if system is not None:
+        vars(system).clear()
+
+
 def planner_robot(robot: Robot, num_joints: int) -> Robot:
     """``robot``, the robot a planner of ``num_joints`` joints runs on; TypeError or ValueError
     naming ``robot`` when it is not a Robot or has another number of joints."""

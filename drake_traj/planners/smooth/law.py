@@ -6,6 +6,7 @@ passing them (:func:`waypoints_timing`), and the joint path of Pająk 2024's pre
 import numpy as np
 
 from drake_traj.errors import Cause, DrakeTrajError, joint_label
+from drake_traj.planners.base import release_system
 from drake_traj.planners.pajak import PajakConfig, PajakPlanner
 from drake_traj.planners.timing import (MAX_GRID_POINTS, SmoothTiming, line_timing, stop_timing, time_path,
                                         waypoint_path)
@@ -84,11 +85,18 @@ def waypoints_timing(q, limits, grid_points, robot: Robot) -> SmoothTiming:
 def pajak_joint_path(config: PajakConfig, robot: Robot, q_initial) -> np.ndarray:
     """The joint samples [rad] (N, n) of the Pająk planner's planned motion (its preflight, one
     sample per update period up to the finish), the path the re-timed planner times."""
-    return pajak_samples(PajakPlanner(config, q_initial, robot=robot))
+    return pajak_samples(PajakPlanner(config, q_initial, robot=robot))[0]
 
 
-def pajak_samples(planner: PajakPlanner) -> np.ndarray:
-    """The planned motion's samples up to the task's finish (not the law's settling after it)."""
-    plan = planner.plan()
-    times = np.asarray(plan.get_segment_times())
-    return plan.vector_values(times[times <= planner.planned_duration() + 1e-12]).T
+def pajak_samples(planner: PajakPlanner) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(samples [rad] (N, n), velocity limit [rad/s] (n,), acceleration limit [rad/s²] (n,)): the
+    Pająk ``planner``'s planned motion up to the task's finish (not the law's settling after it),
+    and the limits it kept. The planner is released afterwards (:func:`release_system`), whether
+    it planned or raised: it must not be used again."""
+    try:
+        plan = planner.plan()
+        times = np.asarray(plan.get_segment_times())
+        samples = plan.vector_values(times[times <= planner.planned_duration() + 1e-12]).T
+        return samples, np.asarray(planner.velocity_limit), np.asarray(planner.acceleration_limit)
+    finally:
+        release_system(planner)

@@ -61,9 +61,8 @@ def make_retimed_pajak(config: RetimedPajakConfig, robot: Robot, q_initial) -> S
     """The planner of ``config`` on ``robot`` from ``q_initial`` [rad]: raises what the Pająk
     preflight raises (an unreachable waypoint, a stall, ...) and what the timing raises."""
     config.validate(robot)
-    pajak = PajakPlanner(config.pajak, q_initial, robot=robot)
-    samples = pajak_samples(pajak)
-    limits = jerk_limited_limits(robot, pajak.velocity_limit, pajak.acceleration_limit,
+    samples, velocity_limit, acceleration_limit = pajak_samples(PajakPlanner(config.pajak, q_initial, robot=robot))
+    limits = jerk_limited_limits(robot, velocity_limit, acceleration_limit,
                                  config.jerk_limit)  # the limits the Pająk planner kept
     timing = timed(samples, "pajak", limits,
                    whole_number(config.grid_points, "grid_points", minimum=20, maximum=MAX_GRID_POINTS))
